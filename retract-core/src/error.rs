@@ -1,0 +1,90 @@
+//! The one error type of the runtime.
+
+use core::fmt;
+
+/// Why a solve or a step failed.
+///
+/// Every variant carries the data needed to act on it; the [`Display`](fmt::Display)
+/// text says what went wrong and what to try.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// A NaN or infinite value appeared in `location` ("initial guess", "residual",
+    /// "Jacobian", "Newton step", ...) at Newton iteration `iteration` (0 = before the
+    /// first iteration).
+    NonFinite {
+        /// Newton iteration at which the value appeared.
+        iteration: usize,
+        /// The quantity that was not finite.
+        location: &'static str,
+    },
+    /// The Newton matrix had a zero pivot (or its solve overflowed) at `iteration`.
+    SingularJacobian {
+        /// Newton iteration at which the factorisation failed.
+        iteration: usize,
+    },
+    /// The iteration cap was reached; `residual_norm` is max|F| at the last iterate.
+    NoConvergence {
+        /// Newton iterations performed.
+        iterations: usize,
+        /// max-norm of the residual at the last iterate.
+        residual_norm: f64,
+    },
+    /// Backtracking could not decrease |F|^2 along the Newton direction.
+    LineSearchFailed {
+        /// Newton iteration whose line search failed.
+        iteration: usize,
+        /// max-norm of the residual at the last accepted iterate.
+        residual_norm: f64,
+    },
+    /// An argument was outside its domain, e.g. theta outside [0, 1] or a non-finite step.
+    InvalidArgument {
+        /// Name of the argument.
+        name: &'static str,
+        /// What is required of it.
+        requirement: &'static str,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Error::NonFinite {
+                iteration,
+                location,
+            } => write!(
+                f,
+                "non-finite value in the {location} at Newton iteration {iteration}: \
+                 check the inputs and parameters for NaN/inf and that the state is inside \
+                 the domain of the Lagrangian"
+            ),
+            Error::SingularJacobian { iteration } => write!(
+                f,
+                "singular Newton matrix at iteration {iteration}: the Lagrangian may be \
+                 degenerate in the top derivative (d2L/du2 not invertible) or the step too large"
+            ),
+            Error::NoConvergence {
+                iterations,
+                residual_norm,
+            } => write!(
+                f,
+                "Newton did not converge in {iterations} iterations (last residual max-norm \
+                 {residual_norm:e}): reduce the step size or raise the iteration cap"
+            ),
+            Error::LineSearchFailed {
+                iteration,
+                residual_norm,
+            } => write!(
+                f,
+                "line search failed at Newton iteration {iteration} (residual max-norm \
+                 {residual_norm:e}): the Newton direction does not decrease the residual; \
+                 reduce the step size"
+            ),
+            Error::InvalidArgument { name, requirement } => {
+                write!(f, "invalid argument `{name}`: {requirement}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {}

@@ -1,0 +1,45 @@
+//! Runtime of `retract`: the traits a generated higher-order system implements, a damped
+//! Newton solver, the lifted theta-scheme step, trajectories and structure diagnostics.
+//!
+//! A $k$-th order Lagrangian $L(q, \dots, q^{(k)})$ on $\mathbb{R}^n$ gives, through the
+//! Ostrogradsky construction, a Hamiltonian system on $z = (x, p) \in \mathbb{R}^{2nk}$.
+//! The lifted midpoint ($\theta = 1/2$) or theta-scheme with step $h$ is
+//!
+//! $$x_1 - x_0 = h\,\partial_p H(x_\theta, p_\theta), \quad
+//!   p_1 - p_0 = -h\,\partial_x H(x_\theta, p_\theta),$$
+//! $$x_\theta = (1-\theta) x_0 + \theta x_1, \quad p_\theta = \theta p_0 + (1-\theta) p_1,$$
+//!
+//! symplectic for every $\theta \in [0, 1]$, of order 2 for $\theta = 1/2$ and 1 otherwise.
+//! It is solved without inverting the Legendre map, with the top derivative $u = q^{(k)}$
+//! as an extra unknown ([`LiftedSystem`]).
+//!
+//! - [`Lagrangian`] and [`LiftedSystem`]: what a system provides ([`system`]);
+//!   [`lifted`] assembles the scheme from a [`Lagrangian`].
+//! - [`newton`]: the solver; [`step`](mod@step): one step and trajectories;
+//!   [`diagnostics`]: energy, symplecticity, drift, RK4.
+//! - [`models`]: a system written by hand.
+//!
+//! # References
+//! A. Anahory Simoes, M. Barbero Liñán, L. Colombo, D. Martín de Diego,
+//! "Higher-order retraction maps and construction of numerical methods for optimal control
+//! of mechanical systems" (Prop. 4.1, Prop. 5.1, Sec. 6).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod diagnostics;
+mod error;
+pub mod lifted;
+pub mod linalg;
+pub mod models;
+pub mod newton;
+pub mod step;
+pub mod system;
+
+pub use error::Error;
+pub use newton::NewtonOptions;
+pub use step::{Interrupted, StepOptions, StepReport, Trajectory, step, trajectory};
+pub use system::{Gradient, Hessian, Lagrangian, LiftedSystem};
+
+/// The linear-algebra crate of the public API, re-exported so users and generated code
+/// name the same version.
+pub use nalgebra;

@@ -1,0 +1,282 @@
+//! Damped Newton's method on statically sized systems.
+//!
+//! Solves $F(w) = 0$, $F: \mathbb{R}^M \to \mathbb{R}^M$, by
+//! $w \leftarrow w + \alpha \Delta$ with $J(w) \Delta = -F(w)$, where the step length
+//! $\alpha \in \{1, 1/2, 1/4, \dots\}$ is the first that satisfies the Armijo condition on
+//! $\phi = \tfrac12 |F|^2$:
+//! $\phi(w + \alpha\Delta) \le (1 - 2 c \alpha)\, \phi(w)$.
+//! A trial point whose residual is not finite is treated as a failed decrease, so the line
+//! search backs away from singularities of the Lagrangian.
+//!
+//! Convergence (max-norms):
+//! - residual: $|F(w)|_\infty \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty$, or
+//! - step: $|\Delta|_\infty \le \text{step\_abs} + \text{step\_rel}\,|w|_\infty$ (the step is
+//!   then applied, so the returned iterate carries the quadratic-convergence gain).
+//!
+//! Nothing here allocates or panics.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Error;
+
+/// A square nonlinear system $F(w) = 0$ with its Jacobian $J = \partial F / \partial w$.
+pub trait Problem<const M: usize> {
+    /// The residual $F(w)$.
+    fn residual(&self, w: &SVector<f64, M>) -> SVector<f64, M>;
+    /// The Jacobian $J(w) = \partial F / \partial w$.
+    fn jacobian(&self, w: &SVector<f64, M>) -> SMatrix<f64, M, M>;
+}
+
+/// Options of [`solve`]. Build with [`NewtonOptions::default`] and the `with_*` methods.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct NewtonOptions {
+    /// Absolute tolerance on $|F|_\infty$.
+    pub residual_abs: f64,
+    /// Tolerance on $|F|_\infty$ relative to the initial residual.
+    pub residual_rel: f64,
+    /// Absolute tolerance on the Newton step $|\Delta|_\infty$.
+    pub step_abs: f64,
+    /// Tolerance on $|\Delta|_\infty$ relative to $|w|_\infty$.
+    pub step_rel: f64,
+    /// Maximum number of Newton iterations (Jacobian factorisations).
+    pub max_iterations: usize,
+    /// Armijo constant $c$ of the sufficient-decrease test.
+    pub armijo: f64,
+    /// Maximum number of step halvings per iteration.
+    pub max_backtracks: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            residual_abs: 1e-14,
+            residual_rel: 0.0,
+            step_abs: 1e-15,
+            step_rel: 1e-10,
+            max_iterations: 50,
+            armijo: 1e-4,
+            max_backtracks: 30,
+        }
+    }
+}
+
+impl NewtonOptions {
+    /// Sets the absolute and relative residual tolerances.
+    pub fn with_residual_tolerance(mut self, abs: f64, rel: f64) -> Self {
+        self.residual_abs = abs;
+        self.residual_rel = rel;
+        self
+    }
+
+    /// Sets the absolute and relative step tolerances.
+    pub fn with_step_tolerance(mut self, abs: f64, rel: f64) -> Self {
+        self.step_abs = abs;
+        self.step_rel = rel;
+        self
+    }
+
+    /// Sets the iteration cap.
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+
+    /// Checks every option is in its domain.
+    pub fn validate(&self) -> Result<(), Error> {
+        let tolerances = [
+            ("residual_abs", self.residual_abs),
+            ("residual_rel", self.residual_rel),
+            ("step_abs", self.step_abs),
+            ("step_rel", self.step_rel),
+        ];
+        for (name, value) in tolerances {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::InvalidArgument {
+                    name,
+                    requirement: "a tolerance must be finite and >= 0",
+                });
+            }
+        }
+        if self.max_iterations == 0 {
+            return Err(Error::InvalidArgument {
+                name: "max_iterations",
+                requirement: "at least one Newton iteration is needed",
+            });
+        }
+        if !(self.armijo > 0.0 && self.armijo < 0.5) {
+            return Err(Error::InvalidArgument {
+                name: "armijo",
+                requirement: "the Armijo constant must lie in (0, 1/2)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A converged Newton solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solution<const M: usize> {
+    /// The root $w$ with $F(w) \approx 0$.
+    pub w: SVector<f64, M>,
+    /// Newton iterations used (Jacobian factorisations).
+    pub iterations: usize,
+    /// $|F(w)|_\infty$ at the returned root.
+    pub residual_norm: f64,
+}
+
+fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
+    m.iter().all(|v| v.is_finite())
+}
+
+/// Solves $F(w) = 0$ from the guess `w0` (module docs give the method).
+///
+/// # Errors
+/// [`Error::NonFinite`] if the guess, a residual at an accepted iterate or a Jacobian is not
+/// finite; [`Error::SingularJacobian`] if the LU factorisation has a zero pivot or its solve
+/// overflows; [`Error::LineSearchFailed`] if no step length decreases $|F|^2$;
+/// [`Error::NoConvergence`] after `max_iterations`; [`Error::InvalidArgument`] for bad
+/// options.
+pub fn solve<P, const M: usize>(
+    problem: &P,
+    w0: SVector<f64, M>,
+    options: &NewtonOptions,
+) -> Result<Solution<M>, Error>
+where
+    P: Problem<M> + ?Sized,
+{
+    options.validate()?;
+    if !all_finite(&w0) {
+        return Err(Error::NonFinite {
+            iteration: 0,
+            location: "initial guess",
+        });
+    }
+    let mut w = w0;
+    let mut r = problem.residual(&w);
+    if !all_finite(&r) {
+        return Err(Error::NonFinite {
+            iteration: 0,
+            location: "residual",
+        });
+    }
+    let mut r_norm = r.amax();
+    let residual_tol = options.residual_abs + options.residual_rel * r_norm;
+    for iteration in 1..=options.max_iterations {
+        if r_norm <= residual_tol {
+            return Ok(Solution {
+                w,
+                iterations: iteration - 1,
+                residual_norm: r_norm,
+            });
+        }
+        let jacobian = problem.jacobian(&w);
+        if !all_finite(&jacobian) {
+            return Err(Error::NonFinite {
+                iteration,
+                location: "Jacobian",
+            });
+        }
+        let delta = match crate::linalg::solve(&jacobian, &(-r)) {
+            Some(delta) if all_finite(&delta) => delta,
+            _ => return Err(Error::SingularJacobian { iteration }),
+        };
+        if delta.amax() <= options.step_abs + options.step_rel * w.amax() {
+            w += delta;
+            r = problem.residual(&w);
+            if !all_finite(&r) {
+                return Err(Error::NonFinite {
+                    iteration,
+                    location: "residual",
+                });
+            }
+            return Ok(Solution {
+                w,
+                iterations: iteration,
+                residual_norm: r.amax(),
+            });
+        }
+        let phi = r.norm_squared();
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..=options.max_backtracks {
+            let trial = w + delta * alpha;
+            let r_trial = problem.residual(&trial);
+            if all_finite(&r_trial)
+                && r_trial.norm_squared() <= (1.0 - 2.0 * options.armijo * alpha) * phi
+            {
+                w = trial;
+                r = r_trial;
+                accepted = true;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            return Err(Error::LineSearchFailed {
+                iteration,
+                residual_norm: r_norm,
+            });
+        }
+        r_norm = r.amax();
+    }
+    if r_norm <= residual_tol {
+        return Ok(Solution {
+            w,
+            iterations: options.max_iterations,
+            residual_norm: r_norm,
+        });
+    }
+    Err(Error::NoConvergence {
+        iterations: options.max_iterations,
+        residual_norm: r_norm,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Vector2};
+
+    /// F(w) = (w0^2 + w1^2 - 4, w0 - w1): root (sqrt 2, sqrt 2) from a positive guess.
+    struct Circle;
+
+    impl Problem<2> for Circle {
+        fn residual(&self, w: &Vector2<f64>) -> Vector2<f64> {
+            Vector2::new(w[0] * w[0] + w[1] * w[1] - 4.0, w[0] - w[1])
+        }
+        fn jacobian(&self, w: &Vector2<f64>) -> Matrix2<f64> {
+            Matrix2::new(2.0 * w[0], 2.0 * w[1], 1.0, -1.0)
+        }
+    }
+
+    #[test]
+    fn converges_quadratically_to_the_root() {
+        let s = solve(&Circle, Vector2::new(3.0, 1.0), &NewtonOptions::default()).unwrap();
+        let root = 2f64.sqrt();
+        assert!((s.w[0] - root).abs() < 1e-15 && (s.w[1] - root).abs() < 1e-15);
+        assert!(s.iterations <= 7, "iterations {}", s.iterations);
+        assert!(s.residual_norm < 1e-14);
+    }
+
+    #[test]
+    fn singular_start_is_reported() {
+        // J(0, 0) = [[0, 0], [1, -1]] has a zero pivot.
+        let e = solve(&Circle, Vector2::zeros(), &NewtonOptions::default()).unwrap_err();
+        assert_eq!(e, Error::SingularJacobian { iteration: 1 });
+    }
+
+    #[test]
+    fn invalid_options_are_rejected() {
+        let o = NewtonOptions::default().with_max_iterations(0);
+        assert!(matches!(
+            solve(&Circle, Vector2::new(1.0, 1.0), &o),
+            Err(Error::InvalidArgument {
+                name: "max_iterations",
+                ..
+            })
+        ));
+        let o = NewtonOptions::default().with_residual_tolerance(f64::NAN, 0.0);
+        assert!(solve(&Circle, Vector2::new(1.0, 1.0), &o).is_err());
+    }
+}

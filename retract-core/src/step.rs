@@ -1,0 +1,237 @@
+//! One step of the lifted theta-scheme, and trajectories.
+//!
+//! A step solves $F(z_0, w) = 0$ (see [`LiftedSystem`]) for $w = (z_1, \dots)$ by
+//! [`newton::solve`](crate::newton::solve()) from the explicit predictor
+//! [`LiftedSystem::predictor`]. [`step`] neither allocates nor panics.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::newton::{self, NewtonOptions, Problem};
+use crate::{Error, LiftedSystem};
+
+/// Options of a step: the scheme parameter $\theta$ and the Newton options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct StepOptions {
+    /// $\theta \in [0, 1]$; $1/2$ (the default) is the lifted midpoint rule, order 2;
+    /// 0 and 1 are the two symplectic Euler methods, order 1.
+    pub theta: f64,
+    /// Options of the Newton solve.
+    pub newton: NewtonOptions,
+}
+
+impl Default for StepOptions {
+    fn default() -> Self {
+        Self {
+            theta: 0.5,
+            newton: NewtonOptions::default(),
+        }
+    }
+}
+
+impl StepOptions {
+    /// Sets $\theta$.
+    pub fn with_theta(mut self, theta: f64) -> Self {
+        self.theta = theta;
+        self
+    }
+
+    /// Sets the Newton options.
+    pub fn with_newton(mut self, newton: NewtonOptions) -> Self {
+        self.newton = newton;
+        self
+    }
+
+    fn validate(&self, h: f64) -> Result<(), Error> {
+        if !(0.0..=1.0).contains(&self.theta) {
+            return Err(Error::InvalidArgument {
+                name: "theta",
+                requirement: "theta must lie in [0, 1]",
+            });
+        }
+        if !(h.is_finite() && h != 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "h",
+                requirement: "the step size must be finite and non-zero",
+            });
+        }
+        self.newton.validate()
+    }
+}
+
+/// What the Newton solve of one step reported.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// $|F|_\infty$ at the accepted solution.
+    pub residual_norm: f64,
+}
+
+/// $F(z_0, \cdot)$ of one step as a Newton [`Problem`].
+struct StepProblem<'a, Sys: ?Sized, const S: usize> {
+    system: &'a Sys,
+    z0: &'a SVector<f64, S>,
+    h: f64,
+    theta: f64,
+}
+
+impl<Sys, const S: usize, const M: usize> Problem<M> for StepProblem<'_, Sys, S>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    fn residual(&self, w: &SVector<f64, M>) -> SVector<f64, M> {
+        self.system.residual(self.z0, w, self.h, self.theta)
+    }
+
+    fn jacobian(&self, w: &SVector<f64, M>) -> SMatrix<f64, M, M> {
+        self.system.jacobian(self.z0, w, self.h, self.theta)
+    }
+}
+
+/// Solves one step from the guess `guess` and returns all unknowns $w$.
+///
+/// # Errors
+/// Invalid `h` or options, or any Newton failure.
+pub fn solve_step<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    guess: SVector<f64, M>,
+    h: f64,
+    options: &StepOptions,
+) -> Result<(SVector<f64, M>, StepReport), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    options.validate(h)?;
+    let problem = StepProblem {
+        system,
+        z0,
+        h,
+        theta: options.theta,
+    };
+    let solution = newton::solve(&problem, guess, &options.newton)?;
+    Ok((
+        solution.w,
+        StepReport {
+            iterations: solution.iterations,
+            residual_norm: solution.residual_norm,
+        },
+    ))
+}
+
+/// One step $z_1 = \Psi_h(z_0)$ of the theta-scheme, from the explicit predictor.
+///
+/// # Errors
+/// Invalid `h` or options, a predictor that cannot be evaluated at $z_0$ (e.g. a
+/// non-finite state), or any Newton failure.
+pub fn step<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+    options: &StepOptions,
+) -> Result<(SVector<f64, S>, StepReport), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    options.validate(h)?;
+    let guess = system.predictor(z0, h, options.theta)?;
+    let (w, report) = solve_step(system, z0, guess, h, options)?;
+    Ok((system.state(&w), report))
+}
+
+/// States $z_0, \dots, z_m$ at $t_i = i h$ and the Newton report of each step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory<const S: usize> {
+    /// The step size $h$.
+    pub h: f64,
+    /// $z_i$, starting with the initial state.
+    pub states: Vec<SVector<f64, S>>,
+    /// `reports[i]` is the report of the step from `states[i]` to `states[i + 1]`.
+    pub reports: Vec<StepReport>,
+}
+
+impl<const S: usize> Trajectory<S> {
+    /// The largest number of Newton iterations of any step (0 for no step).
+    pub fn max_iterations(&self) -> usize {
+        self.reports.iter().map(|r| r.iterations).max().unwrap_or(0)
+    }
+
+    /// The mean number of Newton iterations per step (0 for no step).
+    pub fn mean_iterations(&self) -> f64 {
+        if self.reports.is_empty() {
+            return 0.0;
+        }
+        self.reports
+            .iter()
+            .map(|r| r.iterations as f64)
+            .sum::<f64>()
+            / self.reports.len() as f64
+    }
+}
+
+/// A trajectory that stopped at a failed step. Nothing computed before it is lost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interrupted<const S: usize> {
+    /// The states up to and including the last valid one.
+    pub trajectory: Trajectory<S>,
+    /// Index of the failed step (from `states[step]`).
+    pub step: usize,
+    /// Time $t = \text{step} \cdot h$ at which the failed step started.
+    pub time: f64,
+    /// Why the step failed.
+    pub error: Error,
+}
+
+impl<const S: usize> core::fmt::Display for Interrupted<S> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "step {} from t = {} failed: {}",
+            self.step, self.time, self.error
+        )
+    }
+}
+
+impl<const S: usize> std::error::Error for Interrupted<S> {}
+
+/// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
+///
+/// # Errors
+/// [`Interrupted`], with the trajectory computed so far, at the first failed step.
+pub fn trajectory<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+    steps: usize,
+    options: &StepOptions,
+) -> Result<Trajectory<S>, Interrupted<S>>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let mut trajectory = Trajectory {
+        h,
+        states: Vec::with_capacity(steps + 1),
+        reports: Vec::with_capacity(steps),
+    };
+    trajectory.states.push(*z0);
+    let mut z = *z0;
+    for i in 0..steps {
+        match step(system, &z, h, options) {
+            Ok((next, report)) => {
+                z = next;
+                trajectory.states.push(z);
+                trajectory.reports.push(report);
+            }
+            Err(error) => {
+                return Err(Interrupted {
+                    trajectory,
+                    step: i,
+                    time: i as f64 * h,
+                    error,
+                });
+            }
+        }
+    }
+    Ok(trajectory)
+}

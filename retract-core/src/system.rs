@@ -1,0 +1,214 @@
+//! The traits a generated (or hand-written) system implements.
+//!
+//! A $k$-th order Lagrangian $L(q, q', \dots, q^{(k)})$ on $Q = \mathbb{R}^n$ is seen as
+//! $L(x, u)$ with the jet $x = (x_0, \dots, x_{k-1})$, $x_j = q^{(j)}$, and the top
+//! derivative $u = q^{(k)}$. Two traits describe it:
+//!
+//! - [`Lagrangian<N, K>`]: $L$, its gradient and Hessian in $(x, u)$, the Ostrogradsky
+//!   momenta (the Legendre map) and the solve of $p_{k-1} = \partial L / \partial u$ for $u$.
+//!   Typed by blocks: everything is in terms of `SVector<f64, N>`.
+//! - [`LiftedSystem<S, M>`]: the flat interface the runtime drives, with the Hamiltonian
+//!   state $z = (x, p) \in \mathbb{R}^S$, $S = 2nk$, and the Newton unknowns
+//!   $w = (z_1, u) \in \mathbb{R}^M$, $M = S + n$ for the general scheme. The functions of
+//!   [`crate::lifted`] implement it from a [`Lagrangian`]; [`impl_lifted_system!`](crate::impl_lifted_system)
+//!   writes that impl for a concrete type.
+//!
+//! # Layout of the flat vectors
+//! $z = (x_0, \dots, x_{k-1}, p_0, \dots, p_{k-1})$, each block $n$ long; the derivative data
+//! of the Legendre map is $(q, q', \dots, q^{(2k-1)})$, also $S = 2nk$ long;
+//! $w = (x_{1}, p_{1}, u)$ for the one-step unknowns.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Error;
+
+/// Blocks of the gradient of $L(x, u)$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gradient<const N: usize, const K: usize> {
+    /// `x[j]` $= \partial L / \partial x_j$.
+    pub x: [SVector<f64, N>; K],
+    /// $\partial L / \partial u$.
+    pub u: SVector<f64, N>,
+}
+
+/// Blocks of the Hessian of $L(x, u)$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hessian<const N: usize, const K: usize> {
+    /// `xx[i][j][(a, b)]` $= \partial^2 L / \partial x_{i,a} \partial x_{j,b}$.
+    pub xx: [[SMatrix<f64, N, N>; K]; K],
+    /// `xu[j][(a, b)]` $= \partial^2 L / \partial x_{j,a} \partial u_b$.
+    pub xu: [SMatrix<f64, N, N>; K],
+    /// `uu[(a, b)]` $= \partial^2 L / \partial u_a \partial u_b$.
+    pub uu: SMatrix<f64, N, N>,
+}
+
+impl<const N: usize, const K: usize> Gradient<N, K> {
+    /// The zero gradient.
+    pub fn zeros() -> Self {
+        Self {
+            x: [SVector::zeros(); K],
+            u: SVector::zeros(),
+        }
+    }
+}
+
+impl<const N: usize, const K: usize> Hessian<N, K> {
+    /// The zero Hessian.
+    pub fn zeros() -> Self {
+        Self {
+            xx: [[SMatrix::zeros(); K]; K],
+            xu: [SMatrix::zeros(); K],
+            uu: SMatrix::zeros(),
+        }
+    }
+}
+
+/// A $k$-th order Lagrangian $L(x, u)$ on $\mathbb{R}^N$ with $K = k$.
+pub trait Lagrangian<const N: usize, const K: usize> {
+    /// $L(x, u)$.
+    fn lagrangian(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> f64;
+
+    /// $(\partial L/\partial x_0, \dots, \partial L/\partial x_{k-1}, \partial L/\partial u)$.
+    fn gradient(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Gradient<N, K>;
+
+    /// The Hessian of $L$ in $(x, u)$, by blocks.
+    fn hessian(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Hessian<N, K>;
+
+    /// The Ostrogradsky momenta from derivative data, with `lower` $= (q, \dots, q^{(k-1)})$
+    /// and `upper` $= (q^{(k)}, \dots, q^{(2k-1)})$:
+    /// $p_{k-1} = \partial L/\partial q^{(k)}$,
+    /// $p_{j-1} = \partial L/\partial q^{(j)} - D p_j$ for $j = k-1, \dots, 1$, where
+    /// $D f = \sum_i \partial f/\partial q^{(i)} \cdot q^{(i+1)}$ is the total derivative.
+    fn momenta(
+        &self,
+        lower: &[SVector<f64, N>; K],
+        upper: &[SVector<f64, N>; K],
+    ) -> [SVector<f64, N>; K];
+
+    /// Solves $p_{k-1} = \partial L/\partial u\,(x, u)$ for $u$, starting from `guess`.
+    ///
+    /// The default runs [`crate::newton::solve`] with the Jacobian
+    /// $\partial^2 L / \partial u^2$; a system with a closed-form inverse overrides it.
+    ///
+    /// # Errors
+    /// Any [`Error`] of the Newton solve, e.g. [`Error::SingularJacobian`] for a Lagrangian
+    /// degenerate in $u$.
+    fn top_derivative(
+        &self,
+        x: &[SVector<f64, N>; K],
+        p_top: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, Error> {
+        let problem = TopDerivative {
+            lagrangian: self,
+            x,
+            p_top,
+        };
+        crate::newton::solve(&problem, *guess, &crate::NewtonOptions::default())
+            .map(|solution| solution.w)
+    }
+}
+
+/// $F(u) = \partial L/\partial u\,(x, u) - p_{k-1}$, the Legendre inversion as a root problem.
+struct TopDerivative<'a, L: ?Sized, const N: usize, const K: usize> {
+    lagrangian: &'a L,
+    x: &'a [SVector<f64, N>; K],
+    p_top: &'a SVector<f64, N>,
+}
+
+impl<L, const N: usize, const K: usize> crate::newton::Problem<N> for TopDerivative<'_, L, N, K>
+where
+    L: Lagrangian<N, K> + ?Sized,
+{
+    fn residual(&self, u: &SVector<f64, N>) -> SVector<f64, N> {
+        self.lagrangian.gradient(self.x, u).u - self.p_top
+    }
+
+    fn jacobian(&self, u: &SVector<f64, N>) -> SMatrix<f64, N, N> {
+        self.lagrangian.hessian(self.x, u).uu
+    }
+}
+
+/// The lifted theta-scheme of a higher-order Lagrangian, on flat vectors.
+///
+/// `S` $= 2nk$ is the size of the Hamiltonian state $z = (x, p)$ and `M` the number of
+/// Newton unknowns of one step (for the general scheme $M = S + n$: $w = (z_1, u)$). The
+/// one-step map with step $h$ and parameter $\theta \in [0, 1]$ is defined by
+/// $F(z_0, w) = 0$:
+///
+/// ```text
+/// F_{x,j}   = x_{j,1} - x_{j,0} - h x_{j+1,th}                     (j < k-1)
+/// F_{x,k-1} = x_{k-1,1} - x_{k-1,0} - h u
+/// F_{p,0}   = p_{0,1} - p_{0,0} - h dL/dx_0 (x_th, u)
+/// F_{p,j}   = p_{j,1} - p_{j,0} - h (dL/dx_j (x_th, u) - p_{j-1,th})  (j >= 1)
+/// F_u       = p_{k-1,th} - dL/du (x_th, u)
+/// x_th = (1 - theta) x_0 + theta x_1,   p_th = theta p_0 + (1 - theta) p_1
+/// ```
+pub trait LiftedSystem<const S: usize, const M: usize> {
+    /// Dimension $n$ of the configuration space.
+    const DIMENSION: usize;
+    /// Order $k$ of the Lagrangian.
+    const ORDER: usize;
+
+    /// The Ostrogradsky Hamiltonian
+    /// $H(x, p) = \sum_{j<k-1} p_j \cdot x_{j+1} + p_{k-1} \cdot u - L(x, u)$ with $u$
+    /// solving $p_{k-1} = \partial L/\partial u\,(x, u)$.
+    ///
+    /// # Errors
+    /// When the solve for $u$ fails or a value is not finite.
+    fn hamiltonian(&self, z: &SVector<f64, S>) -> Result<f64, Error>;
+
+    /// Hamilton's equations $z' = (\partial H/\partial p, -\partial H/\partial x)$:
+    /// $x_j' = x_{j+1}$ ($j < k-1$), $x_{k-1}' = u$, $p_0' = \partial L/\partial x_0$,
+    /// $p_j' = \partial L/\partial x_j - p_{j-1}$ ($j \ge 1$).
+    ///
+    /// # Errors
+    /// When the solve for $u$ fails or a value is not finite.
+    fn vector_field(&self, z: &SVector<f64, S>) -> Result<SVector<f64, S>, Error>;
+
+    /// The Legendre map: derivative data $(q, \dots, q^{(2k-1)})$ to $z = (x, p)$, with
+    /// $x_j = q^{(j)}$ and $p$ the Ostrogradsky momenta.
+    fn legendre(&self, jet: &SVector<f64, S>) -> SVector<f64, S>;
+
+    /// The residual $F(z_0, w)$ of the trait docs.
+    fn residual(
+        &self,
+        z0: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        h: f64,
+        theta: f64,
+    ) -> SVector<f64, M>;
+
+    /// $\partial F / \partial w$, the Newton matrix.
+    fn jacobian(
+        &self,
+        z0: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        h: f64,
+        theta: f64,
+    ) -> SMatrix<f64, M, M>;
+
+    /// $\partial F / \partial z_0$, for the derivative of the step map
+    /// $D\Psi = -[(\partial F/\partial w)^{-1} \partial F/\partial z_0]_{1..S}$.
+    fn jacobian_initial(
+        &self,
+        z0: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        h: f64,
+        theta: f64,
+    ) -> SMatrix<f64, M, S>;
+
+    /// An explicit first guess of $w$: one explicit Euler step
+    /// $z_1 \approx z_0 + h\, z'(z_0)$ and $u \approx u(z_0)$.
+    ///
+    /// # Errors
+    /// When the vector field at $z_0$ cannot be evaluated.
+    fn predictor(&self, z0: &SVector<f64, S>, h: f64, theta: f64)
+    -> Result<SVector<f64, M>, Error>;
+
+    /// The new state $z_1$ inside the unknowns $w$ (its first `S` entries).
+    fn state(&self, w: &SVector<f64, M>) -> SVector<f64, S> {
+        const { assert!(S <= M, "the unknowns must contain the state") };
+        w.fixed_rows::<S>(0).into_owned()
+    }
+}

@@ -1,0 +1,2 @@
+//! Procedural macros of `retract`.
+#![forbid(unsafe_code)]
