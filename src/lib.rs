@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub use retract_core::*;
+pub use retract_macros::higher_order_lagrangian;
 
 #[doc(hidden)]
 pub mod __private {

@@ -1,0 +1,324 @@
+//! Symbolic differentiation and substitution on the [`Graph`].
+//!
+//! Forward mode with a memo keyed by (node, variable): a gradient over m variables costs
+//! O(m * nodes), and every derivative is itself hash-consed, so shared subexpressions of the
+//! gradient and Hessian are built once.
+
+use std::collections::HashMap;
+
+use crate::graph::{Func, Graph, Id, Node, Var};
+
+/// Memoised derivatives.
+#[derive(Default)]
+pub struct Differentiator {
+    memo: HashMap<(Id, Var), Id>,
+}
+
+impl Differentiator {
+    /// d(node)/d(var).
+    pub fn diff(&mut self, g: &mut Graph, node: Id, var: Var) -> Id {
+        if let Some(&d) = self.memo.get(&(node, var)) {
+            return d;
+        }
+        let d = self.rule(g, node, var);
+        self.memo.insert((node, var), d);
+        d
+    }
+
+    /// One arm per node kind.
+    fn rule(&mut self, g: &mut Graph, node: Id, var: Var) -> Id {
+        match g.node(node).clone() {
+            Node::Const(_) | Node::Named(_) => g.constant(0.0),
+            Node::Var(v) => g.constant(if v == var { 1.0 } else { 0.0 }),
+            Node::Add(a, b) => {
+                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
+                g.add_op(da, db)
+            }
+            Node::Sub(a, b) => {
+                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
+                g.sub(da, db)
+            }
+            Node::Mul(a, b) => {
+                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
+                let l = g.mul(da, b);
+                let r = g.mul(a, db);
+                g.add_op(l, r)
+            }
+            Node::Div(a, b) => {
+                // (a/b)' = a'/b - (a/b) b'/b
+                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
+                let l = g.div(da, b);
+                let ratio = g.mul(node, db);
+                let r = g.div(ratio, b);
+                g.sub(l, r)
+            }
+            Node::Neg(a) => {
+                let da = self.diff(g, a, var);
+                g.neg(da)
+            }
+            Node::Powi(a, n) => {
+                let da = self.diff(g, a, var);
+                if g.is_const(da, 0.0) {
+                    return da;
+                }
+                let p = g.powi(a, n - 1);
+                let c = g.constant(n as f64);
+                let cp = g.mul(c, p);
+                g.mul(cp, da)
+            }
+            Node::Powf(a, b) => {
+                // exponent b does not depend on the jet: (a^b)' = b a^(b-1) a'
+                let da = self.diff(g, a, var);
+                if g.is_const(da, 0.0) {
+                    return da;
+                }
+                let one = g.constant(1.0);
+                let bm1 = g.sub(b, one);
+                let p = g.powf(a, bm1);
+                let bp = g.mul(b, p);
+                g.mul(bp, da)
+            }
+            Node::Unary(f, a) => {
+                let da = self.diff(g, a, var);
+                if g.is_const(da, 0.0) {
+                    return da;
+                }
+                let outer = match f {
+                    // 1 / (2 sqrt a)
+                    Func::Sqrt => {
+                        let two = g.constant(2.0);
+                        let den = g.mul(two, node);
+                        let one = g.constant(1.0);
+                        g.div(one, den)
+                    }
+                    Func::Exp => node,
+                    Func::Ln => {
+                        let one = g.constant(1.0);
+                        g.div(one, a)
+                    }
+                    Func::Sin => g.unary(Func::Cos, a),
+                    Func::Cos => {
+                        let s = g.unary(Func::Sin, a);
+                        g.neg(s)
+                    }
+                    // 1 + tan^2, 1 - tanh^2
+                    Func::Tan => {
+                        let one = g.constant(1.0);
+                        let sq = g.powi(node, 2);
+                        g.add_op(one, sq)
+                    }
+                    Func::Tanh => {
+                        let one = g.constant(1.0);
+                        let sq = g.powi(node, 2);
+                        g.sub(one, sq)
+                    }
+                    Func::Abs => g.unary(Func::Signum, a),
+                    Func::Signum => return g.constant(0.0),
+                };
+                g.mul(outer, da)
+            }
+            Node::Atan2(y, x) => {
+                // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
+                let (dy, dx) = (self.diff(g, y, var), self.diff(g, x, var));
+                let xdy = g.mul(x, dy);
+                let ydx = g.mul(y, dx);
+                let num = g.sub(xdy, ydx);
+                if g.is_const(num, 0.0) {
+                    return num;
+                }
+                let x2 = g.powi(x, 2);
+                let y2 = g.powi(y, 2);
+                let den = g.add_op(x2, y2);
+                g.div(num, den)
+            }
+            Node::Hypot(a, b) => {
+                // (a da + b db) / hypot(a, b)
+                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
+                let l = g.mul(a, da);
+                let r = g.mul(b, db);
+                let num = g.add_op(l, r);
+                g.div(num, node)
+            }
+            Node::Sum { param, body } => {
+                let db = self.diff(g, body, var);
+                g.sum(param, db)
+            }
+        }
+    }
+}
+
+/// Rebuilds `node` with every variable `v` for which `map(v)` is `Some` replaced; memoised
+/// in `memo`, which must only be shared between calls with the same `map`.
+pub fn substitute(
+    g: &mut Graph,
+    node: Id,
+    map: &dyn Fn(&mut Graph, Var) -> Option<Id>,
+    memo: &mut HashMap<Id, Id>,
+) -> Id {
+    if let Some(&done) = memo.get(&node) {
+        return done;
+    }
+    let mut sub = |g: &mut Graph, id: Id| substitute(g, id, map, memo);
+    let out = match g.node(node).clone() {
+        Node::Const(_) | Node::Named(_) => node,
+        Node::Var(v) => map(g, v).unwrap_or(node),
+        Node::Add(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.add_op(a, b)
+        }
+        Node::Sub(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.sub(a, b)
+        }
+        Node::Mul(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.mul(a, b)
+        }
+        Node::Div(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.div(a, b)
+        }
+        Node::Neg(a) => {
+            let a = sub(g, a);
+            g.neg(a)
+        }
+        Node::Powi(a, n) => {
+            let a = sub(g, a);
+            g.powi(a, n)
+        }
+        Node::Powf(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.powf(a, b)
+        }
+        Node::Unary(f, a) => {
+            let a = sub(g, a);
+            g.unary(f, a)
+        }
+        Node::Atan2(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.atan2(a, b)
+        }
+        Node::Hypot(a, b) => {
+            let (a, b) = (sub(g, a), sub(g, b));
+            g.hypot(a, b)
+        }
+        Node::Sum { param, body } => {
+            let b = sub(g, body);
+            g.sum(param, b)
+        }
+    };
+    memo.insert(node, out);
+    out
+}
+
+/// The total time derivative $D f = \sum_{j < top} \sum_i \partial f/\partial q^{(j)}_i \, q^{(j+1)}_i$
+/// over jets up to q^(top).
+pub fn total_derivative(g: &mut Graph, d: &mut Differentiator, f: Id, n: usize, top: usize) -> Id {
+    let mut acc = g.constant(0.0);
+    for order in 0..top {
+        for index in 0..n {
+            let var = Var::Jet {
+                order: order as u8,
+                index: index as u16,
+            };
+            let partial = d.diff(g, f, var);
+            if g.is_const(partial, 0.0) {
+                continue;
+            }
+            let next = g.var(Var::Jet {
+                order: order as u8 + 1,
+                index: index as u16,
+            });
+            let term = g.mul(partial, next);
+            acc = g.add_op(acc, term);
+        }
+    }
+    acc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::tests::show;
+
+    fn q(g: &mut Graph, order: u8, index: u16) -> Id {
+        g.var(Var::Jet { order, index })
+    }
+
+    fn d_of(build: impl Fn(&mut Graph, Id) -> Id) -> String {
+        let mut g = Graph::default();
+        let x = q(&mut g, 0, 0);
+        let f = build(&mut g, x);
+        let mut d = Differentiator::default();
+        let df = d.diff(&mut g, f, Var::Jet { order: 0, index: 0 });
+        show(&g, df)
+    }
+
+    #[test]
+    fn derivative_table() {
+        assert_eq!(d_of(|g, x| g.powi(x, 3)), "(3 * q0_0^2)");
+        assert_eq!(d_of(|g, x| g.unary(Func::Sin, x)), "cos(q0_0)");
+        assert_eq!(d_of(|g, x| g.unary(Func::Cos, x)), "-sin(q0_0)");
+        assert_eq!(d_of(|g, x| g.unary(Func::Exp, x)), "exp(q0_0)");
+        assert_eq!(d_of(|g, x| g.unary(Func::Ln, x)), "(1 / q0_0)");
+        assert_eq!(
+            d_of(|g, x| g.unary(Func::Sqrt, x)),
+            "(1 / (2 * sqrt(q0_0)))"
+        );
+        assert_eq!(d_of(|g, x| g.unary(Func::Tanh, x)), "(1 - tanh(q0_0)^2)");
+        assert_eq!(d_of(|g, x| g.unary(Func::Abs, x)), "signum(q0_0)");
+        assert_eq!(
+            d_of(|g, x| {
+                let one = g.constant(1.0);
+                g.div(one, x)
+            }),
+            "-((1 / q0_0) / q0_0)"
+        );
+        assert_eq!(
+            d_of(|g, x| {
+                let y = q(g, 0, 1);
+                g.atan2(y, x)
+            }),
+            "(-q0_1 / (q0_0^2 + q0_1^2))"
+        );
+        assert_eq!(
+            d_of(|g, x| {
+                let c = g.constant(1.5);
+                g.powf(x, c)
+            }),
+            "(1.5 * sqrt(q0_0))"
+        );
+        assert_eq!(
+            d_of(|g, x| {
+                let y = q(g, 0, 1);
+                g.mul(x, y)
+            }),
+            "q0_1"
+        );
+    }
+
+    #[test]
+    fn substitution_rebuilds_and_simplifies() {
+        let mut g = Graph::default();
+        let x = q(&mut g, 0, 0);
+        let y = q(&mut g, 0, 1);
+        let f = g.mul(x, y);
+        let mut memo = HashMap::new();
+        let zero_y =
+            |g: &mut Graph, v: Var| (v == Var::Jet { order: 0, index: 1 }).then(|| g.constant(0.0));
+        let s = substitute(&mut g, f, &zero_y, &mut memo);
+        assert_eq!(show(&g, s), "0");
+    }
+
+    #[test]
+    fn total_derivative_of_a_jet_product() {
+        // D(q * q') = q'^2 + q q''
+        let mut g = Graph::default();
+        let x = q(&mut g, 0, 0);
+        let v = q(&mut g, 1, 0);
+        let f = g.mul(x, v);
+        let mut d = Differentiator::default();
+        let df = total_derivative(&mut g, &mut d, f, 1, 2);
+        assert_eq!(show(&g, df), "(q1_0^2 + (q0_0 * q2_0))");
+    }
+}

@@ -1,0 +1,495 @@
+//! The expansion as a plain function, `TokenStream -> TokenStream`, testable without the
+//! compiler's proc-macro bridge.
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{ToTokens, quote};
+use syn::ItemFn;
+
+use crate::codegen::{Leaves, emit};
+use crate::graph::{Graph, Var};
+use crate::lower::Lower;
+use crate::mechanics::{self, Degenerate, Mechanics};
+use crate::signature::{self, Kind, Signature};
+
+/// Expands the attribute; on error, the original item plus `compile_error!`s, so the rest of
+/// the crate still type-checks.
+pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
+    match try_expand(attr, item.clone()) {
+        Ok(tokens) => tokens,
+        Err(error) => {
+            let errors = error.to_compile_error();
+            quote!(#item #errors)
+        }
+    }
+}
+
+/// Combines several errors into one that reports all of them.
+pub fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
+    let mut iter = errors.into_iter();
+    let mut first = iter.next()?;
+    for e in iter {
+        first.combine(e);
+    }
+    Some(first)
+}
+
+/// The expansion, or the errors of the input.
+pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
+    let function: ItemFn = syn::parse2(item)?;
+    let sig = signature::parse(attr, &function)?;
+    let mut graph = Graph::default();
+    let root = {
+        let mut lower = Lower::new(&mut graph, &sig);
+        let root = lower.body(&function.block);
+        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
+            return Err(e);
+        }
+        root
+    };
+    let mech = mechanics::build(&mut graph, root, sig.dim, sig.order).map_err(|reason| {
+        let top = &sig.jet[sig.order];
+        let msg = match reason {
+            Degenerate::Independent => format!(
+                "the Lagrangian does not depend on `{top}` = q^({}): its Legendre map is \
+                 singular; lower the order or add a term in `{top}` (e.g. 0.5 * |{top}|^2)",
+                sig.order
+            ),
+            Degenerate::Linear => format!(
+                "the Lagrangian is linear in `{top}` = q^({}): d2L/d{top}2 = 0, so its Legendre \
+                 map is singular; it must be (at least locally) strictly convex in `{top}`",
+                sig.order
+            ),
+            Degenerate::Singular => format!(
+                "d2L/d{top}2 is a singular constant matrix: the Legendre map is singular; every \
+                 component of `{top}` must enter L quadratically"
+            ),
+        };
+        syn::Error::new(top.span(), msg)
+    })?;
+    Ok(generate(&function, &sig, &graph, &mech))
+}
+
+fn index(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// Names the leaves inside the generated methods.
+struct Names<'a> {
+    sig: &'a Signature,
+    /// q^(order)[index] as an expression.
+    jet: &'a dyn Fn(u8, u16) -> TokenStream,
+}
+
+impl Leaves for Names<'_> {
+    fn var(&self, var: Var) -> TokenStream {
+        match var {
+            Var::Jet { order, index } => (self.jet)(order, index),
+            Var::Param { param, index } => {
+                let p = &self.sig.params[param as usize];
+                let name = &p.name;
+                match p.kind {
+                    Kind::Scalar => quote!(self.#name),
+                    _ => {
+                        let i = self::index(index as usize);
+                        quote!(self.#name[#i])
+                    }
+                }
+            }
+            Var::Elem { index, .. } => {
+                let i = self::index(index as usize);
+                quote!(__e[#i])
+            }
+            Var::Z0(c) => {
+                let c = self::index(c as usize);
+                quote!(z0[#c])
+            }
+            Var::W(c) => {
+                let c = self::index(c as usize);
+                quote!(w[#c])
+            }
+            Var::Step => quote!(h),
+            Var::Theta => quote!(theta),
+        }
+    }
+
+    fn slice(&self, param: u16) -> TokenStream {
+        let name = &self.sig.params[param as usize].name;
+        quote!(self.#name)
+    }
+}
+
+fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> TokenStream {
+    let (n, k) = (sig.dim, sig.order);
+    let (s, m) = (2 * n * k, 2 * n * k + n);
+    let (n_lit, k_lit, s_lit, m_lit) = (index(n), index(k), index(s), index(m));
+    let core = quote!(::retract::__private::retract_core);
+    let na = quote!(::retract::__private::nalgebra);
+    let vec_n = quote!(#na::SVector<f64, #n_lit>);
+    let vec_n_path = quote!(#na::SVector::<f64, #n_lit>);
+    let ty = &sig.type_name;
+    let vis = &function.vis;
+    let fn_name = &function.sig.ident;
+    let has_slice = sig.params.iter().any(|p| matches!(p.kind, Kind::Slice(_)));
+    let (generics, ty_full) = if has_slice {
+        (quote!(<'a>), quote!(#ty<'a>))
+    } else {
+        (quote!(), quote!(#ty))
+    };
+
+    // the parameter struct
+    let fields = sig.params.iter().map(|p| {
+        let name = &p.name;
+        let (t, doc) = match p.kind {
+            Kind::Scalar => (quote!(f64), format!("Parameter `{name}`.")),
+            Kind::Array(len) => {
+                let l = index(len);
+                (quote!([f64; #l]), format!("Parameter `{name}`."))
+            }
+            Kind::Slice(len) => {
+                let l = index(len);
+                (
+                    quote!(&'a [[f64; #l]]),
+                    format!("Parameter list `{name}` (any length; L sums over it)."),
+                )
+            }
+        };
+        quote!(#[doc = #doc] pub #name: #t)
+    });
+    let ctor_args = sig.params.iter().map(|p| {
+        let name = &p.name;
+        match p.kind {
+            Kind::Scalar => quote!(#name: f64),
+            Kind::Array(len) => {
+                let l = index(len);
+                quote!(#name: [f64; #l])
+            }
+            Kind::Slice(len) => {
+                let l = index(len);
+                quote!(#name: &'a [[f64; #l]])
+            }
+        }
+    });
+    let field_names = sig.params.iter().map(|p| &p.name);
+    let body_text = function.block.to_token_stream().to_string();
+    let struct_doc = format!(
+        "The order-{k} Lagrangian [`{fn_name}`] on R^{n} with its parameters, as a system for \
+         the `retract` runtime (generated by `#[higher_order_lagrangian]`).\n\n\
+         L(q, ..., q^({k})) = `{body_text}`\n\n\
+         State z = (x, p) of size {s} = 2nk; Newton unknowns w = (z_1, u) of size {m}."
+    );
+
+    // q^(order)[index] in each method
+    let in_xu = |order: u8, i: u16| {
+        let i = index(i as usize);
+        if (order as usize) < k {
+            let o = index(order as usize);
+            quote!(x[#o][#i])
+        } else {
+            quote!(u[#i])
+        }
+    };
+    let in_jet = |order: u8, i: u16| {
+        let i = index(i as usize);
+        if (order as usize) < k {
+            let o = index(order as usize);
+            quote!(lower[#o][#i])
+        } else {
+            let o = index(order as usize - k);
+            quote!(upper[#o][#i])
+        }
+    };
+    let none = |_: u8, _: u16| quote!(::core::f64::NAN);
+    let xu = Names { sig, jet: &in_xu };
+    let jet = Names { sig, jet: &in_jet };
+    let scheme = Names { sig, jet: &none };
+
+    let lagrangian = emit(g, &[mech.lagrangian], &xu);
+    let (l_stmts, l_expr) = (lagrangian.stmts, &lagrangian.exprs[0]);
+
+    let gradient = emit(g, &mech.gradient, &xu);
+    let g_stmts = gradient.stmts;
+    let g_sets = mech.gradient.iter().enumerate().filter_map(|(a, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &gradient.exprs[a];
+        let (j, i) = (a / n, index(a % n));
+        Some(if j < k {
+            let j = index(j);
+            quote!(__out.x[#j][#i] = #e;)
+        } else {
+            quote!(__out.u[#i] = #e;)
+        })
+    });
+
+    let flat_h: Vec<_> = mech.hessian.iter().flatten().copied().collect();
+    let hessian = emit(g, &flat_h, &xu);
+    let h_stmts = hessian.stmts;
+    let dim = n * (k + 1);
+    let h_sets = flat_h.iter().enumerate().filter_map(|(r, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &hessian.exprs[r];
+        let (a, b) = (r / dim, r % dim);
+        let (ja, ia, jb, ib) = (a / n, index(a % n), b / n, index(b % n));
+        Some(match (ja < k, jb < k) {
+            (true, true) => {
+                let (ja, jb) = (index(ja), index(jb));
+                quote!(__out.xx[#ja][#jb][(#ia, #ib)] = #e;)
+            }
+            (true, false) => {
+                let ja = index(ja);
+                quote!(__out.xu[#ja][(#ia, #ib)] = #e;)
+            }
+            (false, true) => return None, // the transpose, stored in xu
+            (false, false) => quote!(__out.uu[(#ia, #ib)] = #e;),
+        })
+    });
+
+    let momenta = emit(g, &mech.momenta, &jet);
+    let p_stmts = momenta.stmts;
+    let p_sets = mech.momenta.iter().enumerate().filter_map(|(a, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &momenta.exprs[a];
+        let (j, i) = (index(a / n), index(a % n));
+        Some(quote!(__out[#j][#i] = #e;))
+    });
+
+    let top_derivative = mech.legendre_inverse.as_ref().map(|inv| {
+        let mut roots = inv.b.clone();
+        roots.extend(inv.a.iter().copied());
+        let code = emit(g, &roots, &xu);
+        let stmts = code.stmts;
+        let b = &code.exprs[..n];
+        let rhs = (0..n).map(|i| {
+            let bi = &b[i];
+            let ii = index(i);
+            quote!(p_top[#ii] - #bi)
+        });
+        let solve = match &inv.a_inv {
+            Some(a_inv) => {
+                let rows = (0..n).map(|r| {
+                    let terms = (0..n).filter(|c| a_inv[r * n + c] != 0.0).map(|c| {
+                        let v = Literal::f64_suffixed(a_inv[r * n + c]);
+                        let c = index(c);
+                        quote!(+ #v * __rhs[#c])
+                    });
+                    quote!(0.0 #(#terms)*)
+                });
+                quote! {
+                    let __rhs: [f64; #n_lit] = [#(#rhs),*];
+                    ::core::result::Result::Ok(#vec_n_path::new(#(#rows),*))
+                }
+            }
+            None => {
+                let a = &code.exprs[n..];
+                let entries = (0..n * n).map(|e| {
+                    let (r, c) = (index(e / n), index(e % n));
+                    let v = &a[e];
+                    quote!(__a[(#r, #c)] = #v;)
+                });
+                quote! {
+                    let mut __a = #na::SMatrix::<f64, #n_lit, #n_lit>::zeros();
+                    #(#entries)*
+                    let __rhs = #vec_n_path::from([#(#rhs),*]);
+                    #core::linalg::solve(&__a, &__rhs)
+                        .ok_or(#core::Error::SingularJacobian { iteration: 0 })
+                }
+            }
+        };
+        let doc = if inv.a_inv.is_some() {
+            "Closed-form Legendre inverse: L is quadratic in u with a constant Hessian A, so \
+             u = A^{-1} (p_{k-1} - dL/du(x, 0)), with A^{-1} computed at compile time."
+        } else {
+            "Legendre inverse for L quadratic in u: solves A(x) u = p_{k-1} - dL/du(x, 0) with \
+             A = d2L/du2 (independent of u), by LU."
+        };
+        quote! {
+            #[doc = #doc]
+            fn top_derivative(
+                &self,
+                x: &[#vec_n; #k_lit],
+                p_top: &#vec_n,
+                _guess: &#vec_n,
+            ) -> ::core::result::Result<#vec_n, #core::Error> {
+                #stmts
+                #solve
+            }
+        }
+    });
+
+    let residual = emit(g, &mech.residual, &scheme);
+    let r_stmts = residual.stmts;
+    let r_sets = mech.residual.iter().enumerate().filter_map(|(r, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &residual.exprs[r];
+        let r = index(r);
+        Some(quote!(__out[#r] = #e;))
+    });
+    let matrix_sets = |entries: &[crate::graph::Id], cols: usize| {
+        let code = emit(g, entries, &scheme);
+        let sets: Vec<TokenStream> = entries
+            .iter()
+            .enumerate()
+            .filter(|(_, id)| !g.is_const(**id, 0.0))
+            .map(|(e, _)| {
+                let v = &code.exprs[e];
+                let (r, c) = (index(e / cols), index(e % cols));
+                quote!(__out[(#r, #c)] = #v;)
+            })
+            .collect();
+        (code.stmts, sets)
+    };
+    let (j_stmts, j_sets) = matrix_sets(&mech.jacobian, m);
+    let (ji_stmts, ji_sets) = matrix_sets(&mech.jacobian_initial, s);
+
+    let allow = quote!(#[allow(
+        unused_variables,
+        unused_mut,
+        unused_parens,
+        clippy::all,
+        clippy::pedantic,
+        clippy::nursery
+    )]);
+    let vec_s = quote!(#na::SVector<f64, #s_lit>);
+    let vec_m = quote!(#na::SVector<f64, #m_lit>);
+    let vec_m_path = quote!(#na::SVector::<f64, #m_lit>);
+    let jet_blocks = quote!([#vec_n; #k_lit]);
+
+    quote! {
+        #function
+
+        #[doc = #struct_doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        #vis struct #ty #generics {
+            #(#fields,)*
+        }
+
+        #[automatically_derived]
+        impl #generics #ty_full {
+            /// Dimension n of the configuration space.
+            pub const DIMENSION: usize = #n_lit;
+            /// Order k of the Lagrangian.
+            pub const ORDER: usize = #k_lit;
+            /// Size 2nk of the Hamiltonian state z = (x, p).
+            pub const STATE: usize = #s_lit;
+            /// Number 2nk + n of Newton unknowns w = (z_1, u) of one step.
+            pub const UNKNOWNS: usize = #m_lit;
+
+            /// The system with these parameters.
+            #[allow(clippy::too_many_arguments)]
+            pub fn new(#(#ctor_args),*) -> Self {
+                Self { #(#field_names),* }
+            }
+        }
+
+        #[automatically_derived]
+        #allow
+        impl #generics #core::Lagrangian<#n_lit, #k_lit> for #ty_full {
+            /// L(x, u), straight-line code of the annotated function.
+            fn lagrangian(&self, x: &#jet_blocks, u: &#vec_n) -> f64 {
+                #l_stmts
+                #l_expr
+            }
+
+            /// (dL/dx_0, ..., dL/dx_{k-1}, dL/du), differentiated at compile time.
+            fn gradient(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Gradient<#n_lit, #k_lit> {
+                #g_stmts
+                let mut __out = #core::Gradient::zeros();
+                #(#g_sets)*
+                __out
+            }
+
+            /// The Hessian of L in (x, u); structural zeros are not computed.
+            fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
+                #h_stmts
+                let mut __out = #core::Hessian::zeros();
+                #(#h_sets)*
+                __out
+            }
+
+            /// Ostrogradsky momenta p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j.
+            fn momenta(&self, lower: &#jet_blocks, upper: &#jet_blocks) -> #jet_blocks {
+                #p_stmts
+                let mut __out = [#na::SVector::<f64, #n_lit>::zeros(); #k_lit];
+                #(#p_sets)*
+                __out
+            }
+
+            #top_derivative
+        }
+
+        #[automatically_derived]
+        #allow
+        impl #generics #core::LiftedSystem<#s_lit, #m_lit> for #ty_full {
+            const DIMENSION: usize = #n_lit;
+            const ORDER: usize = #k_lit;
+
+            /// The Ostrogradsky Hamiltonian H(x, p).
+            fn hamiltonian(&self, z: &#vec_s) -> ::core::result::Result<f64, #core::Error> {
+                #core::lifted::hamiltonian::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+            }
+
+            /// Hamilton's equations.
+            fn vector_field(&self, z: &#vec_s) -> ::core::result::Result<#vec_s, #core::Error> {
+                #core::lifted::vector_field::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+            }
+
+            /// The Legendre map (q, ..., q^(2k-1)) -> (x, p).
+            fn legendre(&self, jet: &#vec_s) -> #vec_s {
+                #core::lifted::legendre::<Self, #n_lit, #k_lit, #s_lit>(self, jet)
+            }
+
+            /// F(z0, w) of the lifted theta-scheme, straight-line.
+            fn residual(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> #vec_m {
+                #r_stmts
+                let mut __out = #vec_m_path::zeros();
+                #(#r_sets)*
+                __out
+            }
+
+            /// dF/dw of the lifted theta-scheme; structural zeros are not computed.
+            fn jacobian(
+                &self,
+                z0: &#vec_s,
+                w: &#vec_m,
+                h: f64,
+                theta: f64,
+            ) -> #na::SMatrix<f64, #m_lit, #m_lit> {
+                #j_stmts
+                let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
+                #(#j_sets)*
+                __out
+            }
+
+            /// dF/dz0 of the lifted theta-scheme; structural zeros are not computed.
+            fn jacobian_initial(
+                &self,
+                z0: &#vec_s,
+                w: &#vec_m,
+                h: f64,
+                theta: f64,
+            ) -> #na::SMatrix<f64, #m_lit, #s_lit> {
+                #ji_stmts
+                let mut __out = #na::SMatrix::<f64, #m_lit, #s_lit>::zeros();
+                #(#ji_sets)*
+                __out
+            }
+
+            /// Explicit Euler guess of w.
+            fn predictor(
+                &self,
+                z0: &#vec_s,
+                h: f64,
+                _theta: f64,
+            ) -> ::core::result::Result<#vec_m, #core::Error> {
+                #core::lifted::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
+            }
+        }
+    }
+}

@@ -1,0 +1,426 @@
+//! A flat, hash-consed expression DAG over f64.
+//!
+//! Nodes live in one `Vec`, children before parents; inserting a node that exists returns
+//! its id, so common subexpressions are shared by construction. Constructors simplify:
+//! constant folding, `x + 0`, `x * 1`, `x * 0`, `-(-x)`, `x - x`, `x^0`, `x^1`, and
+//! commutative operands in a canonical order.
+
+use std::collections::HashMap;
+
+/// Index of a node in a [`Graph`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Id(pub u32);
+
+/// A leaf symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Var {
+    /// Component `index` of the derivative q^(order).
+    Jet { order: u8, index: u16 },
+    /// Component `index` of parameter `param` (0 for a scalar).
+    Param { param: u16, index: u16 },
+    /// Component `index` of the current element of the slice parameter `param`.
+    Elem { param: u16, index: u16 },
+    /// Component of the state z_0 at the start of a step.
+    Z0(u16),
+    /// Component of the Newton unknowns w = (z_1, u) of a step.
+    W(u16),
+    /// The step size h.
+    Step,
+    /// The scheme parameter theta.
+    Theta,
+}
+
+/// A unary function.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Func {
+    Sqrt,
+    Exp,
+    Ln,
+    Sin,
+    Cos,
+    Tan,
+    Tanh,
+    Abs,
+    Signum,
+}
+
+impl Func {
+    /// The f64 method that computes it.
+    pub fn method(self) -> &'static str {
+        match self {
+            Func::Sqrt => "sqrt",
+            Func::Exp => "exp",
+            Func::Ln => "ln",
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Tanh => "tanh",
+            Func::Abs => "abs",
+            Func::Signum => "signum",
+        }
+    }
+
+    fn eval(self, x: f64) -> f64 {
+        match self {
+            Func::Sqrt => x.sqrt(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Tanh => x.tanh(),
+            Func::Abs => x.abs(),
+            Func::Signum => x.signum(),
+        }
+    }
+}
+
+/// A node of the DAG.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// A constant, stored by its bits.
+    Const(u64),
+    /// A symbol.
+    Var(Var),
+    /// An opaque constant named by a path of the user's crate (index into `Graph::named`).
+    Named(u32),
+    Add(Id, Id),
+    Sub(Id, Id),
+    Mul(Id, Id),
+    Div(Id, Id),
+    Neg(Id),
+    Powi(Id, i32),
+    /// `base.powf(exponent)` with an exponent that does not depend on the jet.
+    Powf(Id, Id),
+    Unary(Func, Id),
+    /// `y.atan2(x)` as `Atan2(y, x)`.
+    Atan2(Id, Id),
+    Hypot(Id, Id),
+    /// Sum over the elements of slice parameter `param` of `body` (which may use
+    /// `Var::Elem { param, .. }`), evaluated by a run-time loop.
+    Sum {
+        param: u16,
+        body: Id,
+    },
+}
+
+/// The DAG.
+#[derive(Default, Debug)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    index: HashMap<Node, Id>,
+    /// Source text of the named constants (paths), for emission.
+    pub named: Vec<String>,
+}
+
+impl Graph {
+    /// The node behind `id`.
+    pub fn node(&self, id: Id) -> &Node {
+        &self.nodes[id.0 as usize]
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    fn add(&mut self, node: Node) -> Id {
+        if let Some(&id) = self.index.get(&node) {
+            return id;
+        }
+        let id = Id(self.nodes.len() as u32);
+        for child in children(&node) {
+            assert!(child < id, "children before parents");
+        }
+        self.nodes.push(node.clone());
+        self.index.insert(node, id);
+        id
+    }
+
+    /// The constant `value` (`-0.0` is stored as `0.0`).
+    pub fn constant(&mut self, value: f64) -> Id {
+        let value = if value == 0.0 { 0.0 } else { value };
+        self.add(Node::Const(value.to_bits()))
+    }
+
+    /// The value of a constant node.
+    pub fn as_const(&self, id: Id) -> Option<f64> {
+        match self.node(id) {
+            Node::Const(bits) => Some(f64::from_bits(*bits)),
+            _ => None,
+        }
+    }
+
+    /// Whether `id` is the constant `value`.
+    pub fn is_const(&self, id: Id, value: f64) -> bool {
+        self.as_const(id) == Some(value)
+    }
+
+    /// A symbol.
+    pub fn var(&mut self, var: Var) -> Id {
+        self.add(Node::Var(var))
+    }
+
+    /// A named constant with source text `path`.
+    pub fn named(&mut self, path: String) -> Id {
+        let index = match self.named.iter().position(|p| *p == path) {
+            Some(i) => i,
+            None => {
+                self.named.push(path);
+                self.named.len() - 1
+            }
+        };
+        self.add(Node::Named(index as u32))
+    }
+
+    pub fn add_op(&mut self, a: Id, b: Id) -> Id {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x + y),
+            (Some(0.0), _) => return b,
+            (_, Some(0.0)) => return a,
+            _ => {}
+        }
+        if let Node::Neg(nb) = *self.node(b) {
+            return self.sub(a, nb);
+        }
+        if let Node::Neg(na) = *self.node(a) {
+            return self.sub(b, na);
+        }
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.add(Node::Add(a, b))
+    }
+
+    pub fn sub(&mut self, a: Id, b: Id) -> Id {
+        if a == b {
+            return self.constant(0.0);
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x - y),
+            (Some(0.0), _) => return self.neg(b),
+            (_, Some(0.0)) => return a,
+            _ => {}
+        }
+        if let Node::Neg(nb) = *self.node(b) {
+            return self.add_op(a, nb);
+        }
+        self.add(Node::Sub(a, b))
+    }
+
+    pub fn mul(&mut self, a: Id, b: Id) -> Id {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x * y),
+            (Some(0.0), _) | (_, Some(0.0)) => return self.constant(0.0),
+            (Some(1.0), _) => return b,
+            (_, Some(1.0)) => return a,
+            (Some(-1.0), _) => return self.neg(b),
+            (_, Some(-1.0)) => return self.neg(a),
+            _ => {}
+        }
+        // constants first, and c1 * (c2 * x) = (c1 c2) * x
+        let (a, b) = if self.as_const(b).is_some() || (self.as_const(a).is_none() && b < a) {
+            (b, a)
+        } else {
+            (a, b)
+        };
+        if let (Some(x), Node::Mul(c, rest)) = (self.as_const(a), self.node(b).clone())
+            && let Some(y) = self.as_const(c)
+        {
+            let folded = self.constant(x * y);
+            return self.mul(folded, rest);
+        }
+        if let Node::Neg(na) = *self.node(a) {
+            let m = self.mul(na, b);
+            return self.neg(m);
+        }
+        if let Node::Neg(nb) = *self.node(b) {
+            let m = self.mul(a, nb);
+            return self.neg(m);
+        }
+        if a == b {
+            return self.powi(a, 2);
+        }
+        self.add(Node::Mul(a, b))
+    }
+
+    pub fn div(&mut self, a: Id, b: Id) -> Id {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) if y != 0.0 => return self.constant(x / y),
+            (Some(0.0), _) => return self.constant(0.0),
+            (_, Some(1.0)) => return a,
+            (_, Some(-1.0)) => return self.neg(a),
+            _ => {}
+        }
+        if a == b {
+            return self.constant(1.0);
+        }
+        self.add(Node::Div(a, b))
+    }
+
+    pub fn neg(&mut self, a: Id) -> Id {
+        if let Some(x) = self.as_const(a) {
+            return self.constant(-x);
+        }
+        match *self.node(a) {
+            Node::Neg(inner) => inner,
+            Node::Sub(x, y) => self.sub(y, x),
+            _ => self.add(Node::Neg(a)),
+        }
+    }
+
+    pub fn powi(&mut self, a: Id, n: i32) -> Id {
+        match n {
+            0 => return self.constant(1.0),
+            1 => return a,
+            _ => {}
+        }
+        if let Some(x) = self.as_const(a) {
+            return self.constant(x.powi(n));
+        }
+        if let Node::Powi(base, m) = *self.node(a)
+            && let Some(nm) = m.checked_mul(n)
+        {
+            return self.powi(base, nm);
+        }
+        self.add(Node::Powi(a, n))
+    }
+
+    pub fn powf(&mut self, a: Id, b: Id) -> Id {
+        if let Some(y) = self.as_const(b) {
+            if y == 0.0 {
+                return self.constant(1.0);
+            }
+            if y == 1.0 {
+                return a;
+            }
+            if y.fract() == 0.0 && y.abs() < 64.0 {
+                return self.powi(a, y as i32);
+            }
+            if y == 0.5 {
+                return self.unary(Func::Sqrt, a);
+            }
+            if let Some(x) = self.as_const(a) {
+                return self.constant(x.powf(y));
+            }
+        }
+        self.add(Node::Powf(a, b))
+    }
+
+    pub fn unary(&mut self, f: Func, a: Id) -> Id {
+        if let Some(x) = self.as_const(a) {
+            return self.constant(f.eval(x));
+        }
+        self.add(Node::Unary(f, a))
+    }
+
+    pub fn atan2(&mut self, y: Id, x: Id) -> Id {
+        if let (Some(a), Some(b)) = (self.as_const(y), self.as_const(x)) {
+            return self.constant(a.atan2(b));
+        }
+        self.add(Node::Atan2(y, x))
+    }
+
+    pub fn hypot(&mut self, a: Id, b: Id) -> Id {
+        if let (Some(x), Some(y)) = (self.as_const(a), self.as_const(b)) {
+            return self.constant(x.hypot(y));
+        }
+        if self.is_const(a, 0.0) {
+            return self.unary(Func::Abs, b);
+        }
+        if self.is_const(b, 0.0) {
+            return self.unary(Func::Abs, a);
+        }
+        self.add(Node::Hypot(a, b))
+    }
+
+    pub fn sum(&mut self, param: u16, body: Id) -> Id {
+        if self.is_const(body, 0.0) {
+            return body;
+        }
+        self.add(Node::Sum { param, body })
+    }
+}
+
+/// The children of a node, in order.
+pub fn children(node: &Node) -> Vec<Id> {
+    match *node {
+        Node::Const(_) | Node::Var(_) | Node::Named(_) => vec![],
+        Node::Neg(a) | Node::Powi(a, _) | Node::Unary(_, a) => vec![a],
+        Node::Sum { body, .. } => vec![body],
+        Node::Add(a, b)
+        | Node::Sub(a, b)
+        | Node::Mul(a, b)
+        | Node::Div(a, b)
+        | Node::Powf(a, b)
+        | Node::Atan2(a, b)
+        | Node::Hypot(a, b) => vec![a, b],
+    }
+}
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+
+    /// A test-only printer: fully parenthesised infix.
+    pub fn show(g: &Graph, id: Id) -> String {
+        match g.node(id).clone() {
+            Node::Const(bits) => format!("{}", f64::from_bits(bits)),
+            Node::Var(Var::Jet { order, index }) => format!("q{order}_{index}"),
+            Node::Var(v) => format!("{v:?}"),
+            Node::Named(i) => g.named[i as usize].clone(),
+            Node::Add(a, b) => format!("({} + {})", show(g, a), show(g, b)),
+            Node::Sub(a, b) => format!("({} - {})", show(g, a), show(g, b)),
+            Node::Mul(a, b) => format!("({} * {})", show(g, a), show(g, b)),
+            Node::Div(a, b) => format!("({} / {})", show(g, a), show(g, b)),
+            Node::Neg(a) => format!("-{}", show(g, a)),
+            Node::Powi(a, n) => format!("{}^{n}", show(g, a)),
+            Node::Powf(a, b) => format!("{}^{}", show(g, a), show(g, b)),
+            Node::Unary(f, a) => format!("{}({})", f.method(), show(g, a)),
+            Node::Atan2(a, b) => format!("atan2({}, {})", show(g, a), show(g, b)),
+            Node::Hypot(a, b) => format!("hypot({}, {})", show(g, a), show(g, b)),
+            Node::Sum { param, body } => format!("sum{param}[{}]", show(g, body)),
+        }
+    }
+
+    fn q(g: &mut Graph, i: u16) -> Id {
+        g.var(Var::Jet { order: 0, index: i })
+    }
+
+    #[test]
+    fn hash_consing_shares_nodes() {
+        let mut g = Graph::default();
+        let a = q(&mut g, 0);
+        let b = q(&mut g, 1);
+        let s1 = g.add_op(a, b);
+        let s2 = g.add_op(b, a);
+        assert_eq!(s1, s2);
+        assert_eq!(g.len(), 3);
+    }
+
+    #[test]
+    fn identities_simplify() {
+        let mut g = Graph::default();
+        let x = q(&mut g, 0);
+        let zero = g.constant(0.0);
+        let one = g.constant(1.0);
+        let two = g.constant(2.0);
+        let three = g.constant(3.0);
+        let cases = [
+            (g.add_op(x, zero), "q0_0"),
+            (g.mul(one, x), "q0_0"),
+            (g.mul(x, zero), "0"),
+            (g.sub(x, x), "0"),
+            (g.mul(two, three), "6"),
+            (g.powi(x, 1), "q0_0"),
+            (g.mul(x, x), "q0_0^2"),
+        ];
+        for (id, want) in cases {
+            assert_eq!(show(&g, id), want);
+        }
+        let m = g.mul(three, x);
+        let mm = g.mul(two, m);
+        assert_eq!(show(&g, mm), "(6 * q0_0)");
+        let n = g.neg(x);
+        let nn = g.neg(n);
+        assert_eq!(nn, x);
+    }
+}

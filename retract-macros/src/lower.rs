@@ -1,0 +1,802 @@
+//! The body of the Lagrangian to a graph node.
+//!
+//! Supported: f64 literals; consts by path; the jet arguments `q[i]`; parameters; `+ - * /`,
+//! unary minus, parentheses; the f64 methods of [`METHODS`]; `let`, `let mut` with `=`,
+//! `+=`, `-=`, `*=`, `/=`; `const` items; `for` over integer ranges (unrolled) and over
+//! slice parameters (a run-time sum: the body may only accumulate into outer variables with
+//! `+=` / `-=`). Everything else is a `syn::Error` at its span; errors are collected so the
+//! user sees all of them.
+
+use std::collections::HashMap;
+
+use proc_macro2::Span;
+use quote::ToTokens;
+use syn::spanned::Spanned;
+use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
+
+use crate::graph::{Func, Graph, Id, Node, Var};
+use crate::signature::{Kind, Signature};
+
+/// The supported f64 methods.
+pub const METHODS: &str =
+    "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, abs";
+
+/// Unrolled iterations allowed in one function (a guard against runaway expansion).
+const MAX_UNROLLED: usize = 100_000;
+
+#[derive(Clone, Copy, Debug)]
+enum Binding {
+    Value { id: Id, mutable: bool },
+    Int(i64),
+    Jet(u8),
+    Param { param: u16, kind: Kind },
+    Element { param: u16, len: usize },
+}
+
+struct SliceLoop {
+    param: u16,
+    /// Scope depth of the loop body; bindings below it are outer.
+    depth: usize,
+    /// Accumulated contributions per outer variable.
+    contributions: Vec<(String, Id)>,
+}
+
+/// Lowers statements into the graph.
+pub struct Lower<'a> {
+    pub g: &'a mut Graph,
+    sig: &'a Signature,
+    scopes: Vec<HashMap<String, Binding>>,
+    slice: Option<SliceLoop>,
+    pub errors: Vec<syn::Error>,
+    unrolled: usize,
+}
+
+impl<'a> Lower<'a> {
+    /// A lowering context with the arguments of `sig` in scope.
+    pub fn new(g: &'a mut Graph, sig: &'a Signature) -> Self {
+        let mut top = HashMap::new();
+        for (order, name) in sig.jet.iter().enumerate() {
+            top.insert(name.to_string(), Binding::Jet(order as u8));
+        }
+        for (i, p) in sig.params.iter().enumerate() {
+            top.insert(
+                p.name.to_string(),
+                Binding::Param {
+                    param: i as u16,
+                    kind: p.kind,
+                },
+            );
+        }
+        Self {
+            g,
+            sig,
+            scopes: vec![top],
+            slice: None,
+            errors: Vec::new(),
+            unrolled: 0,
+        }
+    }
+
+    fn error(&mut self, span: Span, msg: impl Into<String>) -> Id {
+        self.errors.push(syn::Error::new(span, msg.into()));
+        self.g.constant(0.0)
+    }
+
+    fn lookup(&self, name: &str) -> Option<(usize, Binding)> {
+        self.scopes
+            .iter()
+            .enumerate()
+            .rev()
+            .find_map(|(depth, s)| s.get(name).map(|b| (depth, *b)))
+    }
+
+    fn bind(&mut self, name: String, binding: Binding) {
+        if let Some(scope) = self.scopes.last_mut() {
+            scope.insert(name, binding);
+        }
+    }
+
+    /// The whole function body: statements, then the tail expression.
+    pub fn body(&mut self, block: &Block) -> Id {
+        let Some((last, init)) = block.stmts.split_last() else {
+            return self.error(
+                block.span(),
+                "the Lagrangian body is empty: return an f64 expression",
+            );
+        };
+        for stmt in init {
+            self.stmt(stmt);
+        }
+        match last {
+            Stmt::Expr(e, None) => self.expr(e),
+            Stmt::Expr(Expr::Return(r), _) => match &r.expr {
+                Some(e) => self.expr(e),
+                None => self.error(r.span(), "`return` needs the value of the Lagrangian"),
+            },
+            other => {
+                self.stmt(other);
+                self.error(
+                    other.span(),
+                    "the body must end with the value of the Lagrangian (an expression without `;`)",
+                )
+            }
+        }
+    }
+
+    fn block(&mut self, block: &Block) {
+        self.scopes.push(HashMap::new());
+        for stmt in &block.stmts {
+            match stmt {
+                Stmt::Expr(e, None) if !matches!(e, Expr::ForLoop(_)) => {
+                    self.error(
+                        e.span(),
+                        "a loop body must not produce a value: end it with `;`",
+                    );
+                }
+                _ => self.stmt(stmt),
+            }
+        }
+        self.scopes.pop();
+    }
+
+    fn stmt(&mut self, stmt: &Stmt) {
+        match stmt {
+            Stmt::Local(local) => {
+                let (name, mutable) = match &local.pat {
+                    Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
+                        (p.ident.to_string(), p.mutability.is_some())
+                    }
+                    Pat::Type(t) => match &*t.pat {
+                        Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
+                            (p.ident.to_string(), p.mutability.is_some())
+                        }
+                        other => {
+                            self.error(other.span(), "unsupported pattern: bind a plain name");
+                            return;
+                        }
+                    },
+                    other => {
+                        self.error(other.span(), "unsupported pattern: bind a plain name");
+                        return;
+                    }
+                };
+                let id = match &local.init {
+                    Some(init) if init.diverge.is_none() => self.expr(&init.expr),
+                    Some(init) => self.error(init.expr.span(), "`let ... else` is not supported"),
+                    None => self.error(local.span(), "a `let` needs an initial value"),
+                };
+                self.bind(name, Binding::Value { id, mutable });
+            }
+            Stmt::Item(syn::Item::Const(c)) => {
+                let name = c.ident.to_string();
+                match &*c.ty {
+                    syn::Type::Path(p) if p.path.is_ident("f64") => {
+                        let id = self.expr(&c.expr);
+                        if self.g.as_const(id).is_none() && self.errors.is_empty() {
+                            self.error(c.expr.span(), "a `const` must have a constant value");
+                        }
+                        self.bind(name, Binding::Value { id, mutable: false });
+                    }
+                    _ => match self.int(&c.expr) {
+                        Some(v) => self.bind(name, Binding::Int(v)),
+                        None => {
+                            self.bind(name, Binding::Int(0));
+                        }
+                    },
+                }
+            }
+            Stmt::Item(item) => {
+                self.error(
+                    item.span(),
+                    "items inside a Lagrangian are not supported, except `const` values",
+                );
+            }
+            Stmt::Macro(m) => {
+                self.error(m.span(), "macros are not supported inside a Lagrangian");
+            }
+            Stmt::Expr(e, _) => self.effect(e),
+        }
+    }
+
+    /// An expression statement: assignment, compound assignment or a `for` loop.
+    fn effect(&mut self, e: &Expr) {
+        match e {
+            Expr::Assign(a) => {
+                let value = self.expr(&a.right);
+                self.assign(&a.left, None, value);
+            }
+            Expr::Binary(b) if is_assign_op(&b.op) => {
+                let value = self.expr(&b.right);
+                self.assign(&b.left, Some(b.op), value);
+            }
+            Expr::ForLoop(f) => self.for_loop(f),
+            other => {
+                self.unsupported(other);
+            }
+        }
+    }
+
+    fn assign(&mut self, target: &Expr, op: Option<BinOp>, value: Id) {
+        let Expr::Path(p) = target else {
+            self.error(
+                target.span(),
+                "only local `let mut` variables can be assigned",
+            );
+            return;
+        };
+        let Some(ident) = p.path.get_ident() else {
+            self.error(
+                target.span(),
+                "only local `let mut` variables can be assigned",
+            );
+            return;
+        };
+        let name = ident.to_string();
+        let Some((depth, Binding::Value { id: old, mutable })) = self.lookup(&name) else {
+            self.error(
+                ident.span(),
+                format!(
+                    "`{name}` is not a local variable: only `let mut` bindings can be assigned"
+                ),
+            );
+            return;
+        };
+        if !mutable {
+            self.error(
+                ident.span(),
+                format!("`{name}` is not mutable: declare it with `let mut`"),
+            );
+            return;
+        }
+        if let Some(slice) = &self.slice
+            && depth < slice.depth
+        {
+            let sign = match op {
+                Some(BinOp::AddAssign(_)) => 1.0,
+                Some(BinOp::SubAssign(_)) => -1.0,
+                _ => {
+                    self.error(
+                        target.span(),
+                        format!(
+                            "inside a loop over a slice parameter `{name}` can only be \
+                             accumulated with `+=` or `-=` (the loop is a run-time sum)"
+                        ),
+                    );
+                    return;
+                }
+            };
+            let signed = if sign < 0.0 { self.g.neg(value) } else { value };
+            let g = &mut *self.g;
+            if let Some(slice) = &mut self.slice {
+                match slice.contributions.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, acc)) => *acc = g.add_op(*acc, signed),
+                    None => slice.contributions.push((name, signed)),
+                }
+            }
+            return;
+        }
+        let new = match op {
+            None => value,
+            Some(BinOp::AddAssign(_)) => self.g.add_op(old, value),
+            Some(BinOp::SubAssign(_)) => self.g.sub(old, value),
+            Some(BinOp::MulAssign(_)) => self.g.mul(old, value),
+            Some(BinOp::DivAssign(_)) => self.g.div(old, value),
+            Some(other) => {
+                self.error(
+                    other.span(),
+                    "unsupported compound assignment; supported: =, +=, -=, *=, /=",
+                );
+                return;
+            }
+        };
+        for scope in self.scopes.iter_mut().rev() {
+            if let Some(b) = scope.get_mut(&name) {
+                *b = Binding::Value {
+                    id: new,
+                    mutable: true,
+                };
+                break;
+            }
+        }
+    }
+
+    fn for_loop(&mut self, f: &syn::ExprForLoop) {
+        if f.label.is_some() {
+            self.error(f.span(), "loop labels are not supported");
+            return;
+        }
+        let var = match &*f.pat {
+            Pat::Ident(p) if p.by_ref.is_none() && p.mutability.is_none() => {
+                Some(p.ident.to_string())
+            }
+            Pat::Wild(_) => None,
+            other => {
+                self.error(other.span(), "unsupported loop pattern: use a plain name");
+                return;
+            }
+        };
+        match &*f.expr {
+            Expr::Range(r) => {
+                let start = match &r.start {
+                    Some(s) => self.int(s),
+                    None => Some(0),
+                };
+                let Some(end) = r.end.as_ref().and_then(|e| self.int(e)) else {
+                    if r.end.is_none() {
+                        self.error(r.span(), "the range of a `for` loop needs an end");
+                    }
+                    return;
+                };
+                let Some(start) = start else { return };
+                let end = match r.limits {
+                    syn::RangeLimits::HalfOpen(_) => end,
+                    syn::RangeLimits::Closed(_) => end + 1,
+                };
+                let count = (end - start).max(0) as usize;
+                self.unrolled += count * f.body.stmts.len().max(1);
+                if self.unrolled > MAX_UNROLLED {
+                    self.error(r.span(), "loop too long to unroll at compile time");
+                    return;
+                }
+                for i in start..end {
+                    self.scopes.push(HashMap::new());
+                    if let Some(v) = &var {
+                        self.bind(v.clone(), Binding::Int(i));
+                    }
+                    self.block(&f.body);
+                    self.scopes.pop();
+                }
+            }
+            iterable => self.slice_loop(f, var, iterable),
+        }
+    }
+
+    fn slice_loop(&mut self, f: &syn::ExprForLoop, var: Option<String>, iterable: &Expr) {
+        let target = match iterable {
+            Expr::MethodCall(m) if m.method == "iter" && m.args.is_empty() => &*m.receiver,
+            Expr::Reference(r) => &*r.expr,
+            other => other,
+        };
+        let slice = match target {
+            Expr::Path(p) => p
+                .path
+                .get_ident()
+                .and_then(|i| self.lookup(&i.to_string()))
+                .and_then(|(_, b)| match b {
+                    Binding::Param {
+                        param,
+                        kind: Kind::Slice(len),
+                    } => Some((param, len)),
+                    _ => None,
+                }),
+            _ => None,
+        };
+        let Some((param, len)) = slice else {
+            self.error(
+                iterable.span(),
+                "a `for` loop must run over an integer range `a..b` (literal or const bounds) \
+                 or over a slice parameter `&[[f64; N]]`",
+            );
+            return;
+        };
+        if self.slice.is_some() {
+            self.error(
+                iterable.span(),
+                "nested loops over slice parameters are not supported",
+            );
+            return;
+        }
+        self.slice = Some(SliceLoop {
+            param,
+            depth: self.scopes.len(),
+            contributions: Vec::new(),
+        });
+        self.scopes.push(HashMap::new());
+        if let Some(v) = var {
+            self.bind(v, Binding::Element { param, len });
+        }
+        self.block(&f.body);
+        self.scopes.pop();
+        let Some(done) = self.slice.take() else {
+            return;
+        };
+        for (name, body) in done.contributions {
+            let sum = self.g.sum(done.param, body);
+            if let Some((_, Binding::Value { id, .. })) = self.lookup(&name) {
+                let new = self.g.add_op(id, sum);
+                for scope in self.scopes.iter_mut().rev() {
+                    if let Some(b) = scope.get_mut(&name) {
+                        *b = Binding::Value {
+                            id: new,
+                            mutable: true,
+                        };
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    /// An integer expression: literal, loop variable, integer const, + - * and unary minus.
+    fn int(&mut self, e: &Expr) -> Option<i64> {
+        let fail = |this: &mut Self, span: Span| {
+            this.error(
+                span,
+                "expected an integer known at compile time: a literal, a loop variable or a \
+                 `const` declared in the Lagrangian",
+            );
+            None
+        };
+        match e {
+            Expr::Lit(l) => match &l.lit {
+                Lit::Int(i) => i.base10_parse().ok().or_else(|| fail(self, i.span())),
+                other => fail(self, other.span()),
+            },
+            Expr::Paren(p) => self.int(&p.expr),
+            Expr::Group(g) => self.int(&g.expr),
+            Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => self.int(&u.expr).map(|v| -v),
+            Expr::Binary(b) => {
+                let (l, r) = (self.int(&b.left)?, self.int(&b.right)?);
+                match b.op {
+                    BinOp::Add(_) => l.checked_add(r),
+                    BinOp::Sub(_) => l.checked_sub(r),
+                    BinOp::Mul(_) => l.checked_mul(r),
+                    _ => None,
+                }
+                .or_else(|| fail(self, b.span()))
+            }
+            Expr::Path(p) => match p.path.get_ident().and_then(|i| self.lookup(&i.to_string())) {
+                Some((_, Binding::Int(v))) => Some(v),
+                _ => fail(self, p.span()),
+            },
+            other => fail(self, other.span()),
+        }
+    }
+
+    fn unsupported(&mut self, e: &Expr) -> Id {
+        let msg = match e {
+            Expr::If(_) => "`if` is not supported: a Lagrangian must be smooth straight-line code \
+                            (write smooth switches with tanh, abs, ...)"
+                .to_string(),
+            Expr::Match(_) => {
+                "`match` is not supported: a Lagrangian must be straight-line code".into()
+            }
+            Expr::While(_) | Expr::Loop(_) => {
+                "`while` and `loop` are not supported: use `for` over \
+                                               an integer range or a slice parameter"
+                    .into()
+            }
+            Expr::Closure(_) => "closures are not supported inside a Lagrangian".into(),
+            Expr::Macro(_) => "macros are not supported inside a Lagrangian".into(),
+            Expr::Block(_) | Expr::Unsafe(_) => {
+                "blocks are not supported inside an expression".into()
+            }
+            Expr::ForLoop(_) => "a `for` loop is a statement, not a value".into(),
+            Expr::Assign(_) => "an assignment is a statement, not a value".into(),
+            Expr::Reference(_) => "references are not supported in expressions".into(),
+            Expr::Field(_) => "field access is not supported: parameters are f64, [f64; N] or \
+                               &[[f64; N]]"
+                .into(),
+            _ => format!(
+                "unsupported expression `{}`; supported: f64 literals, consts, the arguments \
+                 (indexed as q[i]), + - * /, unary minus, and the methods {METHODS}",
+                e.to_token_stream()
+            ),
+        };
+        self.error(e.span(), msg)
+    }
+
+    /// An f64 expression.
+    pub fn expr(&mut self, e: &Expr) -> Id {
+        match e {
+            Expr::Lit(l) => match &l.lit {
+                Lit::Float(f) => match f.base10_parse::<f64>() {
+                    Ok(v) => self.g.constant(v),
+                    Err(err) => self.error(f.span(), err.to_string()),
+                },
+                Lit::Int(i) => match i.base10_parse::<f64>() {
+                    Ok(v) => self.g.constant(v),
+                    Err(err) => self.error(i.span(), err.to_string()),
+                },
+                other => self.error(other.span(), "only numeric literals are supported"),
+            },
+            Expr::Paren(p) => self.expr(&p.expr),
+            Expr::Group(g) => self.expr(&g.expr),
+            Expr::Unary(u) => match u.op {
+                UnOp::Neg(_) => {
+                    let a = self.expr(&u.expr);
+                    self.g.neg(a)
+                }
+                _ => self.error(u.span(), "unsupported unary operator; supported: `-`"),
+            },
+            Expr::Binary(b) => {
+                let (l, r) = (self.expr(&b.left), self.expr(&b.right));
+                match b.op {
+                    BinOp::Add(_) => self.g.add_op(l, r),
+                    BinOp::Sub(_) => self.g.sub(l, r),
+                    BinOp::Mul(_) => self.g.mul(l, r),
+                    BinOp::Div(_) => self.g.div(l, r),
+                    op if is_assign_op(&op) => {
+                        self.error(b.span(), "an assignment is a statement, not a value")
+                    }
+                    _ => self.error(
+                        b.op.span(),
+                        format!(
+                            "unsupported operator `{}`; supported: + - * /",
+                            b.op.to_token_stream()
+                        ),
+                    ),
+                }
+            }
+            Expr::Path(p) => self.path(p),
+            Expr::Index(ix) => self.index(ix),
+            Expr::MethodCall(m) => self.method(m),
+            Expr::Call(c) => self.call(c),
+            Expr::Cast(c) => {
+                if let Some(v) = self.int_silently(&c.expr) {
+                    return self.g.constant(v as f64);
+                }
+                self.expr(&c.expr)
+            }
+            other => self.unsupported(other),
+        }
+    }
+
+    fn int_silently(&mut self, e: &Expr) -> Option<i64> {
+        let before = self.errors.len();
+        let v = self.int(e);
+        self.errors.truncate(before);
+        v
+    }
+
+    fn path(&mut self, p: &syn::ExprPath) -> Id {
+        if p.qself.is_some() {
+            return self.error(p.span(), "qualified paths are not supported");
+        }
+        let Some(ident) = p.path.get_ident() else {
+            // a const or static of the user's crate, by path
+            let text = p.path.to_token_stream().to_string().replace(' ', "");
+            return self.g.named(text);
+        };
+        let name = ident.to_string();
+        match self.lookup(&name) {
+            Some((depth, Binding::Value { id, .. })) => {
+                if let Some(slice) = &self.slice
+                    && depth < slice.depth
+                    && slice.contributions.iter().any(|(n, _)| *n == name)
+                {
+                    return self.error(
+                        ident.span(),
+                        format!(
+                            "`{name}` is being accumulated by this loop over a slice and cannot \
+                             be read inside it"
+                        ),
+                    );
+                }
+                id
+            }
+            Some((_, Binding::Int(v))) => self.g.constant(v as f64),
+            Some((_, Binding::Jet(order))) => {
+                if self.sig.scalar_jet {
+                    self.g.var(Var::Jet { order, index: 0 })
+                } else {
+                    self.error(
+                        ident.span(),
+                        format!("`{name}` is an array: use its components `{name}[i]`"),
+                    )
+                }
+            }
+            Some((_, Binding::Param { param, kind })) => match kind {
+                Kind::Scalar => self.g.var(Var::Param { param, index: 0 }),
+                _ => self.error(
+                    ident.span(),
+                    format!("`{name}` is an array: use its components `{name}[i]`"),
+                ),
+            },
+            Some((_, Binding::Element { .. })) => self.error(
+                ident.span(),
+                format!("`{name}` is an array: use its components `{name}[i]`"),
+            ),
+            None if is_const_name(&name) => self.g.named(name),
+            None => self.error(
+                ident.span(),
+                format!(
+                    "cannot find `{name}`: a Lagrangian may use its arguments, `let` bindings, \
+                     loop variables and consts (SCREAMING_CASE or by path)"
+                ),
+            ),
+        }
+    }
+
+    fn index(&mut self, ix: &syn::ExprIndex) -> Id {
+        let Expr::Path(p) = &*ix.expr else {
+            return self.error(ix.expr.span(), "only arguments can be indexed, as `q[i]`");
+        };
+        let Some(ident) = p.path.get_ident() else {
+            return self.error(p.span(), "only arguments can be indexed, as `q[i]`");
+        };
+        let name = ident.to_string();
+        let Some(i) = self.int(&ix.index) else {
+            return self.g.constant(0.0);
+        };
+        let (len, var) = match self.lookup(&name) {
+            Some((_, Binding::Jet(order))) if !self.sig.scalar_jet => (
+                self.sig.dim,
+                Var::Jet {
+                    order,
+                    index: i.clamp(0, u16::MAX as i64) as u16,
+                },
+            ),
+            Some((
+                _,
+                Binding::Param {
+                    param,
+                    kind: Kind::Array(len),
+                },
+            )) => (
+                len,
+                Var::Param {
+                    param,
+                    index: i.clamp(0, u16::MAX as i64) as u16,
+                },
+            ),
+            Some((_, Binding::Element { param, len })) => (
+                len,
+                Var::Elem {
+                    param,
+                    index: i.clamp(0, u16::MAX as i64) as u16,
+                },
+            ),
+            _ => {
+                return self.error(
+                    ident.span(),
+                    format!("`{name}` cannot be indexed: only array arguments can, as `q[i]`"),
+                );
+            }
+        };
+        if i < 0 || i as usize >= len {
+            return self.error(
+                ix.index.span(),
+                format!("index {i} out of range for `{name}`, which has {len} components"),
+            );
+        }
+        self.g.var(var)
+    }
+
+    fn method(&mut self, m: &syn::ExprMethodCall) -> Id {
+        if m.turbofish.is_some() {
+            return self.error(m.span(), "turbofish is not supported");
+        }
+        let name = m.method.to_string();
+        let receiver = self.expr(&m.receiver);
+        let args: Vec<&Expr> = m.args.iter().collect();
+        self.apply(&name, m.method.span(), m.span(), receiver, &args)
+    }
+
+    /// `f64::sqrt(x)` and friends: the method form with the receiver as first argument.
+    fn call(&mut self, c: &syn::ExprCall) -> Id {
+        let Expr::Path(p) = &*c.func else {
+            return self.unsupported(&c.func);
+        };
+        let segments: Vec<String> = p
+            .path
+            .segments
+            .iter()
+            .map(|s| s.ident.to_string())
+            .collect();
+        if segments.len() == 2 && segments[0] == "f64" && !c.args.is_empty() {
+            let args: Vec<&Expr> = c.args.iter().collect();
+            let receiver = self.expr(args[0]);
+            let span = p.path.segments[1].ident.span();
+            return self.apply(&segments[1], span, c.span(), receiver, &args[1..]);
+        }
+        self.error(
+            c.func.span(),
+            format!(
+                "call to unknown function `{}`: a Lagrangian can only call the f64 methods \
+                 {METHODS}; inline helper functions into the Lagrangian",
+                p.path.to_token_stream().to_string().replace(' ', "")
+            ),
+        )
+    }
+
+    fn apply(&mut self, name: &str, name_span: Span, span: Span, x: Id, args: &[&Expr]) -> Id {
+        let expected = match name {
+            "powi" | "powf" | "atan2" | "hypot" => 1,
+            "sqrt" | "exp" | "ln" | "sin" | "cos" | "tan" | "tanh" | "recip" | "abs" => 0,
+            _ => {
+                return self.error(
+                    name_span,
+                    format!("unsupported method `{name}`; supported: {METHODS}"),
+                );
+            }
+        };
+        if args.len() != expected {
+            return self.error(span, format!("`{name}` takes {expected} argument(s)"));
+        }
+        let unary = |f| Some(f);
+        let func = match name {
+            "sqrt" => unary(Func::Sqrt),
+            "exp" => unary(Func::Exp),
+            "ln" => unary(Func::Ln),
+            "sin" => unary(Func::Sin),
+            "cos" => unary(Func::Cos),
+            "tan" => unary(Func::Tan),
+            "tanh" => unary(Func::Tanh),
+            "abs" => unary(Func::Abs),
+            _ => None,
+        };
+        if let Some(f) = func {
+            return self.g.unary(f, x);
+        }
+        match name {
+            "recip" => {
+                let one = self.g.constant(1.0);
+                self.g.div(one, x)
+            }
+            "powi" => match self.int(args[0]) {
+                Some(n) if i32::try_from(n).is_ok() => self.g.powi(x, n as i32),
+                Some(_) => self.error(args[0].span(), "exponent out of range for powi"),
+                None => self.g.constant(0.0),
+            },
+            "powf" => {
+                let e = self.expr(args[0]);
+                if self.depends_on_jet(e) {
+                    return self.error(
+                        args[0].span(),
+                        "the exponent of `powf` must not depend on the jet (q, q', ...): write \
+                         `(b * a.ln()).exp()` for a variable exponent",
+                    );
+                }
+                self.g.powf(x, e)
+            }
+            "atan2" => {
+                let other = self.expr(args[0]);
+                self.g.atan2(x, other)
+            }
+            _ => {
+                let other = self.expr(args[0]);
+                self.g.hypot(x, other)
+            }
+        }
+    }
+
+    fn depends_on_jet(&self, id: Id) -> bool {
+        let mut stack = vec![id];
+        let mut seen = std::collections::HashSet::new();
+        while let Some(n) = stack.pop() {
+            if !seen.insert(n) {
+                continue;
+            }
+            match self.g.node(n) {
+                Node::Var(Var::Jet { .. }) => return true,
+                node => stack.extend(crate::graph::children(node)),
+            }
+        }
+        false
+    }
+}
+
+fn is_assign_op(op: &BinOp) -> bool {
+    matches!(
+        op,
+        BinOp::AddAssign(_)
+            | BinOp::SubAssign(_)
+            | BinOp::MulAssign(_)
+            | BinOp::DivAssign(_)
+            | BinOp::RemAssign(_)
+            | BinOp::BitXorAssign(_)
+            | BinOp::BitAndAssign(_)
+            | BinOp::BitOrAssign(_)
+            | BinOp::ShlAssign(_)
+            | BinOp::ShrAssign(_)
+    )
+}
+
+/// SCREAMING_CASE names are consts of the user's crate.
+fn is_const_name(name: &str) -> bool {
+    name.chars().any(|c| c.is_ascii_uppercase())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
+}

@@ -1,0 +1,271 @@
+//! The mechanics of a Lagrangian, as graph nodes: gradient and Hessian in (x, u), the
+//! Ostrogradsky momenta, the Legendre inversion when L is quadratic in u, and the residual
+//! and Jacobians of the lifted theta-scheme (formulas in `retract_core::LiftedSystem`).
+
+use std::collections::HashMap;
+
+use crate::diff::{Differentiator, substitute, total_derivative};
+use crate::graph::{Graph, Id, Var};
+
+/// u = A^{-1} (p_{k-1} - b(x)) where L is quadratic in u: A = d2L/du2 does not depend on u,
+/// b = dL/du at u = 0.
+pub struct LegendreInverse {
+    /// A, row-major n x n.
+    pub a: Vec<Id>,
+    /// b(x), n entries.
+    pub b: Vec<Id>,
+    /// A^{-1} when every entry of A is a number (row-major), else the inversion is a
+    /// run-time linear solve.
+    pub a_inv: Option<Vec<f64>>,
+}
+
+/// Every quantity the emitted code needs.
+pub struct Mechanics {
+    pub lagrangian: Id,
+    /// dL/dq^(j)_i at `j * n + i`, j = 0..=k.
+    pub gradient: Vec<Id>,
+    /// Hessian over the same index, full and symmetric (shared ids).
+    pub hessian: Vec<Vec<Id>>,
+    /// p_j component i at `j * n + i`, j = 0..k, as functions of q..q^(2k-1).
+    pub momenta: Vec<Id>,
+    pub legendre_inverse: Option<LegendreInverse>,
+    /// F(z0, w), M = 2nk + n entries.
+    pub residual: Vec<Id>,
+    /// dF/dw, row-major M x M.
+    pub jacobian: Vec<Id>,
+    /// dF/dz0, row-major M x S.
+    pub jacobian_initial: Vec<Id>,
+}
+
+/// Why the mechanics cannot be built.
+pub enum Degenerate {
+    /// L does not depend on u at all.
+    Independent,
+    /// L depends on u but d2L/du2 vanishes identically (e.g. linear in u).
+    Linear,
+    /// A = d2L/du2 is constant and singular.
+    Singular,
+}
+
+fn jet(order: usize, index: usize) -> Var {
+    Var::Jet {
+        order: order as u8,
+        index: index as u16,
+    }
+}
+
+/// Builds the mechanics of L = `lagrangian` of order k on R^n.
+pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechanics, Degenerate> {
+    let mut d = Differentiator::default();
+    let vars: Vec<Var> = (0..=k)
+        .flat_map(|j| (0..n).map(move |i| jet(j, i)))
+        .collect();
+    let gradient: Vec<Id> = vars.iter().map(|&v| d.diff(g, lagrangian, v)).collect();
+    let m = vars.len();
+    let mut hessian = vec![vec![g.constant(0.0); m]; m];
+    for a in 0..m {
+        for b in a..m {
+            let h = d.diff(g, gradient[a], vars[b]);
+            hessian[a][b] = h;
+            hessian[b][a] = h;
+        }
+    }
+
+    // Degeneracy in the top derivative.
+    let top = k * n;
+    let a: Vec<Id> = (0..n * n)
+        .map(|r| hessian[top + r / n][top + r % n])
+        .collect();
+    if a.iter().all(|&e| g.is_const(e, 0.0)) {
+        return Err(if gradient[top..].iter().all(|&e| g.is_const(e, 0.0)) {
+            Degenerate::Independent
+        } else {
+            Degenerate::Linear
+        });
+    }
+
+    // Momenta: p_{k-1} = dL/dq^(k); p_{j-1} = dL/dq^(j) - D p_j.
+    let mut momenta = vec![g.constant(0.0); n * k];
+    momenta[(k - 1) * n..].copy_from_slice(&gradient[top..top + n]);
+    for j in (1..k).rev() {
+        for i in 0..n {
+            let dp = total_derivative(g, &mut d, momenta[j * n + i], n, 2 * k - 1);
+            momenta[(j - 1) * n + i] = g.sub(gradient[j * n + i], dp);
+        }
+    }
+
+    let legendre_inverse = legendre_inverse(g, &mut d, &a, &gradient[top..], n, k)?;
+    let (residual, jacobian, jacobian_initial) = scheme(g, &mut d, &gradient, n, k);
+    Ok(Mechanics {
+        lagrangian,
+        gradient,
+        hessian,
+        momenta,
+        legendre_inverse,
+        residual,
+        jacobian,
+        jacobian_initial,
+    })
+}
+
+fn legendre_inverse(
+    g: &mut Graph,
+    d: &mut Differentiator,
+    a: &[Id],
+    grad_u: &[Id],
+    n: usize,
+    k: usize,
+) -> Result<Option<LegendreInverse>, Degenerate> {
+    let depends_on_u = a.iter().any(|&e| {
+        (0..n).any(|i| {
+            let de = d.diff(g, e, jet(k, i));
+            !g.is_const(de, 0.0)
+        })
+    });
+    if depends_on_u {
+        return Ok(None);
+    }
+    let mut memo = HashMap::new();
+    let zero_u = move |g: &mut Graph, v: Var| match v {
+        Var::Jet { order, .. } if order as usize == k => Some(g.constant(0.0)),
+        _ => None,
+    };
+    let b = grad_u
+        .iter()
+        .map(|&e| substitute(g, e, &zero_u, &mut memo))
+        .collect();
+    let numbers: Option<Vec<f64>> = a.iter().map(|&e| g.as_const(e)).collect();
+    let a_inv = match numbers {
+        Some(values) => Some(invert(&values, n).ok_or(Degenerate::Singular)?),
+        None => None,
+    };
+    Ok(Some(LegendreInverse {
+        a: a.to_vec(),
+        b,
+        a_inv,
+    }))
+}
+
+/// Gauss-Jordan inverse with partial pivoting; `None` if singular.
+fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    let mut m = a.to_vec();
+    let mut inv: Vec<f64> = (0..n * n)
+        .map(|r| if r / n == r % n { 1.0 } else { 0.0 })
+        .collect();
+    let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    for col in 0..n {
+        let pivot =
+            (col..n).max_by(|&x, &y| m[x * n + col].abs().total_cmp(&m[y * n + col].abs()))?;
+        if m[pivot * n + col].abs() <= 1e-14 * scale {
+            return None;
+        }
+        for c in 0..n {
+            m.swap(col * n + c, pivot * n + c);
+            inv.swap(col * n + c, pivot * n + c);
+        }
+        let p = m[col * n + col];
+        for c in 0..n {
+            m[col * n + c] /= p;
+            inv[col * n + c] /= p;
+        }
+        for r in 0..n {
+            if r != col {
+                let f = m[r * n + col];
+                for c in 0..n {
+                    m[r * n + c] -= f * m[col * n + c];
+                    inv[r * n + c] -= f * inv[col * n + c];
+                }
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// Residual F(z0, w) of the theta-scheme and its Jacobians.
+fn scheme(
+    g: &mut Graph,
+    d: &mut Differentiator,
+    gradient: &[Id],
+    n: usize,
+    k: usize,
+) -> (Vec<Id>, Vec<Id>, Vec<Id>) {
+    let s = 2 * n * k;
+    let m = s + n;
+    let h = g.var(Var::Step);
+    let theta = g.var(Var::Theta);
+    let one = g.constant(1.0);
+    let one_minus_theta = g.sub(one, theta);
+    let x0 = |g: &mut Graph, j: usize, i: usize| g.var(Var::Z0((j * n + i) as u16));
+    let p0 = |g: &mut Graph, j: usize, i: usize| g.var(Var::Z0(((k + j) * n + i) as u16));
+    let x1 = |g: &mut Graph, j: usize, i: usize| g.var(Var::W((j * n + i) as u16));
+    let p1 = |g: &mut Graph, j: usize, i: usize| g.var(Var::W(((k + j) * n + i) as u16));
+    let u = |g: &mut Graph, i: usize| g.var(Var::W((s + i) as u16));
+    let mut x_th = vec![g.constant(0.0); n * k];
+    let mut p_th = vec![g.constant(0.0); n * k];
+    for j in 0..k {
+        for i in 0..n {
+            let (a, b) = (x0(g, j, i), x1(g, j, i));
+            let (ta, tb) = (g.mul(one_minus_theta, a), g.mul(theta, b));
+            x_th[j * n + i] = g.add_op(ta, tb);
+            let (a, b) = (p0(g, j, i), p1(g, j, i));
+            let (ta, tb) = (g.mul(theta, a), g.mul(one_minus_theta, b));
+            p_th[j * n + i] = g.add_op(ta, tb);
+        }
+    }
+    // dL/dx_j and dL/du at (x_th, u)
+    let at_point = {
+        let x_th = x_th.clone();
+        move |g: &mut Graph, v: Var| match v {
+            Var::Jet { order, index } if (order as usize) < k => {
+                Some(x_th[order as usize * n + index as usize])
+            }
+            Var::Jet { order, index } if order as usize == k => {
+                Some(g.var(Var::W((s + index as usize) as u16)))
+            }
+            _ => None,
+        }
+    };
+    let mut memo = HashMap::new();
+    let g_at: Vec<Id> = gradient
+        .iter()
+        .map(|&e| substitute(g, e, &at_point, &mut memo))
+        .collect();
+
+    let mut f = vec![g.constant(0.0); m];
+    for j in 0..k {
+        for i in 0..n {
+            let rate = if j + 1 < k {
+                x_th[(j + 1) * n + i]
+            } else {
+                u(g, i)
+            };
+            let (a, b) = (x1(g, j, i), x0(g, j, i));
+            let diff = g.sub(a, b);
+            let hr = g.mul(h, rate);
+            f[j * n + i] = g.sub(diff, hr);
+
+            let mut force = g_at[j * n + i];
+            if j > 0 {
+                force = g.sub(force, p_th[(j - 1) * n + i]);
+            }
+            let (a, b) = (p1(g, j, i), p0(g, j, i));
+            let diff = g.sub(a, b);
+            let hf = g.mul(h, force);
+            f[(k + j) * n + i] = g.sub(diff, hf);
+        }
+    }
+    for i in 0..n {
+        f[s + i] = g.sub(p_th[(k - 1) * n + i], g_at[k * n + i]);
+    }
+    let mut jacobian = Vec::with_capacity(m * m);
+    let mut jacobian_initial = Vec::with_capacity(m * s);
+    for &row in &f {
+        for c in 0..m {
+            jacobian.push(d.diff(g, row, Var::W(c as u16)));
+        }
+        for c in 0..s {
+            jacobian_initial.push(d.diff(g, row, Var::Z0(c as u16)));
+        }
+    }
+    (f, jacobian, jacobian_initial)
+}

@@ -1,0 +1,310 @@
+//! The attribute and the signature: order k, dimension n, parameters.
+
+use proc_macro2::{Span, TokenStream};
+use syn::spanned::Spanned;
+use syn::{FnArg, Ident, ItemFn, Pat, ReturnType, Type};
+
+/// Highest supported order.
+pub const MAX_ORDER: usize = 4;
+
+/// What an argument of the Lagrangian is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `f64`
+    Scalar,
+    /// `[f64; len]`
+    Array(usize),
+    /// `&[[f64; len]]`: any number of elements, summed over by run-time loops.
+    Slice(usize),
+}
+
+impl Kind {
+    fn describe(self) -> String {
+        match self {
+            Kind::Scalar => "f64".into(),
+            Kind::Array(n) => format!("[f64; {n}]"),
+            Kind::Slice(n) => format!("&[[f64; {n}]]"),
+        }
+    }
+}
+
+/// A parameter: an argument after the jet.
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: Ident,
+    pub kind: Kind,
+}
+
+/// The attribute and signature, checked.
+#[derive(Clone, Debug)]
+pub struct Signature {
+    /// Order k.
+    pub order: usize,
+    /// Dimension n.
+    pub dim: usize,
+    /// Whether the jet arguments are plain `f64` (n = 1).
+    pub scalar_jet: bool,
+    /// Names of q, q', ..., q^(k).
+    pub jet: Vec<Ident>,
+    /// Parameters, in order.
+    pub params: Vec<Param>,
+    /// Name of the generated type.
+    pub type_name: Ident,
+}
+
+/// Options of the attribute.
+struct Options {
+    order: Option<(usize, Span)>,
+    name: Option<Ident>,
+}
+
+fn parse_options(attr: TokenStream) -> syn::Result<Options> {
+    let mut options = Options {
+        order: None,
+        name: None,
+    };
+    let parser = syn::meta::parser(|meta| {
+        if meta.path.is_ident("order") {
+            let lit: syn::LitInt = meta.value()?.parse()?;
+            let k: usize = lit.base10_parse()?;
+            if !(1..=MAX_ORDER).contains(&k) {
+                return Err(syn::Error::new(
+                    lit.span(),
+                    format!("unsupported order {k}; supported: order = 1..={MAX_ORDER}"),
+                ));
+            }
+            options.order = Some((k, lit.span()));
+            Ok(())
+        } else if meta.path.is_ident("name") {
+            options.name = Some(meta.value()?.parse()?);
+            Ok(())
+        } else {
+            Err(meta.error("unsupported option; supported: `order = k` (1..=4), `name = TypeName`"))
+        }
+    });
+    syn::parse::Parser::parse2(parser, attr)?;
+    Ok(options)
+}
+
+fn kind_of(ty: &Type) -> Option<Kind> {
+    fn is_f64(ty: &Type) -> bool {
+        matches!(ty, Type::Path(p) if p.qself.is_none() && p.path.is_ident("f64"))
+    }
+    fn array_len(ty: &Type) -> Option<usize> {
+        match ty {
+            Type::Array(a) if is_f64(&a.elem) => match &a.len {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(n),
+                    ..
+                }) => n.base10_parse().ok().filter(|&n: &usize| n > 0),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+    match ty {
+        _ if is_f64(ty) => Some(Kind::Scalar),
+        Type::Array(_) => array_len(ty).map(Kind::Array),
+        Type::Reference(r) if r.mutability.is_none() => match &*r.elem {
+            Type::Slice(s) => array_len(&s.elem).map(Kind::Slice),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// "UpperCamelCase" of a snake_case name.
+fn camel(name: &Ident) -> Ident {
+    let s: String = name
+        .to_string()
+        .trim_start_matches("r#")
+        .split('_')
+        .filter(|w| !w.is_empty())
+        .map(|w| {
+            let mut c = w.chars();
+            match c.next() {
+                Some(f) => f.to_uppercase().chain(c).collect::<String>(),
+                None => String::new(),
+            }
+        })
+        .collect();
+    let s = if s.is_empty() { "Lagrangian".into() } else { s };
+    Ident::new(&s, name.span())
+}
+
+/// Checks the attribute and the signature of `item`.
+pub fn parse(attr: TokenStream, item: &ItemFn) -> syn::Result<Signature> {
+    let options = parse_options(attr)?;
+    let sig = &item.sig;
+    let mut errors: Vec<syn::Error> = Vec::new();
+    let fail = |errors: &mut Vec<syn::Error>, span: Span, msg: String| {
+        errors.push(syn::Error::new(span, msg))
+    };
+
+    let Some((order, order_span)) = options.order else {
+        return Err(syn::Error::new(
+            Span::call_site(),
+            "missing the order: write #[higher_order_lagrangian(order = k)] with k in 1..=4",
+        ));
+    };
+    if let Some(c) = &sig.constness {
+        fail(
+            &mut errors,
+            c.span(),
+            "a Lagrangian cannot be a `const fn`".into(),
+        );
+    }
+    if let Some(a) = &sig.asyncness {
+        fail(
+            &mut errors,
+            a.span(),
+            "a Lagrangian cannot be `async`".into(),
+        );
+    }
+    if let Some(u) = &sig.unsafety {
+        fail(
+            &mut errors,
+            u.span(),
+            "a Lagrangian cannot be `unsafe`".into(),
+        );
+    }
+    if !sig.generics.params.is_empty() || sig.generics.where_clause.is_some() {
+        fail(
+            &mut errors,
+            sig.generics.span(),
+            "a Lagrangian cannot be generic: write it for f64 and concrete array lengths".into(),
+        );
+    }
+    match &sig.output {
+        ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
+        ReturnType::Type(_, ty) => fail(
+            &mut errors,
+            ty.span(),
+            "a Lagrangian returns a scalar: the return type must be `f64`".into(),
+        ),
+        ReturnType::Default => fail(
+            &mut errors,
+            sig.ident.span(),
+            "a Lagrangian returns a scalar: add `-> f64`".into(),
+        ),
+    }
+
+    let mut args: Vec<(Ident, Kind)> = Vec::new();
+    for input in &sig.inputs {
+        let FnArg::Typed(arg) = input else {
+            fail(
+                &mut errors,
+                input.span(),
+                "a Lagrangian is a free function: `self` is not supported".into(),
+            );
+            continue;
+        };
+        let name = match &*arg.pat {
+            Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
+                if let Some(m) = &p.mutability {
+                    fail(
+                        &mut errors,
+                        m.span(),
+                        format!(
+                            "parameter `{}` cannot be mutable: the arguments of a Lagrangian \
+                             are read-only; copy it into a `let mut` binding",
+                            p.ident
+                        ),
+                    );
+                }
+                p.ident.clone()
+            }
+            other => {
+                fail(
+                    &mut errors,
+                    other.span(),
+                    "unsupported argument pattern: use a plain name".into(),
+                );
+                continue;
+            }
+        };
+        match kind_of(&arg.ty) {
+            Some(kind) => args.push((name, kind)),
+            None => fail(
+                &mut errors,
+                arg.ty.span(),
+                "unsupported argument type; supported: `f64`, `[f64; N]` with a literal N, \
+                 and `&[[f64; N]]` for a parameter list of any length"
+                    .into(),
+            ),
+        }
+    }
+
+    let jet_kind = args.first().map(|(_, k)| *k);
+    let mut dim = 0;
+    let mut scalar_jet = false;
+    match jet_kind {
+        Some(Kind::Scalar) => {
+            dim = 1;
+            scalar_jet = true;
+        }
+        Some(Kind::Array(n)) => dim = n,
+        Some(Kind::Slice(_)) => fail(
+            &mut errors,
+            sig.inputs.span(),
+            "the first argument is the configuration q: `f64` or `[f64; N]`, not a slice".into(),
+        ),
+        None => {}
+    }
+    if args.len() < order + 1 && errors.is_empty() {
+        fail(
+            &mut errors,
+            order_span,
+            format!(
+                "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
+                 the signature has {}",
+                order + 1,
+                args.len()
+            ),
+        );
+    }
+    let mut jet = Vec::new();
+    for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
+        if Some(*kind) != jet_kind {
+            let expected = jet_kind.map(Kind::describe).unwrap_or_default();
+            let msg = if matches!(kind, Kind::Array(_)) && matches!(jet_kind, Some(Kind::Array(_)))
+            {
+                format!(
+                    "inconsistent dimensions across jet arguments: `{name}` is {} but `{}` is \
+                     {expected}",
+                    kind.describe(),
+                    args[0].0
+                )
+            } else {
+                format!(
+                    "order = {order} makes argument {} (`{name}`) the derivative q^({i}), which must \
+                     have the type of q ({expected}), not {}; check the order",
+                    i + 1,
+                    kind.describe()
+                )
+            };
+            fail(&mut errors, name.span(), msg);
+        }
+        jet.push(name.clone());
+    }
+    let params = args
+        .iter()
+        .skip(order + 1)
+        .map(|(name, kind)| Param {
+            name: name.clone(),
+            kind: *kind,
+        })
+        .collect();
+
+    if let Some(e) = crate::expand::combine(errors) {
+        return Err(e);
+    }
+    Ok(Signature {
+        order,
+        dim,
+        scalar_jet,
+        jet,
+        params,
+        type_name: options.name.unwrap_or_else(|| camel(&sig.ident)),
+    })
+}
