@@ -1,8 +1,4 @@
-//! `retract`: structure-preserving integrators and optimal-control solvers for
-//! higher-order Lagrangians.
-//!
-//! This facade re-exports the runtime ([`retract_core`]) and the attribute macro crate.
-//! See the README for a tour.
+#![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

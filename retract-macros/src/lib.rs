@@ -2,7 +2,7 @@
 //!
 //! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically at
 //! compile time and emits straight-line code for the `retract_core` traits. The stages, one
-//! module each: [`signature`] (order, dimension, parameters) -> `lower` (body to a
+//! module each: `signature` (order, dimension, parameters) -> `lower` (body to a
 //! hash-consed expression graph) -> `mechanics` (gradient, Hessian, momenta, scheme) ->
 //! `codegen` (one `let` per shared node). `expand` is an ordinary function over
 //! `proc_macro2` tokens, unit-tested without the compiler.
@@ -20,7 +20,7 @@ use proc_macro::TokenStream;
 
 /// Turns a higher-order Lagrangian into an integrator.
 ///
-/// ```ignore
+/// ```text
 /// #[higher_order_lagrangian(order = 2)]
 /// fn obstacle(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
 ///     0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)

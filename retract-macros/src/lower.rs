@@ -26,11 +26,22 @@ const MAX_UNROLLED: usize = 100_000;
 
 #[derive(Clone, Copy, Debug)]
 enum Binding {
-    Value { id: Id, mutable: bool },
+    Value {
+        id: Id,
+        mutable: bool,
+    },
     Int(i64),
     Jet(u8),
-    Param { param: u16, kind: Kind },
-    Element { param: u16, len: usize },
+    Param {
+        param: u16,
+        kind: Kind,
+    },
+    Element {
+        param: u16,
+        len: usize,
+    },
+    /// A binding whose initialiser was already reported as an error: later uses are silent.
+    Poisoned,
 }
 
 struct SliceLoop {
@@ -160,12 +171,18 @@ impl<'a> Lower<'a> {
                         return;
                     }
                 };
+                let before = self.errors.len();
                 let id = match &local.init {
                     Some(init) if init.diverge.is_none() => self.expr(&init.expr),
                     Some(init) => self.error(init.expr.span(), "`let ... else` is not supported"),
                     None => self.error(local.span(), "a `let` needs an initial value"),
                 };
-                self.bind(name, Binding::Value { id, mutable });
+                let binding = if self.errors.len() > before {
+                    Binding::Poisoned
+                } else {
+                    Binding::Value { id, mutable }
+                };
+                self.bind(name, binding);
             }
             Stmt::Item(syn::Item::Const(c)) => {
                 let name = c.ident.to_string();
@@ -576,6 +593,7 @@ impl<'a> Lower<'a> {
                 id
             }
             Some((_, Binding::Int(v))) => self.g.constant(v as f64),
+            Some((_, Binding::Poisoned)) => self.g.constant(0.0),
             Some((_, Binding::Jet(order))) => {
                 if self.sig.scalar_jet {
                     self.g.var(Var::Jet { order, index: 0 })
@@ -678,6 +696,14 @@ impl<'a> Lower<'a> {
         let Expr::Path(p) = &*c.func else {
             return self.unsupported(&c.func);
         };
+        if let Some(ident) = p.path.get_ident()
+            && matches!(
+                self.lookup(&ident.to_string()),
+                Some((_, Binding::Poisoned))
+            )
+        {
+            return self.g.constant(0.0);
+        }
         let segments: Vec<String> = p
             .path
             .segments

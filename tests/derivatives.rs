@@ -1,0 +1,365 @@
+//! Property tests of the generated code at 100 random points per Lagrangian, against
+//! fourth-order central finite differences (error O(eps^4), relative tolerance 1e-8):
+//! gradient (of `lagrangian`), Hessian (of `gradient`), momenta (by differentiating the
+//! momenta in time along the polynomial curve with the given jet), H(Leg(jet)) = E_L(jet),
+//! the vector field = J grad H, and the scheme's Jacobians (of `residual`).
+
+#![allow(clippy::needless_range_loop)] // index loops mirror the formulas
+
+use proptest::prelude::*;
+use retract::higher_order_lagrangian;
+use retract::nalgebra::{SMatrix, SVector};
+use retract::{Lagrangian, LiftedSystem};
+
+// ---- the Lagrangians --------------------------------------------------------------------
+
+/// k = 1, nonlinear potential (pendulum + quartic) on R^2.
+#[higher_order_lagrangian(order = 1)]
+fn pendulum(q: [f64; 2], dq: [f64; 2], m: f64, g: f64) -> f64 {
+    0.5 * m * (dq[0].powi(2) + dq[1].powi(2)) + m * g * q[0].cos() - 0.25 * q[1].powi(4)
+}
+
+/// k = 1 on R (scalar jet).
+#[higher_order_lagrangian(order = 1)]
+fn anharmonic(q: f64, dq: f64, w: f64) -> f64 {
+    0.5 * dq * dq - 0.5 * w * w * q * q - 0.1 * q.powi(4)
+}
+
+/// k = 2, the obstacle barrier on the SE(2) chart (x, y, theta), any number of obstacles
+/// (cx, cy, r) in a run-time loop.
+#[higher_order_lagrangian(order = 2)]
+fn se2_barrier(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, obstacles: &[[f64; 3]]) -> f64 {
+    let mut l = 0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2));
+    for o in obstacles {
+        l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);
+    }
+    l
+}
+
+/// k = 2, minimum torque of a planar two-link arm: L = 1/2 |M(q) q'' + c(q, q') + g(q)|^2.
+#[higher_order_lagrangian(order = 2)]
+fn arm(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], a: f64, b: f64, d: f64, g1: f64, g2: f64) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let m11 = a + 2.0 * b * c2;
+    let m12 = d + b * c2;
+    let m22 = d;
+    let c1 = -b * s2 * (2.0 * dq[0] * dq[1] + dq[1].powi(2));
+    let cc2 = b * s2 * dq[0].powi(2);
+    let gr1 = g1 * q[0].cos() + g2 * (q[0] + q[1]).cos();
+    let gr2 = g2 * (q[0] + q[1]).cos();
+    let t1 = m11 * ddq[0] + m12 * ddq[1] + c1 + gr1;
+    let t2 = m12 * ddq[0] + m22 * ddq[1] + cc2 + gr2;
+    0.5 * (t1 * t1 + t2 * t2)
+}
+
+/// k = 3, minimum jerk with a potential.
+#[higher_order_lagrangian(order = 3)]
+fn jerk(q: [f64; 2], dq: [f64; 2], _ddq: [f64; 2], dddq: [f64; 2], kappa: f64) -> f64 {
+    0.5 * (dddq[0].powi(2) + dddq[1].powi(2)) + kappa * (q[0] * q[1]).sin() + 0.1 * dq[0].powi(2)
+}
+
+/// k = 4, minimum snap in R^3.
+#[higher_order_lagrangian(order = 4)]
+fn snap(q: [f64; 3], dq: [f64; 3], ddq: [f64; 3], dddq: [f64; 3], d4q: [f64; 3]) -> f64 {
+    let mut l = 0.0;
+    for i in 0..3 {
+        l += 0.5 * d4q[i].powi(2) + 0.01 * ddq[i] * dddq[i] + 0.05 * q[i].powi(2) * dq[i];
+    }
+    l
+}
+
+/// k = 2 with atan2, exp and sqrt, and a configuration-dependent Hessian in q''.
+#[higher_order_lagrangian(order = 2)]
+fn transcendental(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], alpha: f64) -> f64 {
+    let weight = 1.0 + 0.1 * (0.3 * q[0]).exp();
+    0.5 * weight * (ddq[0].powi(2) + ddq[1].powi(2))
+        + 0.2 * ddq[0] * ddq[1] * q[1].atan2(q[0]).cos()
+        + alpha * q[1].atan2(q[0])
+        + (1.0 + q[0].powi(2) + dq[1].powi(2)).sqrt()
+}
+
+// ---- finite differences -----------------------------------------------------------------
+
+/// f'(0) of a scalar function of one variable, fourth-order central stencil.
+fn fd(f: impl Fn(f64) -> f64, eps: f64) -> f64 {
+    (-f(2.0 * eps) + 8.0 * f(eps) - 8.0 * f(-eps) + f(-2.0 * eps)) / (12.0 * eps)
+}
+
+fn close(what: &str, got: f64, want: f64, scale: f64) {
+    let tol = 1e-8 * (1.0 + scale);
+    assert!(
+        (got - want).abs() <= tol,
+        "{what}: generated {got:e}, finite differences {want:e} (|diff| {:e} > {tol:e})",
+        (got - want).abs()
+    );
+}
+
+fn blocks<const N: usize, const K: usize>(v: &[f64]) -> [SVector<f64, N>; K] {
+    core::array::from_fn(|j| SVector::from_fn(|i, _| v[j * N + i]))
+}
+
+/// (x, u) with (x, u)[c] moved by `t`.
+fn shifted<const N: usize, const K: usize>(
+    x: &[SVector<f64, N>; K],
+    u: &SVector<f64, N>,
+    c: usize,
+    t: f64,
+) -> ([SVector<f64, N>; K], SVector<f64, N>) {
+    let (mut x, mut u) = (*x, *u);
+    if c < N * K {
+        x[c / N][c % N] += t;
+    } else {
+        u[c - N * K] += t;
+    }
+    (x, u)
+}
+
+/// Component `c` of the gradient blocks.
+fn grad_entry<const N: usize, const K: usize>(g: &retract::Gradient<N, K>, c: usize) -> f64 {
+    if c < N * K {
+        g.x[c / N][c % N]
+    } else {
+        g.u[c - N * K]
+    }
+}
+
+fn hess_entry<const N: usize, const K: usize>(
+    h: &retract::Hessian<N, K>,
+    a: usize,
+    b: usize,
+) -> f64 {
+    let (ja, ia, jb, ib) = (a / N, a % N, b / N, b % N);
+    match (ja < K, jb < K) {
+        (true, true) => h.xx[ja][jb][(ia, ib)],
+        (true, false) => h.xu[ja][(ia, ib)],
+        (false, true) => h.xu[jb][(ib, ia)],
+        (false, false) => h.uu[(ia, ib)],
+    }
+}
+
+/// Gradient and Hessian of L at (x, u) against finite differences.
+fn check_derivatives<L: Lagrangian<N, K>, const N: usize, const K: usize>(
+    l: &L,
+    x: &[SVector<f64, N>; K],
+    u: &SVector<f64, N>,
+) {
+    let eps = 1e-3;
+    let m = N * (K + 1);
+    let g = l.gradient(x, u);
+    let h = l.hessian(x, u);
+    let g_scale = (0..m).map(|c| grad_entry(&g, c).abs()).fold(0.0, f64::max);
+    let h_scale = (0..m * m)
+        .map(|e| hess_entry(&h, e / m, e % m).abs())
+        .fold(0.0, f64::max);
+    for c in 0..m {
+        let want = fd(
+            |t| {
+                let (x, u) = shifted(x, u, c, t);
+                l.lagrangian(&x, &u)
+            },
+            eps,
+        );
+        close(&format!("dL/dv{c}"), grad_entry(&g, c), want, g_scale);
+        for b in 0..m {
+            let want = fd(
+                |t| {
+                    let (x, u) = shifted(x, u, b, t);
+                    grad_entry(&l.gradient(&x, &u), c)
+                },
+                eps,
+            );
+            close(
+                &format!("d2L/dv{c}dv{b}"),
+                hess_entry(&h, c, b),
+                want,
+                h_scale,
+            );
+        }
+    }
+}
+
+/// The jet at time t of the polynomial curve with derivative data `jet` at t = 0
+/// (q^(j)(t) = sum_i jet[j + i] t^i / i!).
+fn jet_at<const N: usize, const S: usize>(jet: &SVector<f64, S>, t: f64) -> SVector<f64, S> {
+    let orders = S / N;
+    SVector::from_fn(|r, _| {
+        let (j, i) = (r / N, r % N);
+        let mut v = 0.0;
+        let mut factor = 1.0;
+        for m in 0..orders - j {
+            if m > 0 {
+                factor *= t / m as f64;
+            }
+            v += jet[(j + m) * N + i] * factor;
+        }
+        v
+    })
+}
+
+/// Momenta, energy and vector field of a system at derivative data `jet`.
+fn check_mechanics<Sys, const N: usize, const K: usize, const S: usize, const M: usize>(
+    sys: &Sys,
+    jet: &SVector<f64, S>,
+) where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+{
+    let eps = 1e-3;
+    let z = sys.legendre(jet);
+    let (x, p) = retract::lifted::split::<N, K, S>(&z);
+    let u = SVector::<f64, N>::from_fn(|i, _| jet[K * N + i]);
+    let g = sys.gradient(&x, &u);
+    // p_{k-1} = dL/du; p_{j-1} = dL/dx_j - d/dt p_j along the curve
+    let scale = z.amax();
+    for i in 0..N {
+        close("p_{k-1}", p[K - 1][i], g.u[i], scale);
+    }
+    for j in 1..K {
+        for i in 0..N {
+            let dp = fd(
+                |t| sys.legendre(&jet_at::<N, S>(jet, t))[(K + j) * N + i],
+                eps,
+            );
+            close(&format!("p_{}", j - 1), p[j - 1][i], g.x[j][i] - dp, scale);
+        }
+    }
+    // H(Leg(jet)) = E_L = sum_j p_j . q^(j+1) - L
+    let mut energy = -sys.lagrangian(&x, &u);
+    for j in 0..K {
+        energy += p[j].dot(&SVector::<f64, N>::from_fn(|i, _| jet[(j + 1) * N + i]));
+    }
+    let h = sys.hamiltonian(&z).expect("H at a regular point");
+    close("H(Leg(jet)) - E_L", h, energy, energy.abs() + scale);
+    // vector field = J grad H
+    let f = sys
+        .vector_field(&z)
+        .expect("vector field at a regular point");
+    let half = S / 2;
+    for c in 0..S {
+        let partner = if c < half { c + half } else { c - half };
+        let sign = if c < half { 1.0 } else { -1.0 };
+        let dh = fd(
+            |t| {
+                let mut w = z;
+                w[partner] += t;
+                sys.hamiltonian(&w).unwrap()
+            },
+            eps,
+        );
+        close(&format!("z'[{c}] = J grad H"), f[c], sign * dh, f.amax());
+    }
+}
+
+/// The scheme's Jacobians against finite differences of its residual.
+fn check_scheme<Sys, const S: usize, const M: usize>(
+    sys: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+    theta: f64,
+) where
+    Sys: LiftedSystem<S, M>,
+{
+    let eps = 1e-4;
+    let w = sys.predictor(z0, h, theta).expect("predictor");
+    let jac: SMatrix<f64, M, M> = sys.jacobian(z0, &w, h, theta);
+    let jac0: SMatrix<f64, M, S> = sys.jacobian_initial(z0, &w, h, theta);
+    let scale = jac.amax().max(jac0.amax());
+    for r in 0..M {
+        for c in 0..M {
+            let want = fd(
+                |t| {
+                    let mut v = w;
+                    v[c] += t;
+                    sys.residual(z0, &v, h, theta)[r]
+                },
+                eps,
+            );
+            close(&format!("dF{r}/dw{c}"), jac[(r, c)], want, scale);
+        }
+        for c in 0..S {
+            let want = fd(
+                |t| {
+                    let mut v = *z0;
+                    v[c] += t;
+                    sys.residual(&v, &w, h, theta)[r]
+                },
+                eps,
+            );
+            close(&format!("dF{r}/dz0_{c}"), jac0[(r, c)], want, scale);
+        }
+    }
+}
+
+/// Runs every check for one system at a random point.
+fn check_all<Sys, const N: usize, const K: usize, const S: usize, const M: usize>(
+    sys: &Sys,
+    values: &[f64],
+    h: f64,
+    theta: f64,
+) where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+{
+    let x = blocks::<N, K>(values);
+    let u = SVector::<f64, N>::from_fn(|i, _| values[N * K + i]);
+    check_derivatives(sys, &x, &u);
+    let jet = SVector::<f64, S>::from_column_slice(&values[..S]);
+    check_mechanics(sys, &jet);
+    check_scheme(sys, &sys.legendre(&jet), h, theta);
+}
+
+fn point(len: usize, lo: f64, hi: f64) -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(lo..hi, len)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(100))]
+
+    #[test]
+    fn pendulum_k1(v in point(4, -1.5, 1.5), m in 0.5..2.0, h in 0.01..0.2, theta in 0.0..1.0) {
+        check_all(&Pendulum { m, g: 9.81 }, &v, h, theta);
+    }
+
+    #[test]
+    fn anharmonic_scalar_k1(v in point(2, -1.5, 1.5), w in 0.5..2.0, h in 0.01..0.2, theta in 0.0..1.0) {
+        check_all(&Anharmonic { w }, &v, h, theta);
+    }
+
+    #[test]
+    fn se2_barrier_k2(mut v in point(12, -1.0, 1.0), tau in 0.01..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
+        v[0] += 3.0; // keep q clear of the obstacles below
+        let obstacles = [[0.0, 0.0, 1.0], [1.0, -1.5, 0.5]];
+        check_all(&Se2Barrier { tau, obstacles: &obstacles }, &v, h, theta);
+    }
+
+    #[test]
+    fn two_link_arm_k2(v in point(8, -1.0, 1.0), h in 0.01..0.1, theta in 0.0..1.0) {
+        check_all(&Arm { a: 3.0, b: 1.0, d: 1.2, g1: 2.0, g2: 0.7 }, &v, h, theta);
+    }
+
+    #[test]
+    fn minimum_jerk_k3(v in point(12, -1.0, 1.0), kappa in 0.1..2.0, h in 0.01..0.1, theta in 0.0..1.0) {
+        check_all(&Jerk { kappa }, &v, h, theta);
+    }
+
+    #[test]
+    fn minimum_snap_k4(v in point(24, -1.0, 1.0), h in 0.01..0.1, theta in 0.0..1.0) {
+        check_all(&Snap {}, &v, h, theta);
+    }
+
+    #[test]
+    fn atan2_exp_sqrt_k2(mut v in point(8, -1.0, 1.0), alpha in -1.0..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
+        v[0] += 2.0; // away from the atan2 branch point at the origin
+        check_all(&Transcendental { alpha }, &v, h, theta);
+    }
+}
+
+#[test]
+fn generated_functions_stay_callable() {
+    let l = pendulum([0.1, 0.2], [0.3, 0.4], 2.0, 9.81);
+    let x = [SVector::from([0.1, 0.2])];
+    let u = SVector::from([0.3, 0.4]);
+    assert_eq!(l, Pendulum { m: 2.0, g: 9.81 }.lagrangian(&x, &u));
+    assert_eq!(Se2Barrier::DIMENSION, 3);
+    assert_eq!(Snap::STATE, 24);
+    assert_eq!(Snap::UNKNOWNS, 27);
+}

@@ -1,0 +1,9 @@
+#![allow(unused)]
+use retract::higher_order_lagrangian;
+
+#[higher_order_lagrangian(order = 2)]
+fn lagrangian(q: [f64; 2], dq: [f64; 3], ddq: [f64; 2]) -> f64 {
+    ddq[0].powi(2) + ddq[1].powi(2) + dq[2]
+}
+
+fn main() {}

@@ -1,0 +1,9 @@
+#![allow(unused)]
+use retract::higher_order_lagrangian;
+
+#[higher_order_lagrangian(order = 2)]
+fn lagrangian(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    q[0].powi(2) + dq[1].powi(2) + ddq[0] * 0.0
+}
+
+fn main() {}
