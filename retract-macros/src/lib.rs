@@ -1,20 +1,6 @@
-//! The `#[higher_order_lagrangian]` attribute of `retract`.
-//!
-//! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically at
-//! compile time and emits straight-line code for the `retract_core` traits. The stages, one
-//! module each: `signature` (order, dimension, parameters) -> `lower` (body to a
-//! hash-consed expression graph) -> `mechanics` (gradient, Hessian, momenta, scheme) ->
-//! `codegen` (one `let` per shared node). `expand` is an ordinary function over
-//! `proc_macro2` tokens, unit-tested without the compiler.
+//! The `#[higher_order_lagrangian]` attribute of `retract`; the expansion lives in
+//! `retract-codegen`.
 #![forbid(unsafe_code)]
-
-mod codegen;
-mod diff;
-mod expand;
-mod graph;
-mod lower;
-mod mechanics;
-mod signature;
 
 use proc_macro::TokenStream;
 
@@ -31,8 +17,8 @@ use proc_macro::TokenStream;
 /// N = 1); later arguments are parameters (`f64`, `[f64; M]`, `&[[f64; M]]`) and become
 /// public fields of the generated type (`Obstacle`, from the function's name, or
 /// `name = ...`). The function stays callable. Options: `order = k` (1..=4, required),
-/// `name = TypeName`.
+/// `name = TypeName`. See the `retract` crate docs for the generated API.
 #[proc_macro_attribute]
 pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStream {
-    expand::expand(attr.into(), item.into()).into()
+    retract_codegen::expand(attr.into(), item.into()).into()
 }

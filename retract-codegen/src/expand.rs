@@ -11,8 +11,8 @@ use crate::lower::Lower;
 use crate::mechanics::{self, Degenerate, Mechanics};
 use crate::signature::{self, Kind, Signature};
 
-/// Expands the attribute; on error, the original item plus `compile_error!`s, so the rest of
-/// the crate still type-checks.
+/// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
+/// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
 pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
     match try_expand(attr, item.clone()) {
         Ok(tokens) => tokens,
@@ -24,7 +24,7 @@ pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
 }
 
 /// Combines several errors into one that reports all of them.
-pub fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
+pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
     let mut iter = errors.into_iter();
     let mut first = iter.next()?;
     for e in iter {
@@ -33,7 +33,7 @@ pub fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
     Some(first)
 }
 
-/// The expansion, or the errors of the input.
+/// The expansion, or the errors of the input combined into one `syn::Error`.
 pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function)?;
@@ -661,21 +661,10 @@ mod tests {
     #[test]
     fn expression_growth_is_bounded() {
         // n = 6, k = 2, 5 obstacles in an unrolled loop
-        let out = pretty(
-            "order = 2",
-            "fn robot(q: [f64; 6], dq: [f64; 6], ddq: [f64; 6], tau: f64, c: [f64; 15]) -> f64 {
-                let mut l = 0.0;
-                for i in 0..6 { l += 0.5 * ddq[i].powi(2); }
-                for j in 0..5 {
-                    let s = (q[0] - c[3 * j]).powi(2) + (q[1] - c[3 * j + 1]).powi(2)
-                        - c[3 * j + 2].powi(2);
-                    l += tau / s;
-                }
-                l
-            }",
-        )
-        .unwrap();
-        let lines = out.lines().count();
+        let (attr, item) = crate::samples::obstacle_field(6, 5);
+        let tokens = try_expand(attr, item).unwrap();
+        let file: syn::File = syn::parse2(tokens).unwrap();
+        let lines = prettyplease::unparse(&file).lines().count();
         println!("expansion: {lines} lines");
         assert!(lines < 2000, "{lines} lines");
     }

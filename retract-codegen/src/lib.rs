@@ -1,0 +1,22 @@
+//! The expansion behind `#[higher_order_lagrangian]`, as ordinary functions over
+//! `proc_macro2` tokens so that it can be unit-tested, fuzzed and benchmarked.
+//!
+//! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically and
+//! emits straight-line code for the `retract_core` traits. The stages, one module each:
+//! `signature` (order, dimension, parameters) -> `lower` (body to a hash-consed expression
+//! graph) -> `mechanics` (gradient, Hessian, momenta, scheme) -> `codegen` (one `let` per
+//! shared node).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod codegen;
+mod diff;
+mod expand;
+mod graph;
+mod lower;
+mod mechanics;
+mod signature;
+
+pub mod samples;
+
+pub use expand::{expand, try_expand};
