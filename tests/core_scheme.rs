@@ -2,6 +2,8 @@
 //! L = 1/2|q''|^2 + tau/(|q|^2 - r^2) on R^2): order, symplecticity, the closed-form V = 0
 //! solution, Jacobians against finite differences, and every error variant from a real input.
 
+mod common;
+
 use retract::diagnostics::{energy_error, rk4_step, symplecticity_error};
 use retract::models::PlanarBarrier;
 use retract::nalgebra::{SMatrix, SVector};
@@ -25,34 +27,19 @@ fn start(system: &PlanarBarrier, jet: [f64; 8]) -> State {
 /// Initial data passing the obstacle on the upper side, bending visibly over t in [0, 1].
 const PASSING: [f64; 8] = [-2.0, 1.1, 1.0, -0.2, 0.3, -0.4, 0.1, 0.2];
 
-fn midpoint_run(system: &PlanarBarrier, z0: &State, h: f64, steps: usize, theta: f64) -> State {
-    let options = StepOptions::default().with_theta(theta);
-    let run = trajectory(system, z0, h, steps, &options).unwrap();
-    *run.states.last().unwrap()
-}
-
-fn rk4_reference(system: &PlanarBarrier, z0: &State, t_end: f64, steps: usize) -> State {
-    let h = t_end / steps as f64;
-    let mut z = *z0;
-    for _ in 0..steps {
-        z = rk4_step(system, &z, h).unwrap();
-    }
-    z
-}
-
-/// Observed orders log2(e(h) / e(h/2)) of the theta-scheme at t = 1 against RK4 with 1e4 steps.
+/// Observed orders of the theta-scheme at t = 1 against RK4 with 1e4 steps.
 fn observed_orders(theta: f64) -> Vec<f64> {
     let system = barrier(0.5);
     let z0 = start(&system, PASSING);
-    let reference = rk4_reference(&system, &z0, 1.0, 10_000);
-    let errors: Vec<f64> = [20, 40, 80, 160, 320]
-        .iter()
-        .map(|&steps| {
-            let z = midpoint_run(&system, &z0, 1.0 / steps as f64, steps, theta);
-            (z - reference).amax()
-        })
-        .collect();
-    errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect()
+    let reference = common::rk4_final(&system, &z0, 1.0, 10_000);
+    common::observed_orders(
+        &system,
+        &z0,
+        &reference,
+        1.0,
+        theta,
+        &[20, 40, 80, 160, 320],
+    )
 }
 
 #[test]

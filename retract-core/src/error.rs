@@ -10,8 +10,8 @@ use core::fmt;
 #[non_exhaustive]
 pub enum Error {
     /// A NaN or infinite value appeared in `location` ("initial guess", "residual",
-    /// "Jacobian", "Newton step", ...) at Newton iteration `iteration` (0 = before the
-    /// first iteration).
+    /// "Jacobian", "vector field", ...) at Newton iteration `iteration` (0: before the first
+    /// iteration, or outside a Newton solve).
     NonFinite {
         /// Newton iteration at which the value appeared.
         iteration: usize,
@@ -52,12 +52,17 @@ impl fmt::Display for Error {
             Error::NonFinite {
                 iteration,
                 location,
-            } => write!(
-                f,
-                "non-finite value in the {location} at Newton iteration {iteration}: \
-                 check the inputs and parameters for NaN/inf and that the state is inside \
-                 the domain of the Lagrangian"
-            ),
+            } => {
+                write!(f, "non-finite value in the {location}")?;
+                if iteration > 0 {
+                    write!(f, " at Newton iteration {iteration}")?;
+                }
+                write!(
+                    f,
+                    ": check the inputs and parameters for NaN/inf and that the state is \
+                     inside the domain of the Lagrangian"
+                )
+            }
             Error::SingularJacobian { iteration } => write!(
                 f,
                 "singular Newton matrix at iteration {iteration}: the Lagrangian may be \

@@ -1,0 +1,70 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)] // each test file uses a subset
+
+use retract::diagnostics::rk4_step;
+use retract::nalgebra::SVector;
+use retract::{LiftedSystem, StepOptions, trajectory};
+
+/// The state after `steps` steps of size `t_end / steps` of the theta-scheme.
+pub fn theta_final<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    steps: usize,
+    theta: f64,
+) -> SVector<f64, S>
+where
+    Sys: LiftedSystem<S, M>,
+{
+    let options = StepOptions::default().with_theta(theta);
+    let run = trajectory(system, z0, t_end / steps as f64, steps, &options).expect("regular run");
+    run.states[steps]
+}
+
+/// The state at `t_end` by classical RK4 with `steps` steps.
+pub fn rk4_final<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    steps: usize,
+) -> SVector<f64, S>
+where
+    Sys: LiftedSystem<S, M>,
+{
+    let h = t_end / steps as f64;
+    let mut z = *z0;
+    for _ in 0..steps {
+        z = rk4_step(system, &z, h).expect("regular RK4 step");
+    }
+    z
+}
+
+/// Observed orders log2(e(h) / e(h/2)) at `t_end` for the step counts `sweep` (each the
+/// double of the previous), errors max-norm against `reference`.
+pub fn observed_orders<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    reference: &SVector<f64, S>,
+    t_end: f64,
+    theta: f64,
+    sweep: &[usize],
+) -> Vec<f64>
+where
+    Sys: LiftedSystem<S, M>,
+{
+    let errors: Vec<f64> = sweep
+        .iter()
+        .map(|&steps| (theta_final(system, z0, t_end, steps, theta) - reference).amax())
+        .collect();
+    errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect()
+}
+
+/// Asserts every observed order lies in `range`, with the sweep in the message.
+pub fn assert_orders(orders: &[f64], range: std::ops::Range<f64>, what: &str) {
+    for (i, p) in orders.iter().enumerate() {
+        assert!(
+            range.contains(p),
+            "{what}: refinement {i} has order {p:.3} ({orders:?})"
+        );
+    }
+}
