@@ -508,6 +508,11 @@ fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> 
                 __out
             }
 
+            /// h L(x_theta, u), the cost of one step.
+            fn step_cost(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> f64 {
+                #core::lifted::step_cost::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta)
+            }
+
             /// Explicit Euler guess of w.
             fn predictor(
                 &self,

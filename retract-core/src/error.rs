@@ -37,6 +37,26 @@ pub enum Error {
         /// max-norm of the residual at the last accepted iterate.
         residual_norm: f64,
     },
+    /// A boundary-value solution passes through obstacle `obstacle`: its clearance at state
+    /// `step` is `clearance` < 0 (or NaN).
+    ThroughObstacle {
+        /// Index of the obstacle.
+        obstacle: usize,
+        /// Index of the first state inside it.
+        step: usize,
+        /// The clearance there.
+        clearance: f64,
+    },
+    /// The first guess of a boundary-value solve passes through obstacle `obstacle` (at
+    /// state `step`), so Newton cannot pick a side of it.
+    GuessThroughObstacle {
+        /// Index of the obstacle.
+        obstacle: usize,
+        /// Index of the first guessed state inside it.
+        step: usize,
+        /// The clearance there.
+        clearance: f64,
+    },
     /// An argument was outside its domain, e.g. theta outside [0, 1] or a non-finite step.
     InvalidArgument {
         /// Name of the argument.
@@ -84,6 +104,26 @@ impl fmt::Display for Error {
                 "line search failed at Newton iteration {iteration} (residual max-norm \
                  {residual_norm:e}): the Newton direction does not decrease the residual; \
                  reduce the step size"
+            ),
+            Error::ThroughObstacle {
+                obstacle,
+                step,
+                clearance,
+            } => write!(
+                f,
+                "the solution passes through obstacle {obstacle} (clearance {clearance:e} at \
+                 state {step}); inside an obstacle the cost is unbounded below, so this is not \
+                 a plan: start from a guess that goes around it or raise the barrier weight"
+            ),
+            Error::GuessThroughObstacle {
+                obstacle,
+                step,
+                clearance,
+            } => write!(
+                f,
+                "the first guess passes through obstacle {obstacle} (clearance {clearance:e} at \
+                 state {step}), so the solver cannot choose a side: pass a guess that goes \
+                 around it (Guess::States)"
             ),
             Error::InvalidArgument { name, requirement } => {
                 write!(f, "invalid argument `{name}`: {requirement}")

@@ -26,6 +26,8 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod banded;
+pub mod bvp;
 pub mod diagnostics;
 mod error;
 pub mod lifted;
@@ -35,6 +37,7 @@ pub mod newton;
 pub mod step;
 pub mod system;
 
+pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
 pub use error::Error;
 pub use newton::NewtonOptions;
 pub use step::{Interrupted, StepOptions, StepReport, Trajectory, step, trajectory};

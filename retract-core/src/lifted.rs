@@ -313,6 +313,21 @@ where
     jac
 }
 
+/// $h\,L(x_\theta, u)$, the cost of one step.
+pub fn step_cost<L, const N: usize, const K: usize, const S: usize, const M: usize>(
+    lagrangian: &L,
+    z0: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    h: f64,
+    theta: f64,
+) -> f64
+where
+    L: Lagrangian<N, K> + ?Sized,
+{
+    let pt = point::<N, K, S, M>(z0, w, theta);
+    h * lagrangian.lagrangian(&pt.x_th, &pt.u)
+}
+
 /// Explicit Euler guess $w = (z_0 + h\,z'(z_0),\ u(z_0))$.
 ///
 /// # Errors
@@ -405,6 +420,18 @@ macro_rules! impl_lifted_system {
                     { 2 * $n * $k },
                     { 2 * $n * $k + $n },
                 >(self, z0, w, h, theta)
+            }
+
+            fn step_cost(
+                &self,
+                z0: &$crate::nalgebra::SVector<f64, { 2 * $n * $k }>,
+                w: &$crate::nalgebra::SVector<f64, { 2 * $n * $k + $n }>,
+                h: f64,
+                theta: f64,
+            ) -> f64 {
+                $crate::lifted::step_cost::<Self, $n, $k, { 2 * $n * $k }, { 2 * $n * $k + $n }>(
+                    self, z0, w, h, theta,
+                )
             }
 
             fn predictor(

@@ -198,6 +198,10 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
         theta: f64,
     ) -> SMatrix<f64, M, S>;
 
+    /// The cost of one step, $h\,L(x_\theta, u)$: summed over a trajectory, the midpoint-type
+    /// quadrature of $J = \int L\,dt$.
+    fn step_cost(&self, z0: &SVector<f64, S>, w: &SVector<f64, M>, h: f64, theta: f64) -> f64;
+
     /// An explicit first guess of $w$: one explicit Euler step
     /// $z_1 \approx z_0 + h\, z'(z_0)$ and $u \approx u(z_0)$.
     ///
