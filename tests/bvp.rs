@@ -271,6 +271,7 @@ fn continuation_in_the_barrier_weight() {
         200,
         BvpOptions::default(),
         Some((1, &clearance)),
+        Guess::Spline,
     )
     .unwrap();
     assert_sane(&solution);

@@ -109,18 +109,22 @@ impl BandMatrix {
                 }
             }
             let pivot = self.data[col + kv];
-            for p in 1..=km {
-                self.data[col + kv + p] /= pivot;
+            for v in &mut self.data[col + kv + 1..col + kv + 1 + km] {
+                *v /= pivot;
             }
+            // rank-1 update of columns j+1..=ju: A(j+1..=j+km, c) -= L(j+1..=j+km) A(j, c)
             for c in j + 1..=ju {
                 let cc = c * ld;
-                let ajc = self.data[kv + j - c + cc];
+                let off = kv + j - c;
+                let ajc = self.data[cc + off];
                 if ajc == 0.0 {
                     continue;
                 }
-                for p in 1..=km {
-                    let l = self.data[col + kv + p];
-                    self.data[kv + j + p - c + cc] -= l * ajc;
+                let (left, right) = self.data.split_at_mut(cc);
+                let l = &left[col + kv + 1..col + kv + 1 + km];
+                let target = &mut right[off + 1..off + 1 + km];
+                for (t, li) in target.iter_mut().zip(l) {
+                    *t -= li * ajc;
                 }
             }
         }
@@ -138,8 +142,9 @@ impl BandMatrix {
             let km = kl.min(n - 1 - j);
             let bj = b[j];
             if bj != 0.0 {
-                for q in 1..=km {
-                    b[j + q] -= self.data[j * ld + kv + q] * bj;
+                let l = &self.data[j * ld + kv + 1..j * ld + kv + 1 + km];
+                for (bi, li) in b[j + 1..j + 1 + km].iter_mut().zip(l) {
+                    *bi -= li * bj;
                 }
             }
         }
@@ -149,8 +154,10 @@ impl BandMatrix {
             let bj = b[j];
             if bj != 0.0 {
                 let top = j.saturating_sub(kv);
-                for (i, bi) in b.iter_mut().enumerate().take(j).skip(top) {
-                    *bi -= self.data[col + kv + i - j] * bj;
+                // U(top..j, j) is stored at rows kv + top - j .. kv of column j
+                let u = &self.data[col + kv + top - j..col + kv];
+                for (bi, ui) in b[top..j].iter_mut().zip(u) {
+                    *bi -= ui * bj;
                 }
             }
         }

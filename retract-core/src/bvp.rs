@@ -566,8 +566,8 @@ where
 }
 
 /// Solves a sequence of problems whose system depends on a parameter (e.g. a barrier weight
-/// from large to small), each warm-started from the previous solution; the first from
-/// `guess`. Returns the last solution.
+/// from large to small), each warm-started from the previous solution, the first from
+/// `first_guess`. Returns the last solution.
 ///
 /// # Errors
 /// The first failing solve's error.
@@ -581,6 +581,7 @@ pub fn continuation<Sys, F, const S: usize, const M: usize>(
     steps: usize,
     options: BvpOptions,
     clearance: Option<(usize, ClearanceFn<'_, S>)>,
+    first_guess: Guess<'_, S, M>,
 ) -> Result<BvpSolution<S, M>, Error>
 where
     Sys: LiftedSystem<S, M>,
@@ -596,7 +597,7 @@ where
         }
         let guess = match &previous {
             Some(solution) => Guess::Solution(solution),
-            None => Guess::Spline,
+            None => first_guess,
         };
         previous = Some(problem.solve(guess)?);
     }
