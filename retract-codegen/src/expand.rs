@@ -6,8 +6,9 @@ use quote::{ToTokens, quote};
 use syn::ItemFn;
 
 use crate::codegen::{Leaves, emit};
+use crate::graph::Id;
 use crate::graph::{Graph, Var};
-use crate::lower::Lower;
+use crate::lower::{Guard, GuardKind, Lower};
 use crate::mechanics::{self, Degenerate, Mechanics};
 use crate::signature::{self, Kind, Signature};
 
@@ -38,13 +39,13 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function)?;
     let mut graph = Graph::default();
-    let root = {
+    let (root, guards) = {
         let mut lower = Lower::new(&mut graph, &sig);
         let root = lower.body(&function.block);
         if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
             return Err(e);
         }
-        root
+        (root, std::mem::take(&mut lower.guards))
     };
     let mech = mechanics::build(&mut graph, root, sig.dim, sig.order).map_err(|reason| {
         let top = &sig.jet[sig.order];
@@ -66,11 +67,95 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
         };
         syn::Error::new(top.span(), msg)
     })?;
-    Ok(generate(&function, &sig, &graph, &mech))
+    let guards = if sig.guard {
+        guards
+            .into_iter()
+            .map(|guard| {
+                let points = mechanics::at_step_points(&mut graph, guard.node, sig.dim, sig.order);
+                (guard, points)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    Ok(generate(&function, &sig, &graph, &mech, &guards))
+}
+
+/// `check_domain`: each guard at the three points of a step, one loop per slice guard.
+fn domain_check(
+    g: &Graph,
+    sig: &Signature,
+    guards: &[(Guard, [Id; 3])],
+    scheme: &Names<'_>,
+) -> TokenStream {
+    let core = quote!(::retract::__private::retract_core);
+    let check = |guard: &Guard, values: &[TokenStream], element: TokenStream| {
+        let (a, b, c) = (&values[0], &values[1], &values[2]);
+        let text = &guard.text;
+        let (condition, kind) = match guard.kind {
+            GuardKind::Denominator => (
+                quote!(#a.is_finite() && #b.is_finite() && #c.is_finite() && #a != 0.0 && #b != 0.0
+                    && #c != 0.0 && #a.is_sign_positive() == #b.is_sign_positive()
+                    && #a.is_sign_positive() == #c.is_sign_positive()),
+                quote!(Denominator),
+            ),
+            GuardKind::SqrtArgument => (
+                quote!(#a >= 0.0 && #b >= 0.0 && #c >= 0.0),
+                quote!(SqrtArgument),
+            ),
+            GuardKind::LnArgument => (quote!(#a > 0.0 && #b > 0.0 && #c > 0.0), quote!(LnArgument)),
+            GuardKind::PowfBase => (quote!(#a > 0.0 && #b > 0.0 && #c > 0.0), quote!(PowfBase)),
+        };
+        quote! {
+            if !(#condition) {
+                return ::core::result::Result::Err(#core::DomainViolation {
+                    expression: #text,
+                    kind: #core::DomainKind::#kind,
+                    element: #element,
+                });
+            }
+        }
+    };
+    let mut out = TokenStream::new();
+    let plain: Vec<&(Guard, [Id; 3])> = guards
+        .iter()
+        .filter(|(guard, _)| guard.slice.is_none())
+        .collect();
+    if !plain.is_empty() {
+        let roots: Vec<Id> = plain.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+        let code = emit(g, &roots, scheme);
+        let stmts = code.stmts;
+        out.extend(quote!(#stmts));
+        for (i, (guard, _)) in plain.iter().enumerate() {
+            out.extend(check(
+                guard,
+                &code.exprs[3 * i..3 * i + 3],
+                quote!(::core::option::Option::None),
+            ));
+        }
+    }
+    for (guard, points) in guards.iter().filter(|(guard, _)| guard.slice.is_some()) {
+        let Some(param) = guard.slice else { continue };
+        let code = emit(g, points, scheme);
+        let stmts = code.stmts;
+        let name = &sig.params[param as usize].name;
+        let test = check(
+            guard,
+            &code.exprs,
+            quote!(::core::option::Option::Some(__k)),
+        );
+        out.extend(quote! {
+            for (__k, __e) in self.#name.iter().enumerate() {
+                #stmts
+                #test
+            }
+        });
+    }
+    out
 }
 
 /// Token text with the spaces that `to_string` puts around `.`, `[` and calls removed.
-fn tidy(text: &str) -> String {
+pub(crate) fn tidy(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let chars: Vec<char> = text.chars().collect();
     for (i, &c) in chars.iter().enumerate() {
@@ -139,7 +224,13 @@ impl Leaves for Names<'_> {
     }
 }
 
-fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> TokenStream {
+fn generate(
+    function: &ItemFn,
+    sig: &Signature,
+    g: &Graph,
+    mech: &Mechanics,
+    guards: &[(Guard, [Id; 3])],
+) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let (s, m) = (2 * n * k, 2 * n * k + n);
     let (n_lit, k_lit, s_lit, m_lit) = (index(n), index(k), index(s), index(m));
@@ -369,6 +460,34 @@ fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> 
     let (j_stmts, j_sets) = matrix_sets(&mech.jacobian, m);
     let (ji_stmts, ji_sets) = matrix_sets(&mech.jacobian_initial, s);
 
+    let vec_s = quote!(#na::SVector<f64, #s_lit>);
+    let vec_m = quote!(#na::SVector<f64, #m_lit>);
+    let vec_m_path = quote!(#na::SVector::<f64, #m_lit>);
+    let check_domain = (!guards.is_empty()).then(|| {
+        let body = domain_check(g, sig, guards, &scheme);
+        let list: Vec<String> = guards
+            .iter()
+            .map(|(guard, _)| format!("`{}`", guard.text))
+            .collect();
+        let doc = format!(
+            "Domain check at x_0, x_1 and x_theta of a step. Denominators that must keep their \
+             sign, and arguments of sqrt (>= 0), ln and powf (> 0): {}.",
+            list.join(", ")
+        );
+        quote! {
+            #[doc = #doc]
+            fn check_domain(
+                &self,
+                z0: &#vec_s,
+                w: &#vec_m,
+                theta: f64,
+            ) -> ::core::result::Result<(), #core::DomainViolation> {
+                #body
+                ::core::result::Result::Ok(())
+            }
+        }
+    });
+
     let allow = quote!(#[allow(
         unused_variables,
         unused_mut,
@@ -377,9 +496,6 @@ fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> 
         clippy::pedantic,
         clippy::nursery
     )]);
-    let vec_s = quote!(#na::SVector<f64, #s_lit>);
-    let vec_m = quote!(#na::SVector<f64, #m_lit>);
-    let vec_m_path = quote!(#na::SVector::<f64, #m_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
 
     // The generated code does not call the function; it stays for users to call.
@@ -512,6 +628,8 @@ fn generate(function: &ItemFn, sig: &Signature, g: &Graph, mech: &Mechanics) -> 
             fn step_cost(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> f64 {
                 #core::lifted::step_cost::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta)
             }
+
+            #check_domain
 
             /// Explicit Euler guess of w.
             fn predictor(

@@ -44,6 +44,30 @@ enum Binding {
     Poisoned,
 }
 
+/// What a guarded expression must satisfy along a trajectory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuardKind {
+    /// A denominator: must keep its sign and not vanish.
+    Denominator,
+    /// A `sqrt` argument: must stay >= 0.
+    SqrtArgument,
+    /// A `ln` argument: must stay > 0.
+    LnArgument,
+    /// A `powf` base: must stay > 0.
+    PowfBase,
+}
+
+/// An expression of the Lagrangian where it can become singular.
+#[derive(Clone, Debug)]
+pub struct Guard {
+    pub kind: GuardKind,
+    pub node: Id,
+    /// The expression as the user wrote it.
+    pub text: String,
+    /// The slice parameter whose elements it depends on, if any.
+    pub slice: Option<u16>,
+}
+
 struct SliceLoop {
     param: u16,
     /// Scope depth of the loop body; bindings below it are outer.
@@ -59,6 +83,8 @@ pub struct Lower<'a> {
     scopes: Vec<HashMap<String, Binding>>,
     slice: Option<SliceLoop>,
     pub errors: Vec<syn::Error>,
+    /// Guarded expressions that depend on the jet, in order of appearance, deduplicated.
+    pub guards: Vec<Guard>,
     unrolled: usize,
 }
 
@@ -84,6 +110,7 @@ impl<'a> Lower<'a> {
             scopes: vec![top],
             slice: None,
             errors: Vec::new(),
+            guards: Vec::new(),
             unrolled: 0,
         }
     }
@@ -220,11 +247,11 @@ impl<'a> Lower<'a> {
         match e {
             Expr::Assign(a) => {
                 let value = self.expr(&a.right);
-                self.assign(&a.left, None, value);
+                self.assign(&a.left, None, value, &a.right);
             }
             Expr::Binary(b) if is_assign_op(&b.op) => {
                 let value = self.expr(&b.right);
-                self.assign(&b.left, Some(b.op), value);
+                self.assign(&b.left, Some(b.op), value, &b.right);
             }
             Expr::ForLoop(f) => self.for_loop(f),
             other => {
@@ -233,7 +260,7 @@ impl<'a> Lower<'a> {
         }
     }
 
-    fn assign(&mut self, target: &Expr, op: Option<BinOp>, value: Id) {
+    fn assign(&mut self, target: &Expr, op: Option<BinOp>, value: Id, value_expr: &Expr) {
         let Expr::Path(p) = target else {
             self.error(
                 target.span(),
@@ -297,7 +324,10 @@ impl<'a> Lower<'a> {
             Some(BinOp::AddAssign(_)) => self.g.add_op(old, value),
             Some(BinOp::SubAssign(_)) => self.g.sub(old, value),
             Some(BinOp::MulAssign(_)) => self.g.mul(old, value),
-            Some(BinOp::DivAssign(_)) => self.g.div(old, value),
+            Some(BinOp::DivAssign(_)) => {
+                self.guard(GuardKind::Denominator, value, value_expr);
+                self.g.div(old, value)
+            }
             Some(other) => {
                 self.error(
                     other.span(),
@@ -532,7 +562,10 @@ impl<'a> Lower<'a> {
                     BinOp::Add(_) => self.g.add_op(l, r),
                     BinOp::Sub(_) => self.g.sub(l, r),
                     BinOp::Mul(_) => self.g.mul(l, r),
-                    BinOp::Div(_) => self.g.div(l, r),
+                    BinOp::Div(_) => {
+                        self.guard(GuardKind::Denominator, r, &b.right);
+                        self.g.div(l, r)
+                    }
                     op if is_assign_op(&op) => {
                         self.error(b.span(), "an assignment is a statement, not a value")
                     }
@@ -688,7 +721,13 @@ impl<'a> Lower<'a> {
         let name = m.method.to_string();
         let receiver = self.expr(&m.receiver);
         let args: Vec<&Expr> = m.args.iter().collect();
-        self.apply(&name, m.method.span(), m.span(), receiver, &args)
+        self.apply(
+            &name,
+            m.method.span(),
+            m.span(),
+            (receiver, &m.receiver),
+            &args,
+        )
     }
 
     /// `f64::sqrt(x)` and friends: the method form with the receiver as first argument.
@@ -714,7 +753,13 @@ impl<'a> Lower<'a> {
             let args: Vec<&Expr> = c.args.iter().collect();
             let receiver = self.expr(args[0]);
             let span = p.path.segments[1].ident.span();
-            return self.apply(&segments[1], span, c.span(), receiver, &args[1..]);
+            return self.apply(
+                &segments[1],
+                span,
+                c.span(),
+                (receiver, args[0]),
+                &args[1..],
+            );
         }
         self.error(
             c.func.span(),
@@ -726,7 +771,14 @@ impl<'a> Lower<'a> {
         )
     }
 
-    fn apply(&mut self, name: &str, name_span: Span, span: Span, x: Id, args: &[&Expr]) -> Id {
+    fn apply(
+        &mut self,
+        name: &str,
+        name_span: Span,
+        span: Span,
+        (x, x_expr): (Id, &Expr),
+        args: &[&Expr],
+    ) -> Id {
         let expected = match name {
             "powi" | "powf" | "atan2" | "hypot" => 1,
             "sqrt" | "exp" | "ln" | "sin" | "cos" | "tan" | "tanh" | "recip" | "abs" => 0,
@@ -753,10 +805,16 @@ impl<'a> Lower<'a> {
             _ => None,
         };
         if let Some(f) = func {
+            match f {
+                Func::Sqrt => self.guard(GuardKind::SqrtArgument, x, x_expr),
+                Func::Ln => self.guard(GuardKind::LnArgument, x, x_expr),
+                _ => {}
+            }
             return self.g.unary(f, x);
         }
         match name {
             "recip" => {
+                self.guard(GuardKind::Denominator, x, x_expr);
                 let one = self.g.constant(1.0);
                 self.g.div(one, x)
             }
@@ -774,6 +832,9 @@ impl<'a> Lower<'a> {
                          `(b * a.ln()).exp()` for a variable exponent",
                     );
                 }
+                if !matches!(self.g.as_const(e), Some(v) if v.fract() == 0.0) {
+                    self.guard(GuardKind::PowfBase, x, x_expr);
+                }
                 self.g.powf(x, e)
             }
             "atan2" => {
@@ -785,6 +846,46 @@ impl<'a> Lower<'a> {
                 self.g.hypot(x, other)
             }
         }
+    }
+
+    /// Records `node` (written as `expr`) as a guarded expression if it depends on the jet.
+    fn guard(&mut self, kind: GuardKind, node: Id, expr: &Expr) {
+        if !self.depends_on_jet(node)
+            || self.guards.iter().any(|g| g.node == node && g.kind == kind)
+        {
+            return;
+        }
+        let slice = self
+            .slice
+            .as_ref()
+            .map(|s| s.param)
+            .filter(|_| self.depends_on_element(node));
+        let mut expr = expr;
+        while let Expr::Paren(p) = expr {
+            expr = &p.expr;
+        }
+        self.guards.push(Guard {
+            kind,
+            node,
+            text: crate::expand::tidy(&expr.to_token_stream().to_string()),
+            slice,
+        });
+    }
+
+    fn depends_on_element(&self, id: Id) -> bool {
+        let mut stack = vec![id];
+        let mut seen = std::collections::HashSet::new();
+        while let Some(n) = stack.pop() {
+            if !seen.insert(n) {
+                continue;
+            }
+            match self.g.node(n) {
+                Node::Var(Var::Elem { .. }) => return true,
+                Node::Sum { .. } => {}
+                node => stack.extend(crate::graph::children(node)),
+            }
+        }
+        false
     }
 
     fn depends_on_jet(&self, id: Id) -> bool {

@@ -269,3 +269,33 @@ fn scheme(
     }
     (f, jacobian, jacobian_initial)
 }
+
+/// A guarded expression at the three points of a step: start x_0, end x_1 and evaluation
+/// point x_theta (with the top derivative u = w[S..] at each).
+pub fn at_step_points(g: &mut Graph, node: Id, n: usize, k: usize) -> [Id; 3] {
+    let s = 2 * n * k;
+    let theta = g.var(Var::Theta);
+    let one = g.constant(1.0);
+    let one_minus_theta = g.sub(one, theta);
+    let point = |which: usize| {
+        move |g: &mut Graph, v: Var| match v {
+            Var::Jet { order, index } if (order as usize) < k => {
+                let c = (order as usize * n + index as usize) as u16;
+                Some(match which {
+                    0 => g.var(Var::Z0(c)),
+                    1 => g.var(Var::W(c)),
+                    _ => {
+                        let (a, b) = (g.var(Var::Z0(c)), g.var(Var::W(c)));
+                        let (ta, tb) = (g.mul(one_minus_theta, a), g.mul(theta, b));
+                        g.add_op(ta, tb)
+                    }
+                })
+            }
+            Var::Jet { order, index } if order as usize == k => {
+                Some(g.var(Var::W((s + index as usize) as u16)))
+            }
+            _ => None,
+        }
+    };
+    [0, 1, 2].map(|which| substitute(g, node, &point(which), &mut HashMap::new()))
+}

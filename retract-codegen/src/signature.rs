@@ -50,18 +50,22 @@ pub struct Signature {
     pub params: Vec<Param>,
     /// Name of the generated type.
     pub type_name: Ident,
+    /// Whether the domain check (singularity guard) is emitted.
+    pub guard: bool,
 }
 
 /// Options of the attribute.
 struct Options {
     order: Option<(usize, Span)>,
     name: Option<Ident>,
+    guard: bool,
 }
 
 fn parse_options(attr: TokenStream) -> syn::Result<Options> {
     let mut options = Options {
         order: None,
         name: None,
+        guard: true,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("order") {
@@ -77,6 +81,10 @@ fn parse_options(attr: TokenStream) -> syn::Result<Options> {
             Ok(())
         } else if meta.path.is_ident("name") {
             options.name = Some(meta.value()?.parse()?);
+            Ok(())
+        } else if meta.path.is_ident("guard") {
+            let lit: syn::LitBool = meta.value()?.parse()?;
+            options.guard = lit.value;
             Ok(())
         } else {
             Err(meta.error("unsupported option; supported: `order = k` (1..=4), `name = TypeName`"))
@@ -306,5 +314,6 @@ pub fn parse(attr: TokenStream, item: &ItemFn) -> syn::Result<Signature> {
         jet,
         params,
         type_name: options.name.unwrap_or_else(|| camel(&sig.ident)),
+        guard: options.guard,
     })
 }

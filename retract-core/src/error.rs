@@ -2,6 +2,50 @@
 
 use core::fmt;
 
+/// Which domain condition of the Lagrangian a step violated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DomainKind {
+    /// A denominator changed sign or vanished.
+    Denominator,
+    /// The argument of `sqrt` became negative.
+    SqrtArgument,
+    /// The argument of `ln` left $(0, \infty)$.
+    LnArgument,
+    /// The base of `powf` left $(0, \infty)$.
+    PowfBase,
+}
+
+/// A guarded expression of the Lagrangian that left its domain during a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DomainViolation {
+    /// The expression as written in the Lagrangian.
+    pub expression: &'static str,
+    /// The condition it violated.
+    pub kind: DomainKind,
+    /// For an expression inside a loop over a slice parameter: the element's index.
+    pub element: Option<usize>,
+}
+
+impl fmt::Display for DomainViolation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let expression = self.expression;
+        match self.kind {
+            DomainKind::Denominator => {
+                write!(f, "denominator `{expression}` changed sign or vanished")?
+            }
+            DomainKind::SqrtArgument => {
+                write!(f, "argument `{expression}` of sqrt became negative")?
+            }
+            DomainKind::LnArgument => write!(f, "argument `{expression}` of ln left (0, inf)")?,
+            DomainKind::PowfBase => write!(f, "base `{expression}` of powf left (0, inf)")?,
+        }
+        if let Some(k) = self.element {
+            write!(f, " for element {k} of the parameter list")?;
+        }
+        Ok(())
+    }
+}
+
 /// Why a solve or a step failed.
 ///
 /// Every variant carries the data needed to act on it; the [`Display`](fmt::Display)
@@ -57,6 +101,9 @@ pub enum Error {
         /// The clearance there.
         clearance: f64,
     },
+    /// The step left the domain of the Lagrangian (a singular point lies inside it): the
+    /// states after it are not to be trusted.
+    Domain(DomainViolation),
     /// An argument was outside its domain, e.g. theta outside [0, 1] or a non-finite step.
     InvalidArgument {
         /// Name of the argument.
@@ -124,6 +171,11 @@ impl fmt::Display for Error {
                 "the first guess passes through obstacle {obstacle} (clearance {clearance:e} at \
                  state {step}), so the solver cannot choose a side: pass a guess that goes \
                  around it (Guess::States)"
+            ),
+            Error::Domain(violation) => write!(
+                f,
+                "{violation} within the step: the trajectory crossed a singularity of the \
+                 Lagrangian (e.g. entered an obstacle); the states before it are valid"
             ),
             Error::InvalidArgument { name, requirement } => {
                 write!(f, "invalid argument `{name}`: {requirement}")

@@ -38,7 +38,7 @@ pub mod step;
 pub mod system;
 
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
-pub use error::Error;
+pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
 pub use step::{Interrupted, StepOptions, StepReport, Trajectory, step, trajectory};
 pub use system::{Gradient, Hessian, Lagrangian, LiftedSystem};

@@ -18,6 +18,12 @@ pub struct StepOptions {
     pub theta: f64,
     /// Options of the Newton solve.
     pub newton: NewtonOptions,
+    /// Check every step against the domain of the Lagrangian
+    /// ([`LiftedSystem::check_domain`]); on by default.
+    pub check_domain: bool,
+    /// When a trajectory stops at a domain violation, bisect the step size to locate the
+    /// crossing time ([`Interrupted::crossing_time`]); off by default.
+    pub locate_crossing: bool,
 }
 
 impl Default for StepOptions {
@@ -25,6 +31,8 @@ impl Default for StepOptions {
         Self {
             theta: 0.5,
             newton: NewtonOptions::default(),
+            check_domain: true,
+            locate_crossing: false,
         }
     }
 }
@@ -39,6 +47,18 @@ impl StepOptions {
     /// Sets the Newton options.
     pub fn with_newton(mut self, newton: NewtonOptions) -> Self {
         self.newton = newton;
+        self
+    }
+
+    /// Switches the domain check on or off.
+    pub fn with_domain_check(mut self, on: bool) -> Self {
+        self.check_domain = on;
+        self
+    }
+
+    /// Switches the location of a domain crossing on or off.
+    pub fn with_crossing_location(mut self, on: bool) -> Self {
+        self.locate_crossing = on;
         self
     }
 
@@ -89,10 +109,11 @@ where
     }
 }
 
-/// Solves one step from the guess `guess` and returns all unknowns $w$.
+/// Solves one step from the guess `guess` and returns all unknowns $w$; checks the domain
+/// of the Lagrangian when `options.check_domain` is set.
 ///
 /// # Errors
-/// Invalid `h` or options, or any Newton failure.
+/// Invalid `h` or options, any Newton failure, or [`Error::Domain`].
 pub fn solve_step<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
@@ -111,6 +132,11 @@ where
         theta: options.theta,
     };
     let solution = newton::solve(&problem, guess, &options.newton)?;
+    if options.check_domain {
+        system
+            .check_domain(z0, &solution.w, options.theta)
+            .map_err(Error::Domain)?;
+    }
     Ok((
         solution.w,
         StepReport {
@@ -177,19 +203,34 @@ pub struct Interrupted<const S: usize> {
     pub trajectory: Trajectory<S>,
     /// Index of the failed step (from `states[step]`).
     pub step: usize,
-    /// Time $t = \text{step} \cdot h$ at which the failed step started.
-    pub time: f64,
     /// Why the step failed.
     pub error: Error,
+    /// For a domain violation with [`StepOptions::locate_crossing`]: the time at which the
+    /// trajectory leaves the domain, located by bisection of the step size to $10^{-12} h$.
+    pub crossing_time: Option<f64>,
+}
+
+impl<const S: usize> Interrupted<S> {
+    /// Time $t = \text{step} \cdot h$ at which the failed step started.
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.trajectory.h
+    }
 }
 
 impl<const S: usize> core::fmt::Display for Interrupted<S> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "step {} from t = {} failed: {}",
-            self.step, self.time, self.error
-        )
+            "step {} from t = {} to t = {} failed: {}",
+            self.step,
+            self.time(),
+            self.time() + self.trajectory.h,
+            self.error
+        )?;
+        if let Some(t) = self.crossing_time {
+            write!(f, " (crossing located at t = {t})")?;
+        }
+        Ok(())
     }
 }
 
@@ -224,14 +265,44 @@ where
                 trajectory.reports.push(report);
             }
             Err(error) => {
+                let crossing_time = match error {
+                    Error::Domain(_) if options.locate_crossing => {
+                        Some(i as f64 * h + locate_crossing(system, &z, h, options))
+                    }
+                    _ => None,
+                };
                 return Err(Interrupted {
                     trajectory,
                     step: i,
-                    time: i as f64 * h,
                     error,
+                    crossing_time,
                 });
             }
         }
     }
     Ok(trajectory)
+}
+
+/// The largest $\delta \in (0, h]$ (to $10^{-12} h$, by bisection) for which a step of size
+/// $\delta$ from `z` stays in the domain of the Lagrangian.
+pub fn locate_crossing<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z: &SVector<f64, S>,
+    h: f64,
+    options: &StepOptions,
+) -> f64
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let options = options.with_domain_check(true);
+    let (mut inside, mut outside) = (0.0, h);
+    while (outside - inside).abs() > 1e-12 * h.abs() {
+        let mid = 0.5 * (inside + outside);
+        if step(system, z, mid, &options).is_ok() {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    0.5 * (inside + outside)
 }

@@ -20,7 +20,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::Error;
+use crate::{DomainViolation, Error};
 
 /// Blocks of the gradient of $L(x, u)$.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -209,6 +209,24 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
     /// When the vector field at $z_0$ cannot be evaluated.
     fn predictor(&self, z0: &SVector<f64, S>, h: f64, theta: f64)
     -> Result<SVector<f64, M>, Error>;
+
+    /// The domain check of a step: every guarded expression of $L$ (denominators, arguments
+    /// of `sqrt`, `ln`, `powf`) evaluated at the start $x_0$, the end $x_1$ and the
+    /// evaluation point $x_\theta$ of the step from `z0` to the unknowns `w`. A denominator
+    /// must keep its sign and not vanish; a `sqrt` argument must stay $\ge 0$; `ln` and `powf`
+    /// arguments $> 0$. The default checks nothing.
+    ///
+    /// # Errors
+    /// The first violated condition.
+    fn check_domain(
+        &self,
+        z0: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        theta: f64,
+    ) -> Result<(), DomainViolation> {
+        let _ = (z0, w, theta);
+        Ok(())
+    }
 
     /// The new state $z_1$ inside the unknowns $w$ (its first `S` entries).
     fn state(&self, w: &SVector<f64, M>) -> SVector<f64, S> {
