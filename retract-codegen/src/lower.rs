@@ -872,23 +872,18 @@ impl<'a> Lower<'a> {
         });
     }
 
+    /// Whether `id` depends on a loop element (not counting elements bound inside a sum).
     fn depends_on_element(&self, id: Id) -> bool {
-        let mut stack = vec![id];
-        let mut seen = std::collections::HashSet::new();
-        while let Some(n) = stack.pop() {
-            if !seen.insert(n) {
-                continue;
-            }
-            match self.g.node(n) {
-                Node::Var(Var::Elem { .. }) => return true,
-                Node::Sum { .. } => {}
-                node => stack.extend(crate::graph::children(node)),
-            }
-        }
-        false
+        self.reaches(id, |v| matches!(v, Var::Elem { .. }), false)
     }
 
     fn depends_on_jet(&self, id: Id) -> bool {
+        self.reaches(id, |v| matches!(v, Var::Jet { .. }), true)
+    }
+
+    /// Whether a variable with `target` is reachable from `id`; `into_sums`: whether to look
+    /// inside the bodies of sums.
+    fn reaches(&self, id: Id, target: impl Fn(&Var) -> bool, into_sums: bool) -> bool {
         let mut stack = vec![id];
         let mut seen = std::collections::HashSet::new();
         while let Some(n) = stack.pop() {
@@ -896,7 +891,8 @@ impl<'a> Lower<'a> {
                 continue;
             }
             match self.g.node(n) {
-                Node::Var(Var::Jet { .. }) => return true,
+                Node::Var(v) if target(v) => return true,
+                Node::Sum { .. } if !into_sums => {}
                 node => stack.extend(crate::graph::children(node)),
             }
         }
