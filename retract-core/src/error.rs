@@ -133,7 +133,8 @@ impl fmt::Display for Error {
             Error::SingularJacobian { iteration } => write!(
                 f,
                 "singular Newton matrix at iteration {iteration}: the Lagrangian may be \
-                 degenerate in the top derivative (d2L/du2 not invertible) or the step too large"
+                 degenerate in the top derivative (d2L/du2 not invertible) or the step size \
+                 too large"
             ),
             Error::NoConvergence {
                 iterations,
@@ -141,7 +142,8 @@ impl fmt::Display for Error {
             } => write!(
                 f,
                 "Newton did not converge in {iterations} iterations (last residual max-norm \
-                 {residual_norm:e}): reduce the step size or raise the iteration cap"
+                 {residual_norm:e}): reduce the step size (or allow step halving) or raise the \
+                 iteration cap"
             ),
             Error::LineSearchFailed {
                 iteration,
@@ -150,7 +152,7 @@ impl fmt::Display for Error {
                 f,
                 "line search failed at Newton iteration {iteration} (residual max-norm \
                  {residual_norm:e}): the Newton direction does not decrease the residual; \
-                 reduce the step size"
+                 reduce the step size (or allow step halving)"
             ),
             Error::ThroughObstacle {
                 obstacle,
@@ -185,3 +187,105 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every variant, with the words its message must contain.
+    fn cases() -> Vec<(Error, Vec<&'static str>)> {
+        let violation = |kind| DomainViolation {
+            expression: "x * x - 1.0",
+            kind,
+            element: Some(3),
+        };
+        vec![
+            (
+                Error::NonFinite {
+                    iteration: 2,
+                    location: "residual",
+                },
+                vec!["non-finite", "residual", "iteration 2", "NaN"],
+            ),
+            (
+                Error::NonFinite {
+                    iteration: 0,
+                    location: "vector field",
+                },
+                vec!["non-finite", "vector field"],
+            ),
+            (
+                Error::SingularJacobian { iteration: 1 },
+                vec!["singular", "iteration 1", "degenerate"],
+            ),
+            (
+                Error::NoConvergence {
+                    iterations: 50,
+                    residual_norm: 1.5e-3,
+                },
+                vec!["50 iterations", "1.5e-3", "step size"],
+            ),
+            (
+                Error::LineSearchFailed {
+                    iteration: 4,
+                    residual_norm: 2.0,
+                },
+                vec!["line search", "iteration 4", "step size"],
+            ),
+            (
+                Error::ThroughObstacle {
+                    obstacle: 1,
+                    step: 17,
+                    clearance: -0.25,
+                },
+                vec!["obstacle 1", "-2.5e-1", "state 17", "guess"],
+            ),
+            (
+                Error::GuessThroughObstacle {
+                    obstacle: 0,
+                    step: 5,
+                    clearance: -1.0,
+                },
+                vec!["first guess", "obstacle 0", "Guess::States"],
+            ),
+            (
+                Error::Domain(violation(DomainKind::Denominator)),
+                vec!["denominator `x * x - 1.0`", "changed sign", "element 3"],
+            ),
+            (
+                Error::Domain(violation(DomainKind::SqrtArgument)),
+                vec!["sqrt", "negative"],
+            ),
+            (
+                Error::Domain(violation(DomainKind::LnArgument)),
+                vec!["ln", "(0, inf)"],
+            ),
+            (
+                Error::Domain(violation(DomainKind::PowfBase)),
+                vec!["powf", "(0, inf)"],
+            ),
+            (
+                Error::InvalidArgument {
+                    name: "theta",
+                    requirement: "theta must lie in [0, 1]",
+                },
+                vec!["`theta`", "[0, 1]"],
+            ),
+        ]
+    }
+
+    #[test]
+    fn every_variant_renders_an_actionable_message() {
+        for (error, words) in cases() {
+            let message = error.to_string();
+            for word in words {
+                assert!(
+                    message.contains(word),
+                    "{error:?}: `{message}` lacks `{word}`"
+                );
+            }
+            let source: &dyn std::error::Error = &error;
+            assert!(source.source().is_none());
+        }
+    }
+}

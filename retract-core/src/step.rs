@@ -24,6 +24,10 @@ pub struct StepOptions {
     /// When a trajectory stops at a domain violation, bisect the step size to locate the
     /// crossing time ([`Interrupted::crossing_time`]); off by default.
     pub locate_crossing: bool,
+    /// In [`trajectory`]: when a step fails to converge, retry it as 2, 4, ... substeps, at
+    /// most this many halvings (reported in [`StepReport::halvings`]); 0 (the default) stops
+    /// at the first failure. Domain violations are never retried.
+    pub max_halvings: u32,
 }
 
 impl Default for StepOptions {
@@ -33,6 +37,7 @@ impl Default for StepOptions {
             newton: NewtonOptions::default(),
             check_domain: true,
             locate_crossing: false,
+            max_halvings: 0,
         }
     }
 }
@@ -62,6 +67,12 @@ impl StepOptions {
         self
     }
 
+    /// Sets the number of step halvings a trajectory may try on a failed step.
+    pub fn with_max_halvings(mut self, max_halvings: u32) -> Self {
+        self.max_halvings = max_halvings;
+        self
+    }
+
     fn validate(&self, h: f64) -> Result<(), Error> {
         if !(0.0..=1.0).contains(&self.theta) {
             return Err(Error::InvalidArgument {
@@ -82,10 +93,12 @@ impl StepOptions {
 /// What the Newton solve of one step reported.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {
-    /// Newton iterations used.
+    /// Newton iterations used (summed over substeps).
     pub iterations: usize,
-    /// $|F|_\infty$ at the accepted solution.
+    /// $|F|_\infty$ at the accepted solution (the largest over substeps).
     pub residual_norm: f64,
+    /// How often the step was halved before it converged ([`StepOptions::max_halvings`]).
+    pub halvings: u32,
 }
 
 /// $F(z_0, \cdot)$ of one step as a Newton [`Problem`].
@@ -142,6 +155,7 @@ where
         StepReport {
             iterations: solution.iterations,
             residual_norm: solution.residual_norm,
+            halvings: 0,
         },
     ))
 }
@@ -239,7 +253,8 @@ impl<const S: usize> std::error::Error for Interrupted<S> {}
 /// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
 ///
 /// # Errors
-/// [`Interrupted`], with the trajectory computed so far, at the first failed step.
+/// [`Interrupted`], with the trajectory computed so far, at the first failed step (with no
+/// state at all for a non-finite `z0`).
 pub fn trajectory<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
@@ -255,10 +270,21 @@ where
         states: Vec::with_capacity(steps + 1),
         reports: Vec::with_capacity(steps),
     };
+    if !z0.iter().all(|v| v.is_finite()) {
+        return Err(Interrupted {
+            trajectory,
+            step: 0,
+            error: Error::NonFinite {
+                iteration: 0,
+                location: "initial state",
+            },
+            crossing_time: None,
+        });
+    }
     trajectory.states.push(*z0);
     let mut z = *z0;
     for i in 0..steps {
-        match step(system, &z, h, options) {
+        match step_with_halving(system, &z, h, options) {
             Ok((next, report)) => {
                 z = next;
                 trajectory.states.push(z);
@@ -281,6 +307,54 @@ where
         }
     }
     Ok(trajectory)
+}
+
+/// One step of size `h`, retried as `2^m` substeps (m = 1..=`max_halvings`) when Newton
+/// fails; domain violations and invalid arguments are not retried.
+fn step_with_halving<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+    options: &StepOptions,
+) -> Result<(SVector<f64, S>, StepReport), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let mut error = match step(system, z0, h, options) {
+        Ok(done) => return Ok(done),
+        Err(e) => e,
+    };
+    for halvings in 1..=options.max_halvings {
+        if matches!(error, Error::Domain(_) | Error::InvalidArgument { .. }) {
+            break;
+        }
+        let pieces = 1usize << halvings.min(30);
+        let sub = h / pieces as f64;
+        let mut z = *z0;
+        let mut report = StepReport {
+            halvings,
+            ..StepReport::default()
+        };
+        let mut failed = None;
+        for _ in 0..pieces {
+            match step(system, &z, sub, options) {
+                Ok((next, r)) => {
+                    z = next;
+                    report.iterations += r.iterations;
+                    report.residual_norm = report.residual_norm.max(r.residual_norm);
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        match failed {
+            None => return Ok((z, report)),
+            Some(e) => error = e,
+        }
+    }
+    Err(error)
 }
 
 /// The largest $\delta \in (0, h]$ (to $10^{-12} h$, by bisection) for which a step of size
