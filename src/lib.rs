@@ -1,4 +1,5 @@
 #![doc = include_str!("../README.md")]
+#![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -8,5 +9,6 @@ pub use retract_macros::higher_order_lagrangian;
 #[doc(hidden)]
 pub mod __private {
     pub use retract_core;
+    pub use retract_core::Float;
     pub use retract_core::nalgebra;
 }

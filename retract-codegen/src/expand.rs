@@ -427,6 +427,8 @@ fn generate(
                 p_top: &#vec_n,
                 _guess: &#vec_n,
             ) -> ::core::result::Result<#vec_n, #core::Error> {
+                #[allow(unused_imports)]
+                use ::retract::__private::Float as _;
                 #stmts
                 #solve
             }
@@ -482,13 +484,21 @@ fn generate(
                 w: &#vec_m,
                 theta: f64,
             ) -> ::core::result::Result<(), #core::DomainViolation> {
+                #[allow(unused_imports)]
+                use ::retract::__private::Float as _;
                 #body
                 ::core::result::Result::Ok(())
             }
         }
     });
 
+    // math methods for no_std (with std the inherent f64 methods take precedence)
+    let float = quote!(
+        #[allow(unused_imports)]
+        use ::retract::__private::Float as _;
+    );
     let allow = quote!(#[allow(
+        unused_imports,
         unused_variables,
         unused_mut,
         unused_parens,
@@ -500,6 +510,13 @@ fn generate(
 
     // The generated code does not call the function; it stays for users to call.
     let mut function = function.clone();
+    function.block.stmts.insert(
+        0,
+        syn::parse_quote!(
+            #[allow(unused_imports)]
+            use ::retract::__private::Float as _;
+        ),
+    );
     function
         .attrs
         .push(syn::parse_quote!(#[allow(dead_code, clippy::too_many_arguments)]));
@@ -536,12 +553,14 @@ fn generate(
         impl #generics #core::Lagrangian<#n_lit, #k_lit> for #ty_full {
             /// L(x, u), straight-line code of the annotated function.
             fn lagrangian(&self, x: &#jet_blocks, u: &#vec_n) -> f64 {
+                #float
                 #l_stmts
                 #l_expr
             }
 
             /// (dL/dx_0, ..., dL/dx_{k-1}, dL/du), differentiated at compile time.
             fn gradient(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Gradient<#n_lit, #k_lit> {
+                #float
                 #g_stmts
                 let mut __out = #core::Gradient::zeros();
                 #(#g_sets)*
@@ -550,6 +569,7 @@ fn generate(
 
             /// The Hessian of L in (x, u); structural zeros are not computed.
             fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
+                #float
                 #h_stmts
                 let mut __out = #core::Hessian::zeros();
                 #(#h_sets)*
@@ -558,6 +578,7 @@ fn generate(
 
             /// Ostrogradsky momenta p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j.
             fn momenta(&self, lower: &#jet_blocks, upper: &#jet_blocks) -> #jet_blocks {
+                #float
                 #p_stmts
                 let mut __out = [#na::SVector::<f64, #n_lit>::zeros(); #k_lit];
                 #(#p_sets)*
@@ -590,6 +611,7 @@ fn generate(
 
             /// F(z0, w) of the lifted theta-scheme, straight-line.
             fn residual(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> #vec_m {
+                #float
                 #r_stmts
                 let mut __out = #vec_m_path::zeros();
                 #(#r_sets)*
@@ -604,6 +626,7 @@ fn generate(
                 h: f64,
                 theta: f64,
             ) -> #na::SMatrix<f64, #m_lit, #m_lit> {
+                #float
                 #j_stmts
                 let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
                 #(#j_sets)*
@@ -618,6 +641,7 @@ fn generate(
                 h: f64,
                 theta: f64,
             ) -> #na::SMatrix<f64, #m_lit, #s_lit> {
+                #float
                 #ji_stmts
                 let mut __out = #na::SMatrix::<f64, #m_lit, #s_lit>::zeros();
                 #(#ji_sets)*

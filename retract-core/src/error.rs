@@ -186,7 +186,7 @@ impl fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {}
+impl core::error::Error for Error {}
 
 #[cfg(test)]
 mod tests {
@@ -284,7 +284,7 @@ mod tests {
                     "{error:?}: `{message}` lacks `{word}`"
                 );
             }
-            let source: &dyn std::error::Error = &error;
+            let source: &dyn core::error::Error = &error;
             assert!(source.source().is_none());
         }
     }

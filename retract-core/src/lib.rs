@@ -23,10 +23,18 @@
 //! A. Anahory Simoes, M. Barbero Liñán, L. Colombo, D. Martín de Diego,
 //! "Higher-order retraction maps and construction of numerical methods for optimal control
 //! of mechanical systems" (Prop. 4.1, Prop. 5.1, Sec. 6).
+//!
+//! # Features
+//! `std` (default): trajectories ([`trajectory`]), the boundary-value solver ([`bvp`]) and
+//! the banded LU. Without it the crate is `no_std` and allocation-free: steps, Newton,
+//! diagnostics and everything generated code needs; math goes through `libm`.
+#![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+#[cfg(feature = "std")]
 pub mod banded;
+#[cfg(feature = "std")]
 pub mod bvp;
 pub mod diagnostics;
 mod error;
@@ -37,12 +45,19 @@ pub mod newton;
 pub mod step;
 pub mod system;
 
+#[cfg(feature = "std")]
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
-pub use step::{Interrupted, StepOptions, StepReport, Trajectory, step, trajectory};
+#[cfg(feature = "std")]
+pub use step::{Interrupted, Trajectory, trajectory};
+pub use step::{StepOptions, StepReport, step};
 pub use system::{Gradient, Hessian, Lagrangian, LiftedSystem};
 
 /// The linear-algebra crate of the public API, re-exported so users and generated code
 /// name the same version.
 pub use nalgebra;
+
+/// The float methods (`sqrt`, `powi`, ...) for `no_std` code: generated code imports it, and
+/// a `no_std` crate can too (with std the inherent methods take precedence).
+pub use num_traits::Float;

@@ -180,6 +180,7 @@ where
     Ok((system.state(&w), report))
 }
 
+#[cfg(feature = "std")]
 /// States $z_0, \dots, z_m$ at $t_i = i h$ and the Newton report of each step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trajectory<const S: usize> {
@@ -191,6 +192,7 @@ pub struct Trajectory<const S: usize> {
     pub reports: Vec<StepReport>,
 }
 
+#[cfg(feature = "std")]
 impl<const S: usize> Trajectory<S> {
     /// The largest number of Newton iterations of any step (0 for no step).
     pub fn max_iterations(&self) -> usize {
@@ -210,6 +212,7 @@ impl<const S: usize> Trajectory<S> {
     }
 }
 
+#[cfg(feature = "std")]
 /// A trajectory that stopped at a failed step. Nothing computed before it is lost.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Interrupted<const S: usize> {
@@ -224,6 +227,7 @@ pub struct Interrupted<const S: usize> {
     pub crossing_time: Option<f64>,
 }
 
+#[cfg(feature = "std")]
 impl<const S: usize> Interrupted<S> {
     /// Time $t = \text{step} \cdot h$ at which the failed step started.
     pub fn time(&self) -> f64 {
@@ -231,6 +235,7 @@ impl<const S: usize> Interrupted<S> {
     }
 }
 
+#[cfg(feature = "std")]
 impl<const S: usize> core::fmt::Display for Interrupted<S> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
@@ -248,8 +253,10 @@ impl<const S: usize> core::fmt::Display for Interrupted<S> {
     }
 }
 
-impl<const S: usize> std::error::Error for Interrupted<S> {}
+#[cfg(feature = "std")]
+impl<const S: usize> core::error::Error for Interrupted<S> {}
 
+#[cfg(feature = "std")]
 /// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
 ///
 /// # Errors
@@ -309,6 +316,7 @@ where
     Ok(trajectory)
 }
 
+#[cfg(feature = "std")]
 /// One step of size `h`, retried as `2^m` substeps (m = 1..=`max_halvings`) when Newton
 /// fails; domain violations and invalid arguments are not retried.
 fn step_with_halving<Sys, const S: usize, const M: usize>(
