@@ -78,7 +78,16 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
     } else {
         Vec::new()
     };
-    Ok(generate(&function, &sig, &graph, &mech, &guards))
+    let flat: Vec<Vec<Id>> = mech.hessian.clone();
+    let reduced = mechanics::reduce(&mut graph, &mech.gradient, &flat, sig.dim, sig.order);
+    Ok(generate(
+        &function,
+        &sig,
+        &graph,
+        &mech,
+        &guards,
+        reduced.as_ref(),
+    ))
 }
 
 /// `check_domain`: each guard at the three points of a step, one loop per slice guard.
@@ -213,6 +222,10 @@ impl Leaves for Names<'_> {
                 let c = self::index(c as usize);
                 quote!(w[#c])
             }
+            Var::Core(m) => {
+                let m = self::index(m as usize);
+                quote!(y[#m])
+            }
             Var::Step => quote!(h),
             Var::Theta => quote!(theta),
         }
@@ -230,6 +243,7 @@ fn generate(
     g: &Graph,
     mech: &Mechanics,
     guards: &[(Guard, [Id; 3])],
+    reduced: Option<&mechanics::Reduced>,
 ) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let (s, m) = (2 * n * k, 2 * n * k + n);
@@ -506,6 +520,74 @@ fn generate(
         clippy::pedantic,
         clippy::nursery
     )]);
+    let reduced_unknowns = index(reduced.map_or(0, |r| r.core.len()));
+    let reduced_impl = reduced.map(|red| {
+        let r = red.core.len();
+        let r_lit = index(r);
+        let core_list = red.core.iter().map(|&c| index(c));
+        let (a_stmts, a_sets) = matrix_sets(&red.linear, m);
+        let affine = emit(g, &red.affine, &scheme);
+        let c_stmts = affine.stmts;
+        let c_sets = red
+            .affine
+            .iter()
+            .enumerate()
+            .filter(|(_, id)| !g.is_const(**id, 0.0))
+            .map(|(e, _)| {
+                let v = &affine.exprs[e];
+                let e = index(e);
+                quote!(__out[#e] = #v;)
+            });
+        let (cj_stmts, cj_sets) = matrix_sets(&red.affine_jacobian, r);
+        let vec_r = quote!(#na::SVector<f64, #r_lit>);
+        let doc = format!(
+            "The reduced step: the Hessian of L depends only on the jet components {:?} (flat \
+             indices j n + i), so Newton runs on {r} unknowns instead of {m}.",
+            red.core
+        );
+        quote! {
+            #[doc = #doc]
+            #[automatically_derived]
+            #allow
+            impl #generics #core::ReducedScheme<#s_lit, #m_lit, #r_lit> for #ty_full {
+                const CORE: [usize; #r_lit] = [#(#core_list),*];
+
+                /// A = dF/dw, constant in the state.
+                fn linear_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #m_lit> {
+                    #float
+                    #a_stmts
+                    let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
+                    #(#a_sets)*
+                    __out
+                }
+
+                /// c(z0, y) = F(z0, w) - A w.
+                fn affine_part(&self, z0: &#vec_s, y: &#vec_r, h: f64, theta: f64) -> #vec_m {
+                    #float
+                    #c_stmts
+                    let mut __out = #vec_m_path::zeros();
+                    #(#c_sets)*
+                    __out
+                }
+
+                /// dc/dy.
+                fn affine_jacobian(
+                    &self,
+                    z0: &#vec_s,
+                    y: &#vec_r,
+                    h: f64,
+                    theta: f64,
+                ) -> #na::SMatrix<f64, #m_lit, #r_lit> {
+                    #float
+                    #cj_stmts
+                    let mut __out = #na::SMatrix::<f64, #m_lit, #r_lit>::zeros();
+                    #(#cj_sets)*
+                    __out
+                }
+            }
+        }
+    });
+
     let jet_blocks = quote!([#vec_n; #k_lit]);
 
     // The generated code does not call the function; it stays for users to call.
@@ -540,6 +622,9 @@ fn generate(
             pub const STATE: usize = #s_lit;
             /// Number 2nk + n of Newton unknowns w = (z_1, u) of one step.
             pub const UNKNOWNS: usize = #m_lit;
+            /// Unknowns of the reduced step (`retract::ReducedScheme`), or 0 where the
+            /// general step is kept.
+            pub const REDUCED_UNKNOWNS: usize = #reduced_unknowns;
 
             /// The system with these parameters.
             #[allow(clippy::too_many_arguments)]
@@ -665,6 +750,8 @@ fn generate(
                 #core::lifted::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
             }
         }
+
+        #reduced_impl
     }
 }
 

@@ -28,6 +28,9 @@ pub enum Var {
     Step,
     /// The scheme parameter theta.
     Theta,
+    /// Core variable m of the reduced step: the value at the evaluation point of a jet
+    /// component on which the Hessian of L depends.
+    Core(u16),
 }
 
 /// A unary function.

@@ -181,6 +181,93 @@ fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
     Some(inv)
 }
 
+/// The evaluation point of a step: x_theta = (1 - theta) x_0 + theta x_1 and
+/// p_theta = theta p_0 + (1 - theta) p_1, componentwise, as graph nodes.
+fn evaluation_point(g: &mut Graph, n: usize, k: usize) -> (Vec<Id>, Vec<Id>) {
+    let theta = g.var(Var::Theta);
+    let one = g.constant(1.0);
+    let one_minus_theta = g.sub(one, theta);
+    let mut x_th = Vec::with_capacity(n * k);
+    let mut p_th = Vec::with_capacity(n * k);
+    for j in 0..k {
+        for i in 0..n {
+            let (x0, x1) = (
+                g.var(Var::Z0((j * n + i) as u16)),
+                g.var(Var::W((j * n + i) as u16)),
+            );
+            let (ta, tb) = (g.mul(one_minus_theta, x0), g.mul(theta, x1));
+            x_th.push(g.add_op(ta, tb));
+            let c = ((k + j) * n + i) as u16;
+            let (p0, p1) = (g.var(Var::Z0(c)), g.var(Var::W(c)));
+            let (ta, tb) = (g.mul(theta, p0), g.mul(one_minus_theta, p1));
+            p_th.push(g.add_op(ta, tb));
+        }
+    }
+    (x_th, p_th)
+}
+
+/// The residual F(z0, w) of the theta-scheme, given the gradient of L already evaluated at
+/// the evaluation point (`g_at[j * n + i]` = dL/dq^(j)_i, j = 0..=k).
+fn residual_from(
+    g: &mut Graph,
+    g_at: &[Id],
+    p_th: &[Id],
+    x_th: &[Id],
+    n: usize,
+    k: usize,
+) -> Vec<Id> {
+    let s = 2 * n * k;
+    let h = g.var(Var::Step);
+    let mut f = vec![g.constant(0.0); s + n];
+    for j in 0..k {
+        for i in 0..n {
+            let rate = if j + 1 < k {
+                x_th[(j + 1) * n + i]
+            } else {
+                g.var(Var::W((s + i) as u16))
+            };
+            let (a, b) = (
+                g.var(Var::W((j * n + i) as u16)),
+                g.var(Var::Z0((j * n + i) as u16)),
+            );
+            let diff = g.sub(a, b);
+            let hr = g.mul(h, rate);
+            f[j * n + i] = g.sub(diff, hr);
+
+            let mut force = g_at[j * n + i];
+            if j > 0 {
+                force = g.sub(force, p_th[(j - 1) * n + i]);
+            }
+            let c = ((k + j) * n + i) as u16;
+            let (a, b) = (g.var(Var::W(c)), g.var(Var::Z0(c)));
+            let diff = g.sub(a, b);
+            let hf = g.mul(h, force);
+            f[(k + j) * n + i] = g.sub(diff, hf);
+        }
+    }
+    for i in 0..n {
+        f[s + i] = g.sub(p_th[(k - 1) * n + i], g_at[k * n + i]);
+    }
+    f
+}
+
+/// The gradient with jet component (j, i) replaced by `at(j, i)`.
+fn gradient_at(
+    g: &mut Graph,
+    gradient: &[Id],
+    at: &dyn Fn(&mut Graph, usize, usize) -> Option<Id>,
+) -> Vec<Id> {
+    let map = |g: &mut Graph, v: Var| match v {
+        Var::Jet { order, index } => at(g, order as usize, index as usize),
+        _ => None,
+    };
+    let mut memo = HashMap::new();
+    gradient
+        .iter()
+        .map(|&e| substitute(g, e, &map, &mut memo))
+        .collect()
+}
+
 /// Residual F(z0, w) of the theta-scheme and its Jacobians.
 fn scheme(
     g: &mut Graph,
@@ -191,72 +278,16 @@ fn scheme(
 ) -> (Vec<Id>, Vec<Id>, Vec<Id>) {
     let s = 2 * n * k;
     let m = s + n;
-    let h = g.var(Var::Step);
-    let theta = g.var(Var::Theta);
-    let one = g.constant(1.0);
-    let one_minus_theta = g.sub(one, theta);
-    let x0 = |g: &mut Graph, j: usize, i: usize| g.var(Var::Z0((j * n + i) as u16));
-    let p0 = |g: &mut Graph, j: usize, i: usize| g.var(Var::Z0(((k + j) * n + i) as u16));
-    let x1 = |g: &mut Graph, j: usize, i: usize| g.var(Var::W((j * n + i) as u16));
-    let p1 = |g: &mut Graph, j: usize, i: usize| g.var(Var::W(((k + j) * n + i) as u16));
-    let u = |g: &mut Graph, i: usize| g.var(Var::W((s + i) as u16));
-    let mut x_th = vec![g.constant(0.0); n * k];
-    let mut p_th = vec![g.constant(0.0); n * k];
-    for j in 0..k {
-        for i in 0..n {
-            let (a, b) = (x0(g, j, i), x1(g, j, i));
-            let (ta, tb) = (g.mul(one_minus_theta, a), g.mul(theta, b));
-            x_th[j * n + i] = g.add_op(ta, tb);
-            let (a, b) = (p0(g, j, i), p1(g, j, i));
-            let (ta, tb) = (g.mul(theta, a), g.mul(one_minus_theta, b));
-            p_th[j * n + i] = g.add_op(ta, tb);
-        }
-    }
-    // dL/dx_j and dL/du at (x_th, u)
-    let at_point = {
-        let x_th = x_th.clone();
-        move |g: &mut Graph, v: Var| match v {
-            Var::Jet { order, index } if (order as usize) < k => {
-                Some(x_th[order as usize * n + index as usize])
-            }
-            Var::Jet { order, index } if order as usize == k => {
-                Some(g.var(Var::W((s + index as usize) as u16)))
-            }
-            _ => None,
-        }
+    let (x_th, p_th) = evaluation_point(g, n, k);
+    let at = |g: &mut Graph, j: usize, i: usize| {
+        Some(if j < k {
+            x_th[j * n + i]
+        } else {
+            g.var(Var::W((s + i) as u16))
+        })
     };
-    let mut memo = HashMap::new();
-    let g_at: Vec<Id> = gradient
-        .iter()
-        .map(|&e| substitute(g, e, &at_point, &mut memo))
-        .collect();
-
-    let mut f = vec![g.constant(0.0); m];
-    for j in 0..k {
-        for i in 0..n {
-            let rate = if j + 1 < k {
-                x_th[(j + 1) * n + i]
-            } else {
-                u(g, i)
-            };
-            let (a, b) = (x1(g, j, i), x0(g, j, i));
-            let diff = g.sub(a, b);
-            let hr = g.mul(h, rate);
-            f[j * n + i] = g.sub(diff, hr);
-
-            let mut force = g_at[j * n + i];
-            if j > 0 {
-                force = g.sub(force, p_th[(j - 1) * n + i]);
-            }
-            let (a, b) = (p1(g, j, i), p0(g, j, i));
-            let diff = g.sub(a, b);
-            let hf = g.mul(h, force);
-            f[(k + j) * n + i] = g.sub(diff, hf);
-        }
-    }
-    for i in 0..n {
-        f[s + i] = g.sub(p_th[(k - 1) * n + i], g_at[k * n + i]);
-    }
+    let g_at = gradient_at(g, gradient, &at);
+    let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
     let mut jacobian = Vec::with_capacity(m * m);
     let mut jacobian_initial = Vec::with_capacity(m * s);
     for &row in &f {
@@ -268,6 +299,97 @@ fn scheme(
         }
     }
     (f, jacobian, jacobian_initial)
+}
+
+/// The reduced step: F(w) = A w + c(z0, y), with y the values at the evaluation point of the
+/// jet components on which the Hessian of L depends (the nonlinear core) and A depending on
+/// h, theta and parameters only.
+pub struct Reduced {
+    /// Jet index j * n + i (j < k) of each core variable.
+    pub core: Vec<usize>,
+    /// A, row-major M x M.
+    pub linear: Vec<Id>,
+    /// c(z0, y), M entries.
+    pub affine: Vec<Id>,
+    /// dc/dy, row-major M x R.
+    pub affine_jacobian: Vec<Id>,
+}
+
+/// The reduced step of L, if its Hessian depends on some jet components but on no component
+/// of the top derivative u (else the general scheme is kept).
+pub fn reduce(
+    g: &mut Graph,
+    gradient: &[Id],
+    hessian: &[Vec<Id>],
+    n: usize,
+    k: usize,
+) -> Option<Reduced> {
+    let (s, m) = (2 * n * k, 2 * n * k + n);
+    let vars = n * (k + 1);
+    let varying = |g: &Graph, id: Id| depends_on(g, id, &|v| matches!(v, Var::Jet { .. }));
+    let core: Vec<usize> = (0..vars)
+        .filter(|&a| (0..vars).any(|b| varying(g, hessian[a][b])))
+        .collect();
+    if core.is_empty() || core.iter().any(|&a| a >= k * n) {
+        return None;
+    }
+    let (x_th, p_th) = evaluation_point(g, n, k);
+    let at = |g: &mut Graph, j: usize, i: usize| {
+        let a = j * n + i;
+        Some(match core.iter().position(|&c| c == a) {
+            Some(pos) => g.var(Var::Core(pos as u16)),
+            None if j < k => x_th[a],
+            None => g.var(Var::W((s + i) as u16)),
+        })
+    };
+    let g_at = gradient_at(g, gradient, &at);
+    let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
+    let mut d = Differentiator::default();
+    let mut linear = Vec::with_capacity(m * m);
+    for &row in &f {
+        for c in 0..m {
+            linear.push(d.diff(g, row, Var::W(c as u16)));
+        }
+    }
+    // A must not depend on w or on the core (else the split is not affine)
+    let on_state = |v: &Var| matches!(v, Var::W(_) | Var::Core(_) | Var::Z0(_));
+    if linear.iter().any(|&e| depends_on(g, e, &on_state)) {
+        return None;
+    }
+    let zero_w = |g: &mut Graph, v: Var| matches!(v, Var::W(_)).then(|| g.constant(0.0));
+    let mut memo = HashMap::new();
+    let affine: Vec<Id> = f
+        .iter()
+        .map(|&e| substitute(g, e, &zero_w, &mut memo))
+        .collect();
+    let mut affine_jacobian = Vec::with_capacity(m * core.len());
+    for &row in &affine {
+        for c in 0..core.len() {
+            affine_jacobian.push(d.diff(g, row, Var::Core(c as u16)));
+        }
+    }
+    Some(Reduced {
+        core,
+        linear,
+        affine,
+        affine_jacobian,
+    })
+}
+
+/// Whether a variable matching `target` is reachable from `id` (through sums too).
+fn depends_on(g: &Graph, id: Id, target: &dyn Fn(&Var) -> bool) -> bool {
+    let mut stack = vec![id];
+    let mut seen = std::collections::HashSet::new();
+    while let Some(node) = stack.pop() {
+        if !seen.insert(node) {
+            continue;
+        }
+        match g.node(node) {
+            crate::graph::Node::Var(v) if target(v) => return true,
+            other => stack.extend(crate::graph::children(other)),
+        }
+    }
+    false
 }
 
 /// A guarded expression at the three points of a step: start x_0, end x_1 and evaluation

@@ -42,6 +42,7 @@ pub mod lifted;
 pub mod linalg;
 pub mod models;
 pub mod newton;
+pub mod reduced;
 pub mod step;
 pub mod system;
 
@@ -49,6 +50,7 @@ pub mod system;
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
+pub use reduced::{ReducedScheme, ReducedStepper};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};

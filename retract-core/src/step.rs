@@ -73,7 +73,7 @@ impl StepOptions {
         self
     }
 
-    fn validate(&self, h: f64) -> Result<(), Error> {
+    pub(crate) fn validate(&self, h: f64) -> Result<(), Error> {
         if !(0.0..=1.0).contains(&self.theta) {
             return Err(Error::InvalidArgument {
                 name: "theta",

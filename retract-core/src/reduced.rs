@@ -1,0 +1,169 @@
+//! The reduced step: Newton on the nonlinear core only.
+//!
+//! When the Hessian of $L$ depends on a few jet components $y$ (the core, e.g. the position
+//! of a body in a barrier potential) and on no component of the top derivative, the
+//! theta-scheme residual splits as
+//!
+//! $$F(z_0, w) = A(h, \theta)\, w + c(z_0, y), \qquad y = P w + y_0(z_0),$$
+//!
+//! with $y$ the core values at the evaluation point ($P$ picks $\theta x_1$, $y_0 = (1-\theta) x_0$)
+//! and $A$ independent of the state. Then $w = -A^{-1} c(z_0, y)$ and $y$ solves the small
+//! system
+//!
+//! $$r(y) = y - y_0 + K c(z_0, y) = 0, \qquad K = P A^{-1}, \qquad
+//!   \partial r/\partial y = I + K\, \partial c/\partial y,$$
+//!
+//! $R$ unknowns instead of $M$. $A^{-1}$ and $K$ depend on $(h, \theta)$ only and are cached by
+//! [`ReducedStepper`]. The result is the same $z_1$ as the general step, to rounding.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::newton::{self, Problem};
+use crate::step::StepReport;
+use crate::{Error, LiftedSystem, StepOptions};
+
+/// A system whose step reduces to its nonlinear core of `R` variables.
+pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
+    LiftedSystem<S, M>
+{
+    /// Flat index $j n + i$ (into $z$ and $w$) of the jet component of each core variable.
+    const CORE: [usize; R];
+
+    /// $A = \partial F/\partial w$, constant in the state.
+    fn linear_part(&self, h: f64, theta: f64) -> SMatrix<f64, M, M>;
+
+    /// $c(z_0, y) = F(z_0, w) - A w$ with the core values $y$ at the evaluation point.
+    fn affine_part(
+        &self,
+        z0: &SVector<f64, S>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
+    ) -> SVector<f64, M>;
+
+    /// $\partial c / \partial y$.
+    fn affine_jacobian(
+        &self,
+        z0: &SVector<f64, S>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
+    ) -> SMatrix<f64, M, R>;
+}
+
+/// Cached factors for one $(h, \theta)$.
+#[derive(Clone, Copy, Debug)]
+struct Factors<const M: usize, const R: usize> {
+    h: f64,
+    theta: f64,
+    a_inv: SMatrix<f64, M, M>,
+    k: SMatrix<f64, R, M>,
+}
+
+/// Steps a [`ReducedScheme`] with Newton on its core; caches $A^{-1}$ per step size. No heap.
+#[derive(Clone, Debug)]
+pub struct ReducedStepper<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
+    system: &'a Sys,
+    factors: Option<Factors<M, R>>,
+}
+
+/// $r(y)$ of the module docs as a Newton problem.
+struct CoreProblem<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
+    system: &'a Sys,
+    z0: &'a SVector<f64, S>,
+    y0: SVector<f64, R>,
+    k: &'a SMatrix<f64, R, M>,
+    h: f64,
+    theta: f64,
+}
+
+impl<Sys, const S: usize, const M: usize, const R: usize> Problem<R>
+    for CoreProblem<'_, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    fn residual(&self, y: &SVector<f64, R>) -> SVector<f64, R> {
+        y - self.y0 + self.k * self.system.affine_part(self.z0, y, self.h, self.theta)
+    }
+
+    fn jacobian(&self, y: &SVector<f64, R>) -> SMatrix<f64, R, R> {
+        SMatrix::identity() + self.k * self.system.affine_jacobian(self.z0, y, self.h, self.theta)
+    }
+}
+
+impl<'a, Sys, const S: usize, const M: usize, const R: usize> ReducedStepper<'a, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    /// A stepper for `system` (factors are computed at the first step).
+    pub fn new(system: &'a Sys) -> Self {
+        Self {
+            system,
+            factors: None,
+        }
+    }
+
+    fn factors(&mut self, h: f64, theta: f64) -> Result<Factors<M, R>, Error> {
+        if let Some(f) = self.factors
+            && f.h == h
+            && f.theta == theta
+        {
+            return Ok(f);
+        }
+        let a = self.system.linear_part(h, theta);
+        let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
+            .ok_or(Error::SingularJacobian { iteration: 0 })?;
+        let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
+        let f = Factors { h, theta, a_inv, k };
+        self.factors = Some(f);
+        Ok(f)
+    }
+
+    /// One step $z_1 = \Psi_h(z_0)$, the same map as [`crate::step`].
+    ///
+    /// # Errors
+    /// As [`crate::step`]; a singular $A$ (only for degenerate $\theta$ and $h$) is
+    /// [`Error::SingularJacobian`] at iteration 0.
+    pub fn step(
+        &mut self,
+        z0: &SVector<f64, S>,
+        h: f64,
+        options: &StepOptions,
+    ) -> Result<(SVector<f64, S>, StepReport), Error> {
+        options.validate(h)?;
+        let theta = options.theta;
+        let factors = self.factors(h, theta)?;
+        let w_guess = self.system.predictor(z0, h, theta)?;
+        let y0 = SVector::<f64, R>::from_fn(|m, _| (1.0 - theta) * z0[Sys::CORE[m]]);
+        let y_guess = SVector::<f64, R>::from_fn(|m, _| y0[m] + theta * w_guess[Sys::CORE[m]]);
+        let problem = CoreProblem {
+            system: self.system,
+            z0,
+            y0,
+            k: &factors.k,
+            h,
+            theta,
+        };
+        let solution = newton::solve(&problem, y_guess, &options.newton)?;
+        let w = -(factors.a_inv * self.system.affine_part(z0, &solution.w, h, theta));
+        if !w.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite {
+                iteration: solution.iterations,
+                location: "reduced step",
+            });
+        }
+        if options.check_domain {
+            self.system
+                .check_domain(z0, &w, theta)
+                .map_err(Error::Domain)?;
+        }
+        Ok((
+            self.system.state(&w),
+            StepReport {
+                iterations: solution.iterations,
+                residual_norm: solution.residual_norm,
+                halvings: 0,
+            },
+        ))
+    }
+}
