@@ -119,10 +119,10 @@ where
         Ok(f)
     }
 
-    /// One step $z_1 = \Psi_h(z_0)$, the same map as [`crate::step`].
+    /// One step $z_1 = \Psi_h(z_0)$, the same map as [`crate::step()`].
     ///
     /// # Errors
-    /// As [`crate::step`]; a singular $A$ (only for degenerate $\theta$ and $h$) is
+    /// As [`crate::step()`]; a singular $A$ (only for degenerate $\theta$ and $h$) is
     /// [`Error::SingularJacobian`] at iteration 0.
     pub fn step(
         &mut self,
