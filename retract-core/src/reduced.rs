@@ -52,7 +52,7 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
 }
 
 /// Cached factors for one $(h, \theta)$.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Factors<const M: usize, const R: usize> {
     h: f64,
     theta: f64,
@@ -103,20 +103,18 @@ where
         }
     }
 
-    fn factors(&mut self, h: f64, theta: f64) -> Result<Factors<M, R>, Error> {
-        if let Some(f) = self.factors
-            && f.h == h
-            && f.theta == theta
-        {
-            return Ok(f);
+    fn factors(&mut self, h: f64, theta: f64) -> Result<&Factors<M, R>, Error> {
+        let cached = matches!(&self.factors, Some(f) if f.h == h && f.theta == theta);
+        if !cached {
+            let a = self.system.linear_part(h, theta);
+            let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
+                .ok_or(Error::SingularJacobian { iteration: 0 })?;
+            let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
+            self.factors = Some(Factors { h, theta, a_inv, k });
         }
-        let a = self.system.linear_part(h, theta);
-        let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
-            .ok_or(Error::SingularJacobian { iteration: 0 })?;
-        let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
-        let f = Factors { h, theta, a_inv, k };
-        self.factors = Some(f);
-        Ok(f)
+        self.factors
+            .as_ref()
+            .ok_or(Error::SingularJacobian { iteration: 0 })
     }
 
     /// One step $z_1 = \Psi_h(z_0)$, the same map as [`crate::step()`].
@@ -131,13 +129,25 @@ where
         options: &StepOptions,
     ) -> Result<(SVector<f64, S>, StepReport), Error> {
         options.validate(h)?;
+        if !z0.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite {
+                iteration: 0,
+                location: "state",
+            });
+        }
         let theta = options.theta;
+        let system = self.system;
         let factors = self.factors(h, theta)?;
-        let w_guess = self.system.predictor(z0, h, theta)?;
         let y0 = SVector::<f64, R>::from_fn(|m, _| (1.0 - theta) * z0[Sys::CORE[m]]);
-        let y_guess = SVector::<f64, R>::from_fn(|m, _| y0[m] + theta * w_guess[Sys::CORE[m]]);
+        // first guess: x_theta ~ x_0 + theta h x_0' (the next jet block), x_0 for the last block
+        let n = Sys::DIMENSION;
+        let y_guess = SVector::<f64, R>::from_fn(|m, _| {
+            let c = Sys::CORE[m];
+            let rate = if c + n < S / 2 { z0[c + n] } else { 0.0 };
+            z0[c] + theta * h * rate
+        });
         let problem = CoreProblem {
-            system: self.system,
+            system,
             z0,
             y0,
             k: &factors.k,
@@ -145,7 +155,7 @@ where
             theta,
         };
         let solution = newton::solve(&problem, y_guess, &options.newton)?;
-        let w = -(factors.a_inv * self.system.affine_part(z0, &solution.w, h, theta));
+        let w = -(factors.a_inv * system.affine_part(z0, &solution.w, h, theta));
         if !w.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFinite {
                 iteration: solution.iterations,
@@ -153,12 +163,10 @@ where
             });
         }
         if options.check_domain {
-            self.system
-                .check_domain(z0, &w, theta)
-                .map_err(Error::Domain)?;
+            system.check_domain(z0, &w, theta).map_err(Error::Domain)?;
         }
         Ok((
-            self.system.state(&w),
+            system.state(&w),
             StepReport {
                 iterations: solution.iterations,
                 residual_norm: solution.residual_norm,
