@@ -36,6 +36,7 @@
 pub mod banded;
 #[cfg(feature = "std")]
 pub mod bvp;
+pub mod compose;
 pub mod diagnostics;
 mod error;
 pub mod lifted;
@@ -48,6 +49,7 @@ pub mod system;
 
 #[cfg(feature = "std")]
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
+pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
 pub use reduced::{ReducedScheme, ReducedStepper};
