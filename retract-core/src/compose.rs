@@ -56,7 +56,7 @@ fn libm_pow2(x: f64) -> f64 {
 }
 
 /// One step of size `h` of the composition of `order` built from `base` (a symmetric
-/// one-step map `base(z, h)`, e.g. a closure around [`crate::step`] or
+/// one-step map `base(z, h)`, e.g. a closure around [`crate::step()`] or
 /// [`crate::ReducedStepper::step`]). Reports are summed over stages.
 ///
 /// # Errors
@@ -79,7 +79,7 @@ pub fn compose<const S: usize>(
     Ok((z, report))
 }
 
-/// One step of the composition of `order` of the midpoint rule ([`crate::step`]).
+/// One step of the composition of `order` of the midpoint rule ([`crate::step()`]).
 ///
 /// # Errors
 /// `options.theta` other than 1/2 (the base must be symmetric), an invalid order, or a

@@ -60,11 +60,17 @@ struct Factors<const M: usize, const R: usize> {
     k: SMatrix<f64, R, M>,
 }
 
-/// Steps a [`ReducedScheme`] with Newton on its core; caches $A^{-1}$ per step size. No heap.
+/// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps (a composition of
+/// order 4 or more alternates between two or three step sizes).
+const CACHED: usize = 4;
+
+/// Steps a [`ReducedScheme`] with Newton on its core; caches $A^{-1}$ for the last
+/// few step sizes. No heap.
 #[derive(Clone, Debug)]
 pub struct ReducedStepper<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,
-    factors: Option<Factors<M, R>>,
+    factors: [Option<Factors<M, R>>; CACHED],
+    next_slot: usize,
 }
 
 /// $r(y)$ of the module docs as a Newton problem.
@@ -99,20 +105,30 @@ where
     pub fn new(system: &'a Sys) -> Self {
         Self {
             system,
-            factors: None,
+            factors: [const { None }; CACHED],
+            next_slot: 0,
         }
     }
 
     fn factors(&mut self, h: f64, theta: f64) -> Result<&Factors<M, R>, Error> {
-        let cached = matches!(&self.factors, Some(f) if f.h == h && f.theta == theta);
-        if !cached {
-            let a = self.system.linear_part(h, theta);
-            let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
-                .ok_or(Error::SingularJacobian { iteration: 0 })?;
-            let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
-            self.factors = Some(Factors { h, theta, a_inv, k });
-        }
-        self.factors
+        let slot = match self
+            .factors
+            .iter()
+            .position(|f| matches!(f, Some(f) if f.h == h && f.theta == theta))
+        {
+            Some(slot) => slot,
+            None => {
+                let a = self.system.linear_part(h, theta);
+                let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
+                    .ok_or(Error::SingularJacobian { iteration: 0 })?;
+                let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
+                let slot = self.next_slot;
+                self.factors[slot] = Some(Factors { h, theta, a_inv, k });
+                self.next_slot = (slot + 1) % CACHED;
+                slot
+            }
+        };
+        self.factors[slot]
             .as_ref()
             .ok_or(Error::SingularJacobian { iteration: 0 })
     }

@@ -1,0 +1,373 @@
+//! Speed against error.
+//!
+//! 1. The paper's obstacle IVP (SE(2), tau = 1e-2, q(0) = (-2, 1.05, 0), q'(0) = (1, 0, 0.5),
+//!    T = 4): final error against a tight reference versus wall time for the midpoint rule
+//!    and its compositions of order 4, 6, 8 (all on the generated reduced step), classical
+//!    RK4 and adaptive DOP853 (ode_solvers) on the same Hamilton equations.
+//! 2. The bounded Pais-Uhlenbeck oscillator (MATH.md; w1 = 1, w2 = sqrt 2, eps = -0.05) over
+//!    10^6 midpoint steps of h = 0.1 (T = 10^5): max |H - H(0)| so far against time for the
+//!    midpoint rule, the order-4 composition at 3h (same number of implicit solves), RK4 and
+//!    DOP853 with their step size or tolerance chosen to cost about as much as the midpoint
+//!    run.
+//!
+//! Writes docs/work_precision.svg and docs/energy_long_run.svg and prints the tables.
+//! Run: `cargo run --release --example work_precision`
+
+mod common;
+
+use std::time::Instant;
+
+use ode_solvers::{Dop853, System};
+use retract::compose::compose;
+use retract::diagnostics::rk4_step;
+use retract::higher_order_lagrangian;
+use retract::nalgebra::SVector;
+use retract::{LiftedSystem, ReducedScheme, ReducedStepper, StepOptions};
+
+#[higher_order_lagrangian(order = 2)]
+fn rigid_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, r: f64) -> f64 {
+    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
+        + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
+}
+
+#[higher_order_lagrangian(order = 2)]
+fn pais_uhlenbeck(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], w1: f64, w2: f64, eps: f64) -> f64 {
+    let r2 = q[0].powi(2) + q[1].powi(2);
+    0.5 * (ddq[0].powi(2) + ddq[1].powi(2))
+        - 0.5 * (w1 * w1 + w2 * w2) * (dq[0].powi(2) + dq[1].powi(2))
+        + 0.5 * w1 * w1 * w2 * w2 * r2
+        + eps * r2 * r2
+}
+
+/// Hamilton's equations of a generated system for ode_solvers (its own nalgebra version).
+struct Hamilton<'a, Sys, const M: usize>(&'a Sys);
+
+impl<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>
+    System<f64, ode_solvers::SVector<f64, S>> for Hamilton<'_, Sys, M>
+{
+    fn system(
+        &self,
+        _t: f64,
+        y: &ode_solvers::SVector<f64, S>,
+        dy: &mut ode_solvers::SVector<f64, S>,
+    ) {
+        let z = SVector::<f64, S>::from_column_slice(y.as_slice());
+        let f = self
+            .0
+            .vector_field(&z)
+            .unwrap_or_else(|_| SVector::repeat(f64::NAN));
+        dy.as_mut_slice().copy_from_slice(f.as_slice());
+    }
+}
+
+/// DOP853 (ode_solvers' defaults: safety 0.9, step factors in [1/3, 6]) with
+/// rtol = atol = `tol` and steps at most `h_max`: the states after every accepted step (its
+/// dense output is not used: in ode_solvers 0.6.2 it is inaccurate for coarse output
+/// intervals), and the number of accepted steps.
+#[allow(clippy::type_complexity)]
+fn dop853<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    tol: f64,
+    h_max: f64,
+) -> Result<(Vec<(f64, SVector<f64, S>)>, u32), Box<dyn std::error::Error>> {
+    let y0 = ode_solvers::SVector::<f64, S>::from_column_slice(z0.as_slice());
+    let mut solver = Dop853::from_param(
+        Hamilton::<Sys, M>(system),
+        0.0,
+        t_end,
+        t_end,
+        y0,
+        tol,
+        tol,
+        0.9,
+        0.0,
+        0.333,
+        6.0,
+        h_max,
+        0.0,
+        u32::MAX,
+        1000,
+        ode_solvers::dop_shared::OutputType::Sparse,
+    );
+    let stats = solver.integrate().map_err(|e| format!("DOP853: {e:?}"))?;
+    let states = solver
+        .x_out()
+        .iter()
+        .zip(solver.y_out())
+        .map(|(t, y)| (*t, SVector::from_column_slice(y.as_slice())))
+        .collect();
+    Ok((states, stats.accepted_steps))
+}
+
+/// The state at `t_end` from [`dop853`].
+fn dop853_end<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    tol: f64,
+    h_max: f64,
+) -> Result<(SVector<f64, S>, u32), String> {
+    let (states, steps) = dop853(system, z0, t_end, tol, h_max).map_err(|e| e.to_string())?;
+    let end = states
+        .last()
+        .map(|s| s.1)
+        .ok_or("DOP853 returned no state")?;
+    Ok((end, steps))
+}
+
+/// Best wall time (seconds) over `repeats` runs of `f`, and its last result.
+fn timed<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::INFINITY;
+    let mut out = f();
+    for _ in 0..repeats {
+        let t = Instant::now();
+        out = f();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    (best, out)
+}
+
+/// `steps` steps of the composition of `order` on the reduced stepper.
+fn composed<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    steps: usize,
+    order: u32,
+) -> Result<SVector<f64, S>, retract::Error>
+where
+    Sys: ReducedScheme<S, M, R>,
+{
+    let options = StepOptions::default();
+    let mut stepper = ReducedStepper::new(system);
+    let h = t_end / steps as f64;
+    let mut z = *z0;
+    for _ in 0..steps {
+        z = compose(|z, h| stepper.step(z, h, &options), &z, h, order)?.0;
+    }
+    Ok(z)
+}
+
+fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
+    let system = RigidBody { tau: 1e-2, r: 1.0 };
+    let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let z0 = system.legendre(&SVector::from_column_slice(&jet));
+    let t_end = 4.0;
+    let reference = composed(&system, &z0, t_end, 4000, 8)?;
+    let (dop_reference, _) = dop853_end(&system, &z0, t_end, 1e-14, t_end)?;
+    println!("Obstacle IVP to T = 4; reference: order-8 composition, 4000 steps");
+    println!(
+        "(its distance to DOP853 at tol 1e-14: {:.1e})\n",
+        (reference - dop_reference).amax()
+    );
+    println!("| method | steps / tol | final error | wall time |");
+    println!("|---|---|---|---|");
+    let mut curves = Vec::new();
+    let methods: [(&str, u32, &[usize]); 4] = [
+        ("midpoint", 2, &[100, 200, 400, 800, 1600, 3200, 6400]),
+        ("composition, order 4", 4, &[20, 40, 80, 160, 320, 640]),
+        ("composition, order 6", 6, &[10, 20, 40, 80, 160]),
+        ("composition, order 8", 8, &[5, 10, 20, 40, 80]),
+    ];
+    for (name, order, sweep) in methods {
+        let mut points = Vec::new();
+        for &n in sweep {
+            let (time, end) = timed(5, || composed(&system, &z0, t_end, n, order));
+            match end {
+                Ok(end) => {
+                    let error = (end - reference).amax();
+                    println!("| {name} | {n} | {error:.2e} | {:.1} us |", time * 1e6);
+                    points.push((time, error.max(1e-16)));
+                }
+                Err(e) => println!("| {name} | {n} | stopped: {e} | - |"),
+            }
+        }
+        curves.push(common::Curve::new(name, points));
+    }
+    let mut points = Vec::new();
+    for n in [50, 100, 200, 400, 800, 1600, 3200] {
+        let h = t_end / n as f64;
+        let (time, end) = timed(5, || {
+            let mut z = z0;
+            for _ in 0..n {
+                z = rk4_step(&system, &z, h)?;
+            }
+            Ok::<_, retract::Error>(z)
+        });
+        match end {
+            Ok(end) => {
+                let error = (end - reference).amax();
+                println!("| RK4 | {n} | {error:.2e} | {:.1} us |", time * 1e6);
+                points.push((time, error.max(1e-16)));
+            }
+            Err(e) => println!("| RK4 | {n} | stopped: {e} | - |"),
+        }
+    }
+    curves.push(common::Curve::new("RK4", points));
+    for (label, h_max) in [("DOP853", t_end)] {
+        let mut points = Vec::new();
+        for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
+            let (time, result) = timed(5, || dop853_end(&system, &z0, t_end, tol, h_max));
+            let (end, steps) = result?;
+            let error = (end - reference).amax();
+            println!(
+                "| {label} | tol {tol:.0e} ({steps} steps) | {error:.2e} | {:.1} us |",
+                time * 1e6
+            );
+            points.push((time, error.max(1e-16)));
+        }
+        curves.push(common::Curve::new(label, points));
+    }
+    let figure = common::docs_path("work_precision.svg");
+    common::panels(
+        &figure,
+        "Obstacle IVP to T = 4: final error against wall time",
+        "wall time [s]",
+        &[("max-norm error at T", curves)],
+        true,
+    )?;
+    println!("\nfigure: {}", figure.display());
+    Ok(())
+}
+
+/// max |H - H(0)| so far, sampled at t = 10^(k/4).
+fn energy_record(
+    system: &PaisUhlenbeck,
+    z0: &SVector<f64, 8>,
+    h: f64,
+    steps: usize,
+    mut advance: impl FnMut(&SVector<f64, 8>) -> Result<SVector<f64, 8>, retract::Error>,
+) -> Result<(f64, Vec<(f64, f64)>), retract::Error> {
+    let h0 = system.hamiltonian(z0)?;
+    let mut z = *z0;
+    let mut worst: f64 = 1e-17;
+    let mut record = Vec::new();
+    let mut next_sample = 1.0;
+    let started = Instant::now();
+    for i in 1..=steps {
+        z = advance(&z)?;
+        worst = worst.max((system.hamiltonian(&z)? - h0).abs());
+        let t = i as f64 * h;
+        if t >= next_sample {
+            record.push((t, worst));
+            next_sample *= 10f64.powf(0.25);
+        }
+    }
+    Ok((started.elapsed().as_secs_f64(), record))
+}
+
+fn long_run() -> Result<(), Box<dyn std::error::Error>> {
+    let system = PaisUhlenbeck {
+        w1: 1.0,
+        w2: 2f64.sqrt(),
+        eps: -0.05,
+    };
+    let z0 = system.legendre(&SVector::from_column_slice(&[
+        0.3, 0.0, 0.0, 0.25, -0.1, 0.05, 0.0, 0.1,
+    ]));
+    let t_end = 1e5;
+    let options = StepOptions::default();
+    println!("\nPais-Uhlenbeck, T = 1e5: energy error at matched cost");
+    println!(
+        "| method | step size / tol | steps | wall time | max abs(H - H0) at T = 1e3 | at T = 1e5 |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let mut curves = Vec::new();
+    let mut report =
+        |name: &str, detail: String, steps: usize, time: f64, record: Vec<(f64, f64)>| {
+            let at = |t: f64| {
+                record
+                    .iter()
+                    .rfind(|p| p.0 <= t * 1.001)
+                    .map_or(0.0, |p| p.1)
+            };
+            println!(
+                "| {name} | {detail} | {steps} | {time:.2} s | {:.2e} | {:.2e} |",
+                at(1e3),
+                at(1e5)
+            );
+            curves.push(common::Curve::new(name, record));
+        };
+    let mut stepper = ReducedStepper::new(&system);
+    let h = 0.1;
+    let steps = (t_end / h) as usize;
+    let (midpoint_time, record) = energy_record(&system, &z0, h, steps, |z| {
+        Ok(stepper.step(z, h, &options)?.0)
+    })?;
+    report("midpoint", format!("h = {h}"), steps, midpoint_time, record);
+    let h4 = 3.0 * h;
+    let n4 = (t_end / h4) as usize;
+    let (time, record) = energy_record(&system, &z0, h4, n4, |z| {
+        Ok(compose(|z, s| stepper.step(z, s, &options), z, h4, 4)?.0)
+    })?;
+    report(
+        "composition, order 4",
+        format!("h = {h4:.1}"),
+        n4,
+        time,
+        record,
+    );
+    // RK4: a step costs less than an implicit one; use the step count that costs the same
+    let (rk_probe, _) = energy_record(&system, &z0, h, 20_000, |z| rk4_step(&system, z, h))?;
+    let rk_steps = (steps as f64 * midpoint_time / (rk_probe * 50.0)).min(1e7) as usize;
+    let h_rk = t_end / rk_steps as f64;
+    let (time, record) =
+        energy_record(&system, &z0, h_rk, rk_steps, |z| rk4_step(&system, z, h_rk))?;
+    report("RK4", format!("h = {h_rk:.3}"), rk_steps, time, record);
+    // DOP853: the tolerance whose run costs about as much as the midpoint run
+    let mut best: Option<(f64, f64)> = None;
+    for tol in [1e-6, 1e-8, 1e-10, 1e-12] {
+        let (time, _) = timed(0, || {
+            dop853(&system, &z0, t_end, tol, t_end)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        });
+        if best.is_none_or(|(_, t)| {
+            (time.ln() - midpoint_time.ln()).abs() < (t.ln() - midpoint_time.ln()).abs()
+        }) {
+            best = Some((tol, time));
+        }
+    }
+    if let Some((tol, _)) = best {
+        let started = Instant::now();
+        let (states, steps) = dop853(&system, &z0, t_end, tol, t_end)?;
+        let time = started.elapsed().as_secs_f64();
+        let h0 = system.hamiltonian(&z0)?;
+        let mut worst: f64 = 1e-17;
+        let mut record = Vec::new();
+        let mut next_sample = 1.0;
+        for (t, z) in &states {
+            worst = worst.max((system.hamiltonian(z)? - h0).abs());
+            if *t >= next_sample {
+                record.push((*t, worst));
+                next_sample *= 10f64.powf(0.25);
+            }
+        }
+        report(
+            "DOP853 (adaptive)",
+            format!("tol {tol:.0e}"),
+            steps as usize,
+            time,
+            record,
+        );
+    }
+    let figure = common::docs_path("energy_long_run.svg");
+    common::panels(
+        &figure,
+        "Pais-Uhlenbeck: max |H - H(0)| up to time t, matched cost",
+        "t",
+        &[("max energy error", curves)],
+        true,
+    )?;
+    println!("\nfigure: {}", figure.display());
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = obstacle_ivp().and_then(|()| long_run()) {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
