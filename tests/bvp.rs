@@ -2,20 +2,13 @@
 //! self-convergence with obstacles, agreement with shooting, and hard cases that end in
 //! convergence or a typed error (never NaN, never a panic).
 
+mod common;
+
+use common::models::Scene;
 use retract::bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess, continuation};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{DMatrix, DVector, SVector};
 use retract::{Error, StepOptions, trajectory};
-
-/// The SE(2) chart with a run-time list of disc obstacles (cx, cy, r).
-#[higher_order_lagrangian(order = 2)]
-fn scene(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, obstacles: &[[f64; 3]]) -> f64 {
-    let mut l = 0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2));
-    for o in obstacles {
-        l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);
-    }
-    l
-}
 
 /// Minimum jerk in R^2 (quintic splines).
 #[higher_order_lagrangian(order = 3)]

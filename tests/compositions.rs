@@ -1,18 +1,13 @@
 //! Symmetric compositions of the midpoint rule: observed orders 4, 6 and 8, and a symplectic
 //! composed map.
 
+mod common;
+
+use common::models::RigidBody;
 use retract::compose::coefficients;
 use retract::diagnostics::{canonical_structure, step_map_derivative};
-use retract::higher_order_lagrangian;
 use retract::nalgebra::{SMatrix, SVector};
 use retract::{LiftedSystem, ReducedStepper, StepOptions, composed_step};
-
-/// The paper's SE(2) obstacle Lagrangian.
-#[higher_order_lagrangian(order = 2)]
-fn rigid_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, r: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
-        + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
-}
 
 type Z = SVector<f64, 12>;
 

@@ -1,27 +1,14 @@
 //! Hard cases through the macro. Each ends in convergence or a typed error: never a NaN in
 //! a returned state, never a panic.
 
+mod common;
+
+use common::models::{PaisUhlenbeck, RigidBody};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{
     Error, Interrupted, LiftedSystem, NewtonOptions, StepOptions, Trajectory, step, trajectory,
 };
-
-#[higher_order_lagrangian(order = 2)]
-fn rigid_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, r: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
-        + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
-}
-
-/// Rotation-invariant Pais-Uhlenbeck oscillator in R^2 (MATH.md), with a quartic term.
-#[higher_order_lagrangian(order = 2)]
-fn pais_uhlenbeck(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], w1: f64, w2: f64, eps: f64) -> f64 {
-    let r2 = q[0].powi(2) + q[1].powi(2);
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2))
-        - 0.5 * (w1 * w1 + w2 * w2) * (dq[0].powi(2) + dq[1].powi(2))
-        + 0.5 * w1 * w1 * w2 * w2 * r2
-        + eps * r2 * r2
-}
 
 /// Minimum snap with a potential, k = 4.
 #[higher_order_lagrangian(order = 4)]

@@ -2,11 +2,13 @@
 //! during steps (predictor, Newton, domain check), a Newton solve, the symplecticity
 //! diagnostic and an RK4 step of a generated system.
 
+mod common;
+
+use common::models::Scene;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use retract::diagnostics::{rk4_step, symplecticity_error};
-use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{LiftedSystem, StepOptions, step};
 
@@ -39,15 +41,6 @@ static ALLOCATOR: Counting = Counting;
 
 fn allocations() -> usize {
     ALLOCATIONS.with(|c| c.get())
-}
-
-#[higher_order_lagrangian(order = 2)]
-fn scene(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, obstacles: &[[f64; 3]]) -> f64 {
-    let mut l = 0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2));
-    for o in obstacles {
-        l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);
-    }
-    l
 }
 
 #[test]

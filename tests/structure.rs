@@ -4,28 +4,11 @@
 
 mod common;
 
+use common::models::{PaisUhlenbeck, RigidBody};
 use retract::diagnostics::{component_drift, rk4_step, symplecticity_error};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{LiftedSystem, StepOptions, step, trajectory};
-
-/// The paper's planar rigid body on the SE(2) chart (x, y, theta) with the disc barrier.
-#[higher_order_lagrangian(order = 2)]
-fn rigid_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, r: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
-        + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
-}
-
-/// Rotation-invariant Pais-Uhlenbeck oscillator in R^2 with a quartic term:
-/// L = 1/2|q''|^2 - (w1^2 + w2^2)/2 |q'|^2 + w1^2 w2^2 / 2 |q|^2 + eps |q|^4.
-#[higher_order_lagrangian(order = 2)]
-fn pais_uhlenbeck(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], w1: f64, w2: f64, eps: f64) -> f64 {
-    let r2 = q[0].powi(2) + q[1].powi(2);
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2))
-        - 0.5 * (w1 * w1 + w2 * w2) * (dq[0].powi(2) + dq[1].powi(2))
-        + 0.5 * w1 * w1 * w2 * w2 * r2
-        + eps * r2 * r2
-}
 
 /// Minimum jerk in R^2: L = 1/2 |q'''|^2 (exact solutions: quintics).
 #[higher_order_lagrangian(order = 3)]

@@ -1,7 +1,8 @@
 //! Straight-line Rust from graph nodes.
 //!
-//! For a set of roots, every needed non-leaf node becomes one `let __tN: f64 = ...;` in id
-//! order (children first), so each shared subexpression is computed once. Leaves (symbols,
+//! For a set of roots, every needed non-leaf node that is used more than once becomes one
+//! `let __tN: f64 = ...;` in id order (children first), so each shared subexpression is
+//! computed once; a node used once is inlined, parenthesised, into its parent. Leaves (symbols,
 //! constants, named consts) are inlined. A [`Node::Sum`] becomes a run-time loop over its
 //! slice parameter; the nodes of its body that depend on the loop element are emitted inside
 //! the loop, the others are hoisted before it.
@@ -105,22 +106,125 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
         }
     }
 
-    let reference = |id: Id| -> TokenStream {
-        match g.node(id) {
+    // use counts at function level: a node used once (and not from inside a loop) is inlined
+    // into its parent instead of getting a `let`
+    let mut uses = vec![0usize; len];
+    let mut pinned = vec![false; len];
+    for i in 0..len {
+        let node = g.node(Id(i as u32));
+        if top[i] && !is_leaf(node) {
+            match node {
+                Node::Sum { .. } => {
+                    pinned[i] = true;
+                    for (j, &m) in body_of[i].iter().enumerate() {
+                        if m {
+                            for c in children(g.node(Id(j as u32))) {
+                                if top[c.0 as usize] {
+                                    pinned[c.0 as usize] = true;
+                                }
+                            }
+                        }
+                    }
+                    if let Node::Sum { body, .. } = node
+                        && top[body.0 as usize]
+                    {
+                        pinned[body.0 as usize] = true;
+                    }
+                }
+                n => {
+                    for c in children(n) {
+                        uses[c.0 as usize] += 1;
+                    }
+                }
+            }
+        }
+    }
+    for r in roots {
+        uses[r.0 as usize] += 2; // roots are always bound
+    }
+    let inline: Vec<bool> = (0..len)
+        .map(|i| top[i] && uses[i] == 1 && !pinned[i] && !is_leaf(g.node(Id(i as u32))))
+        .collect();
+    let emitter = Emitter {
+        g,
+        leaves,
+        inline: &inline,
+    };
+    let reference = |id: Id| emitter.reference(id, false);
+    let value = |id: Id| emitter.value(id, false);
+
+    let mut stmts = TokenStream::new();
+    for i in 0..len {
+        let id = Id(i as u32);
+        let node = g.node(id);
+        if !top[i] || is_leaf(node) || inline[i] {
+            continue;
+        }
+        let t = temp(id);
+        if let Node::Sum { param, body } = *node {
+            let marks = &body_of[i];
+            let mut inside = TokenStream::new();
+            for (j, &m) in marks.iter().enumerate() {
+                let jd = Id(j as u32);
+                if m && !is_leaf(g.node(jd)) {
+                    let tj = temp(jd);
+                    let v = emitter.value(jd, true);
+                    inside.extend(quote!(let #tj: f64 = #v;));
+                }
+            }
+            let slice = leaves.slice(param);
+            let element = leaves.element();
+            let b = emitter.reference(body, true);
+            stmts.extend(quote! {
+                let mut #t: f64 = 0.0;
+                for #element in #slice.iter() {
+                    #inside
+                    #t += #b;
+                }
+            });
+        } else {
+            let v = value(id);
+            stmts.extend(quote!(let #t: f64 = #v;));
+        }
+    }
+    Emitted {
+        stmts,
+        exprs: roots.iter().map(|&r| reference(r)).collect(),
+    }
+}
+
+/// Expression tokens of nodes, with single-use nodes inlined.
+struct Emitter<'a> {
+    g: &'a Graph,
+    leaves: &'a dyn Leaves,
+    inline: &'a [bool],
+}
+
+impl Emitter<'_> {
+    /// How a parent refers to `id`: a leaf, a temporary, or (inlined) its parenthesised value.
+    /// `in_loop`: inside a loop body every non-leaf is a temporary.
+    fn reference(&self, id: Id, in_loop: bool) -> TokenStream {
+        match self.g.node(id) {
             Node::Const(bits) => constant(f64::from_bits(*bits)),
-            Node::Var(v) => leaves.var(*v),
+            Node::Var(v) => self.leaves.var(*v),
             Node::Named(k) => {
-                let path: TokenStream = g.named[*k as usize]
+                let path: TokenStream = self.g.named[*k as usize]
                     .parse()
                     .unwrap_or_else(|_| quote!(::core::f64::NAN));
                 quote!((#path))
             }
+            _ if !in_loop && self.inline[id.0 as usize] => {
+                let v = self.value(id, in_loop);
+                quote!((#v))
+            }
             _ => temp(id),
         }
-    };
-    let value = |id: Id| -> TokenStream {
-        let r = |c: Id| reference(c);
-        match g.node(id).clone() {
+    }
+
+    /// The expression computing `id` from its children.
+    fn value(&self, id: Id, in_loop: bool) -> TokenStream {
+        let r = |c: Id| self.reference(c, in_loop);
+        match self.g.node(id).clone() {
             Node::Add(a, b) => {
                 let (a, b) = (r(a), r(b));
                 quote!(#a + #b)
@@ -162,46 +266,7 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
                 let (a, b) = (r(a), r(b));
                 quote!(#a.hypot(#b))
             }
-            _ => reference(id),
+            _ => self.reference(id, in_loop),
         }
-    };
-
-    let mut stmts = TokenStream::new();
-    for i in 0..len {
-        let id = Id(i as u32);
-        let node = g.node(id);
-        if !top[i] || is_leaf(node) {
-            continue;
-        }
-        let t = temp(id);
-        if let Node::Sum { param, body } = *node {
-            let marks = &body_of[i];
-            let mut inside = TokenStream::new();
-            for (j, &m) in marks.iter().enumerate() {
-                let jd = Id(j as u32);
-                if m && !is_leaf(g.node(jd)) {
-                    let tj = temp(jd);
-                    let v = value(jd);
-                    inside.extend(quote!(let #tj: f64 = #v;));
-                }
-            }
-            let slice = leaves.slice(param);
-            let element = leaves.element();
-            let b = reference(body);
-            stmts.extend(quote! {
-                let mut #t: f64 = 0.0;
-                for #element in #slice.iter() {
-                    #inside
-                    #t += #b;
-                }
-            });
-        } else {
-            let v = value(id);
-            stmts.extend(quote!(let #t: f64 = #v;));
-        }
-    }
-    Emitted {
-        stmts,
-        exprs: roots.iter().map(|&r| reference(r)).collect(),
     }
 }

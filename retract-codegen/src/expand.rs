@@ -525,7 +525,6 @@ fn generate(
         let r = red.core.len();
         let r_lit = index(r);
         let core_list = red.core.iter().map(|&c| index(c));
-        let (a_stmts, a_sets) = matrix_sets(&red.linear, m);
         let affine = emit(g, &red.affine, &scheme);
         let c_stmts = affine.stmts;
         let c_sets = red
@@ -551,15 +550,6 @@ fn generate(
             #allow
             impl #generics #core::ReducedScheme<#s_lit, #m_lit, #r_lit> for #ty_full {
                 const CORE: [usize; #r_lit] = [#(#core_list),*];
-
-                /// A = dF/dw, constant in the state.
-                fn linear_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #m_lit> {
-                    #float
-                    #a_stmts
-                    let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
-                    #(#a_sets)*
-                    __out
-                }
 
                 /// c(z0, y) = F(z0, w) - A w.
                 fn affine_part(&self, z0: &#vec_s, y: &#vec_r, h: f64, theta: f64) -> #vec_m {

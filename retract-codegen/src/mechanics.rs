@@ -307,8 +307,6 @@ fn scheme(
 pub struct Reduced {
     /// Jet index j * n + i (j < k) of each core variable.
     pub core: Vec<usize>,
-    /// A, row-major M x M.
-    pub linear: Vec<Id>,
     /// c(z0, y), M entries.
     pub affine: Vec<Id>,
     /// dc/dy, row-major M x R.
@@ -370,7 +368,6 @@ pub fn reduce(
     }
     Some(Reduced {
         core,
-        linear,
         affine,
         affine_jacobian,
     })

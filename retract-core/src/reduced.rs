@@ -14,7 +14,10 @@
 //!   \partial r/\partial y = I + K\, \partial c/\partial y,$$
 //!
 //! $R$ unknowns instead of $M$. $A^{-1}$ and $K$ depend on $(h, \theta)$ only and are cached by
-//! [`ReducedStepper`]. The result is the same $z_1$ as the general step, to rounding.
+//! [`ReducedStepper`]; $A$ itself is not generated but formed from the Jacobian of the general
+//! scheme, $A = \partial F/\partial w - (\partial c/\partial y) P$, at the first state stepped
+//! with that $(h, \theta)$ (the macro has checked that it does not depend on the state). The
+//! result is the same $z_1$ as the general step, to rounding.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -28,9 +31,6 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
 {
     /// Flat index $j n + i$ (into $z$ and $w$) of the jet component of each core variable.
     const CORE: [usize; R];
-
-    /// $A = \partial F/\partial w$, constant in the state.
-    fn linear_part(&self, h: f64, theta: f64) -> SMatrix<f64, M, M>;
 
     /// $c(z_0, y) = F(z_0, w) - A w$ with the core values $y$ at the evaluation point.
     fn affine_part(
@@ -110,7 +110,14 @@ where
         }
     }
 
-    fn factors(&mut self, h: f64, theta: f64) -> Result<&Factors<M, R>, Error> {
+    /// The cached factors for $(h, \theta)$, formed at `z0` with the first guess `y` if new.
+    fn factors(
+        &mut self,
+        z0: &SVector<f64, S>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
+    ) -> Result<&Factors<M, R>, Error> {
         let slot = match self
             .factors
             .iter()
@@ -118,7 +125,20 @@ where
         {
             Some(slot) => slot,
             None => {
-                let a = self.system.linear_part(h, theta);
+                // A = dF/dw - (dc/dy) P at any state: here z0 and w with w[CORE] = x_1 from y
+                let mut w = SVector::<f64, M>::zeros();
+                for (m, &c) in Sys::CORE.iter().enumerate() {
+                    if theta != 0.0 {
+                        w[c] = (y[m] - (1.0 - theta) * z0[c]) / theta;
+                    }
+                }
+                let dc = self.system.affine_jacobian(z0, y, h, theta);
+                let mut a = self.system.jacobian(z0, &w, h, theta);
+                for (m, &c) in Sys::CORE.iter().enumerate() {
+                    for r in 0..M {
+                        a[(r, c)] -= dc[(r, m)] * theta;
+                    }
+                }
                 let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
                     .ok_or(Error::SingularJacobian { iteration: 0 })?;
                 let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
@@ -153,7 +173,6 @@ where
         }
         let theta = options.theta;
         let system = self.system;
-        let factors = self.factors(h, theta)?;
         let y0 = SVector::<f64, R>::from_fn(|m, _| (1.0 - theta) * z0[Sys::CORE[m]]);
         // first guess: x_theta ~ x_0 + theta h x_0' (the next jet block), x_0 for the last block
         let n = Sys::DIMENSION;
@@ -162,6 +181,7 @@ where
             let rate = if c + n < S / 2 { z0[c + n] } else { 0.0 };
             z0[c] + theta * h * rate
         });
+        let factors = self.factors(z0, &y_guess, h, theta)?;
         let problem = CoreProblem {
             system,
             z0,

@@ -1,4 +1,4 @@
-//! Helpers shared by the integration tests.
+//! Helpers and Lagrangians shared by the integration tests.
 #![allow(dead_code)] // each test file uses a subset
 
 use retract::diagnostics::rk4_step;
@@ -68,3 +68,5 @@ pub fn assert_orders(orders: &[f64], range: std::ops::Range<f64>, what: &str) {
         );
     }
 }
+
+pub mod models;
