@@ -278,6 +278,28 @@ fn iteration_cap_is_no_convergence_with_the_last_residual() {
 }
 
 #[test]
+fn overshooting_full_newton_steps_are_a_line_search_failure() {
+    // Backtracking disabled (as a hard real-time controller might): next to a strong barrier
+    // the full Newton step of a large step size increases |F|.
+    let system = barrier(50.0);
+    let z0 = start(&system, [-1.05, 0.0, 1.0, 0.3, 0.0, 0.0, 0.0, 0.0]);
+    let newton = NewtonOptions::default().with_max_backtracks(0);
+    let options = StepOptions::default().with_newton(newton);
+    let mut failure = None;
+    for h in [0.05, 0.1, 0.2, 0.4] {
+        if let Err(e @ Error::LineSearchFailed { .. }) = step(&system, &z0, h, &options) {
+            failure = Some((h, e));
+            break;
+        }
+    }
+    let (h, e) = failure.expect("some step size overshoots");
+    assert!(e.to_string().contains("line search"), "{e}");
+    // with backtracking the same step converges
+    let (z1, _) = step(&system, &z0, h, &StepOptions::default()).expect("backtracking recovers");
+    assert!(z1.iter().all(|v| v.is_finite()));
+}
+
+#[test]
 fn an_interrupted_trajectory_keeps_the_states_before_the_failure() {
     // Heading straight at the obstacle with tau = 0: the free spline crosses the circle,
     // and with a NaN-free run but an iteration cap of 1 the first step fails.

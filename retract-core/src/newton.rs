@@ -82,6 +82,12 @@ impl NewtonOptions {
         self
     }
 
+    /// Sets the number of step halvings per iteration (0: full Newton steps only).
+    pub fn with_max_backtracks(mut self, max_backtracks: usize) -> Self {
+        self.max_backtracks = max_backtracks;
+        self
+    }
+
     /// Checks every option is in its domain.
     pub fn validate(&self) -> Result<(), Error> {
         let tolerances = [
