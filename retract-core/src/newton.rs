@@ -152,6 +152,19 @@ where
     P: Problem<M> + ?Sized,
 {
     options.validate()?;
+    solve_validated(problem, w0, options)
+}
+
+/// [`solve`] for options already checked with [`NewtonOptions::validate`] (the step paths
+/// validate once per step).
+pub(crate) fn solve_validated<P, const M: usize>(
+    problem: &P,
+    w0: SVector<f64, M>,
+    options: &NewtonOptions,
+) -> Result<Solution<M>, Error>
+where
+    P: Problem<M> + ?Sized,
+{
     if !all_finite(&w0) {
         return Err(Error::NonFinite {
             iteration: 0,

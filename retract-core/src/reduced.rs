@@ -190,19 +190,25 @@ where
             h,
             theta,
         };
-        let solution = newton::solve(&problem, y_guess, &options.newton)?;
-        let w = -(factors.a_inv * system.affine_part(z0, &solution.w, h, theta));
-        if !w.iter().all(|v| v.is_finite()) {
+        let solution = newton::solve_validated(&problem, y_guess, &options.newton)?;
+        let c = system.affine_part(z0, &solution.w, h, theta);
+        let z1: SVector<f64, S> = -(factors.a_inv.fixed_rows::<S>(0) * c);
+        if !z1.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFinite {
                 iteration: solution.iterations,
                 location: "reduced step",
             });
         }
         if options.check_domain {
+            // the domain check reads x_1 from w and u from its tail
+            let mut w = SVector::<f64, M>::zeros();
+            w.fixed_rows_mut::<S>(0).copy_from(&z1);
+            let tail = -(factors.a_inv.fixed_rows::<M>(0).rows(S, M - S) * c);
+            w.rows_mut(S, M - S).copy_from(&tail);
             system.check_domain(z0, &w, theta).map_err(Error::Domain)?;
         }
         Ok((
-            system.state(&w),
+            z1,
             StepReport {
                 iterations: solution.iterations,
                 residual_norm: solution.residual_norm,

@@ -144,7 +144,7 @@ where
         h,
         theta: options.theta,
     };
-    let solution = newton::solve(&problem, guess, &options.newton)?;
+    let solution = newton::solve_validated(&problem, guess, &options.newton)?;
     if options.check_domain {
         system
             .check_domain(z0, &solution.w, options.theta)
