@@ -203,8 +203,9 @@ where
             // the domain check reads x_1 from w and u from its tail
             let mut w = SVector::<f64, M>::zeros();
             w.fixed_rows_mut::<S>(0).copy_from(&z1);
-            let tail = -(factors.a_inv.fixed_rows::<M>(0).rows(S, M - S) * c);
-            w.rows_mut(S, M - S).copy_from(&tail);
+            for r in S..M {
+                w[r] = -(0..M).map(|k| factors.a_inv[(r, k)] * c[k]).sum::<f64>();
+            }
             system.check_domain(z0, &w, theta).map_err(Error::Domain)?;
         }
         Ok((
@@ -215,5 +216,32 @@ where
                 halvings: 0,
             },
         ))
+    }
+}
+
+#[cfg(feature = "std")]
+impl<Sys, const S: usize, const M: usize, const R: usize> ReducedStepper<'_, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    /// `steps` reduced steps of size `h` from `z0`, with the driver of [`crate::trajectory`]
+    /// (step halving, domain crossing location).
+    ///
+    /// # Errors
+    /// [`crate::Interrupted`] with the states before the failed step.
+    pub fn trajectory(
+        &mut self,
+        z0: &SVector<f64, S>,
+        h: f64,
+        steps: usize,
+        options: &StepOptions,
+    ) -> Result<crate::Trajectory<S>, crate::Interrupted<S>> {
+        crate::step::drive(
+            |z: &SVector<f64, S>, h, o: &StepOptions| self.step(z, h, o),
+            z0,
+            h,
+            steps,
+            options,
+        )
     }
 }

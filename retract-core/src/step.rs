@@ -256,6 +256,18 @@ impl<const S: usize> core::fmt::Display for Interrupted<S> {
 #[cfg(feature = "std")]
 impl<const S: usize> core::error::Error for Interrupted<S> {}
 
+/// A one-step map `(z, h, options) -> (z_1, report)`: [`step`] or
+/// [`crate::ReducedStepper::step`].
+pub trait OneStep<const S: usize>:
+    FnMut(&SVector<f64, S>, f64, &StepOptions) -> Result<(SVector<f64, S>, StepReport), Error>
+{
+}
+
+impl<F, const S: usize> OneStep<S> for F where
+    F: FnMut(&SVector<f64, S>, f64, &StepOptions) -> Result<(SVector<f64, S>, StepReport), Error>
+{
+}
+
 #[cfg(feature = "std")]
 /// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
 ///
@@ -272,6 +284,29 @@ pub fn trajectory<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
+    drive(
+        |z: &SVector<f64, S>, h, o: &StepOptions| step(system, z, h, o),
+        z0,
+        h,
+        steps,
+        options,
+    )
+}
+
+#[cfg(feature = "std")]
+/// The trajectory driver over any one-step map: `steps` steps of size `h`, halving a failed
+/// step when [`StepOptions::max_halvings`] allows, locating a domain crossing when
+/// [`StepOptions::locate_crossing`] is set.
+///
+/// # Errors
+/// As [`trajectory`].
+pub fn drive<const S: usize>(
+    mut one: impl OneStep<S>,
+    z0: &SVector<f64, S>,
+    h: f64,
+    steps: usize,
+    options: &StepOptions,
+) -> Result<Trajectory<S>, Interrupted<S>> {
     let mut trajectory = Trajectory {
         h,
         states: Vec::with_capacity(steps + 1),
@@ -291,7 +326,7 @@ where
     trajectory.states.push(*z0);
     let mut z = *z0;
     for i in 0..steps {
-        match step_with_halving(system, &z, h, options) {
+        match step_with_halving(&mut one, &z, h, options) {
             Ok((next, report)) => {
                 z = next;
                 trajectory.states.push(z);
@@ -300,7 +335,7 @@ where
             Err(error) => {
                 let crossing_time = match error {
                     Error::Domain(_) if options.locate_crossing => {
-                        Some(i as f64 * h + locate_crossing(system, &z, h, options))
+                        Some(i as f64 * h + locate_crossing_with(&mut one, &z, h, options))
                     }
                     _ => None,
                 };
@@ -319,16 +354,13 @@ where
 #[cfg(feature = "std")]
 /// One step of size `h`, retried as `2^m` substeps (m = 1..=`max_halvings`) when Newton
 /// fails; domain violations and invalid arguments are not retried.
-fn step_with_halving<Sys, const S: usize, const M: usize>(
-    system: &Sys,
+fn step_with_halving<const S: usize>(
+    one: &mut impl OneStep<S>,
     z0: &SVector<f64, S>,
     h: f64,
     options: &StepOptions,
-) -> Result<(SVector<f64, S>, StepReport), Error>
-where
-    Sys: LiftedSystem<S, M> + ?Sized,
-{
-    let mut error = match step(system, z0, h, options) {
+) -> Result<(SVector<f64, S>, StepReport), Error> {
+    let mut error = match one(z0, h, options) {
         Ok(done) => return Ok(done),
         Err(e) => e,
     };
@@ -345,7 +377,7 @@ where
         };
         let mut failed = None;
         for _ in 0..pieces {
-            match step(system, &z, sub, options) {
+            match one(&z, sub, options) {
                 Ok((next, r)) => {
                     z = next;
                     report.iterations += r.iterations;
@@ -376,11 +408,26 @@ pub fn locate_crossing<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
+    locate_crossing_with(
+        &mut |z: &SVector<f64, S>, h, o: &StepOptions| step(system, z, h, o),
+        z,
+        h,
+        options,
+    )
+}
+
+/// [`locate_crossing`] for any one-step map.
+fn locate_crossing_with<const S: usize>(
+    one: &mut impl OneStep<S>,
+    z: &SVector<f64, S>,
+    h: f64,
+    options: &StepOptions,
+) -> f64 {
     let options = options.with_domain_check(true);
     let (mut inside, mut outside) = (0.0, h);
     while (outside - inside).abs() > 1e-12 * h.abs() {
         let mid = 0.5 * (inside + outside);
-        if step(system, z, mid, &options).is_ok() {
+        if one(z, mid, &options).is_ok() {
             inside = mid;
         } else {
             outside = mid;
