@@ -35,7 +35,8 @@ fn temp(id: Id) -> TokenStream {
     quote!(#ident)
 }
 
-fn constant(value: f64) -> TokenStream {
+/// A constant as tokens: a suffixed literal, or the `f64` constant for NaN and infinities.
+pub(crate) fn constant(value: f64) -> TokenStream {
     if value.is_nan() {
         quote!(::core::f64::NAN)
     } else if value.is_infinite() {

@@ -61,8 +61,9 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
                 sig.order
             ),
             Degenerate::Singular => format!(
-                "d2L/d{top}2 is a singular constant matrix: the Legendre map is singular; every \
-                 component of `{top}` must enter L quadratically"
+                "d2L/d{top}2 is a singular constant matrix (or has a non-finite entry): the \
+                 Legendre map is singular; every component of `{top}` must enter L \
+                 quadratically with finite weights"
             ),
         };
         syn::Error::new(top.span(), msg)
@@ -399,7 +400,7 @@ fn generate(
             Some(a_inv) => {
                 let rows = (0..n).map(|r| {
                     let terms = (0..n).filter(|c| a_inv[r * n + c] != 0.0).map(|c| {
-                        let v = Literal::f64_suffixed(a_inv[r * n + c]);
+                        let v = crate::codegen::constant(a_inv[r * n + c]);
                         let c = index(c);
                         quote!(+ #v * __rhs[#c])
                     });

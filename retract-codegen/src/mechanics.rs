@@ -146,8 +146,11 @@ fn legendre_inverse(
     }))
 }
 
-/// Gauss-Jordan inverse with partial pivoting; `None` if singular.
+/// Gauss-Jordan inverse with partial pivoting; `None` if singular or not finite.
 fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    if a.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
     let mut m = a.to_vec();
     let mut inv: Vec<f64> = (0..n * n)
         .map(|r| if r / n == r % n { 1.0 } else { 0.0 })
@@ -178,7 +181,7 @@ fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
             }
         }
     }
-    Some(inv)
+    inv.iter().all(|v| v.is_finite()).then_some(inv)
 }
 
 /// The evaluation point of a step: x_theta = (1 - theta) x_0 + theta x_1 and

@@ -173,6 +173,22 @@ fn valid_inputs_expand() {
     }
 }
 
+#[test]
+fn non_finite_constants_never_panic() {
+    // found by `mutated_lagrangians`: an infinite weight on |q''|^2 made the compile-time
+    // Legendre inverse NaN, whose literal panicked
+    let j = "q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]";
+    for body in [
+        "1e400 * (ddq[0].powi(2) + ddq[1].powi(2))",
+        "(0.0 * 1e400) * ddq[0].powi(2) + ddq[1].powi(2)",
+        "ddq[0].powi(2) + ddq[1].powi(2) + 1e400 * q[0]",
+        "ddq[0].powi(2) + ddq[1].powi(2) + (-1.0f64).sqrt() * q[0] + 1e-400 / 0.0",
+        "(1e300 * 1e300) * ddq[0] * ddq[0] + ddq[1].powi(2)",
+    ] {
+        assert!(expands("order = 2", &format!("fn l({j}) -> f64 {{ {body} }}")).is_some());
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(400))]
 
