@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::models::{PaisUhlenbeck, RigidBody};
+use common::models::{RigidBody, bounded_pais_uhlenbeck};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{
@@ -169,14 +169,7 @@ fn order_four_with_a_tiny_step() {
 fn angular_momentum_over_a_million_steps() {
     // L is invariant under rotations of the plane, so J = q x p_0 + q' x p_1 is conserved;
     // the midpoint rule preserves quadratic invariants.
-    let system = PaisUhlenbeck {
-        w1: 1.0,
-        w2: 2f64.sqrt(),
-        eps: -0.05,
-    };
-    let z0 = system.legendre(&SVector::from_column_slice(&[
-        0.3, 0.0, 0.0, 0.25, -0.1, 0.05, 0.0, 0.1,
-    ]));
+    let (system, z0) = bounded_pais_uhlenbeck();
     let momentum = |z: &SVector<f64, 8>| {
         let cross = |a: usize, b: usize| z[a] * z[b + 1] - z[a + 1] * z[b];
         cross(0, 4) + cross(2, 6)

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::models::{PaisUhlenbeck, RigidBody};
+use common::models::{PaisUhlenbeck, RigidBody, bounded_pais_uhlenbeck};
 use retract::diagnostics::{component_drift, rk4_step, symplecticity_error};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
@@ -104,15 +104,7 @@ fn energy_trend(
 
 #[test]
 fn energy_error_is_bounded_while_rk4_drifts() {
-    // eps = -0.05 with these data stays bounded (max |q| about 0.79); eps = +0.05 does not.
-    let system = PaisUhlenbeck {
-        w1: 1.0,
-        w2: 2f64.sqrt(),
-        eps: -0.05,
-    };
-    let z0 = system.legendre(&SVector::from_column_slice(&[
-        0.3, 0.0, 0.0, 0.25, -0.1, 0.05, 0.0, 0.1,
-    ]));
+    let (system, z0) = bounded_pais_uhlenbeck();
     let (h, n) = (0.1, 100_000);
     let options = StepOptions::default();
     let (first, last) = energy_trend(&system, z0, n, |z| step(&system, z, h, &options).unwrap().0);

@@ -102,27 +102,7 @@ pub fn plane(
             RGBColor(200, 200, 200).filled(),
         )))?;
     }
-    for (i, c) in curves.iter().enumerate() {
-        let color = COLORS[i % COLORS.len()];
-        chart
-            .draw_series(LineSeries::new(
-                c.points.iter().copied(),
-                color.stroke_width(2),
-            ))?
-            .label(c.label.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
-        if let (Some(&first), Some(&last)) = (c.points.first(), c.points.last()) {
-            chart.draw_series(std::iter::once(Circle::new(first, 5, color.filled())))?;
-            chart.draw_series(std::iter::once(Cross::new(last, 6, color.stroke_width(2))))?;
-        }
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_curves(&mut chart, curves, Markers::Ends)?;
     root.present()?;
     Ok(())
 }
@@ -154,7 +134,7 @@ pub fn panels(
                 .x_desc(x_label)
                 .y_desc(*y_label)
                 .draw()?;
-            draw_curves(&mut chart, curves, true)?;
+            draw_curves(&mut chart, curves, Markers::Points)?;
         } else {
             let mut chart = chart.build_cartesian_2d(padded(x0, x1), padded(y0, y1))?;
             chart
@@ -162,17 +142,27 @@ pub fn panels(
                 .x_desc(x_label)
                 .y_desc(*y_label)
                 .draw()?;
-            draw_curves(&mut chart, curves, false)?;
+            draw_curves(&mut chart, curves, Markers::None)?;
         }
     }
     root.present()?;
     Ok(())
 }
 
+/// Which points of a curve get a marker.
+#[derive(Clone, Copy)]
+enum Markers {
+    None,
+    /// every point (sweeps)
+    Points,
+    /// start (circle) and end (cross)
+    Ends,
+}
+
 fn draw_curves<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     curves: &[Curve],
-    markers: bool,
+    markers: Markers,
 ) -> Result<(), Box<dyn Error>>
 where
     DB: DrawingBackend + 'a,
@@ -190,8 +180,21 @@ where
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
             });
-        if markers {
-            chart.draw_series(c.points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+        match markers {
+            Markers::None => {}
+            Markers::Points => {
+                chart.draw_series(c.points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+            }
+            Markers::Ends => {
+                if let (Some(&first), Some(&last)) = (c.points.first(), c.points.last()) {
+                    chart.draw_series(std::iter::once(Circle::new(first, 5, color.filled())))?;
+                    chart.draw_series(std::iter::once(Cross::new(
+                        last,
+                        6,
+                        color.stroke_width(2),
+                    )))?;
+                }
+            }
         }
     }
     chart

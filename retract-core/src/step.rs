@@ -138,6 +138,20 @@ where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     options.validate(h)?;
+    solve_validated(system, z0, guess, h, options)
+}
+
+/// [`solve_step`] for options already checked (the step paths validate once per step).
+fn solve_validated<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    guess: SVector<f64, M>,
+    h: f64,
+    options: &StepOptions,
+) -> Result<(SVector<f64, M>, StepReport), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
     let problem = StepProblem {
         system,
         z0,
@@ -176,7 +190,7 @@ where
 {
     options.validate(h)?;
     let guess = system.predictor(z0, h, options.theta)?;
-    let (w, report) = solve_step(system, z0, guess, h, options)?;
+    let (w, report) = solve_validated(system, z0, guess, h, options)?;
     Ok((system.state(&w), report))
 }
 

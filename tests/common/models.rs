@@ -30,3 +30,18 @@ pub fn pais_uhlenbeck(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], w1: f64, w2: f64
         + 0.5 * w1 * w1 * w2 * w2 * r2
         + eps * r2 * r2
 }
+
+/// The bounded nonlinear Pais-Uhlenbeck case used in the long-run tests: w1 = 1, w2 = sqrt 2,
+/// eps = -0.05 and the jet (0.3, 0), (0, 0.25), (-0.1, 0.05), (0, 0.1), whose motion stays
+/// bounded (max |q| about 0.79; eps = +0.05 is not).
+pub fn bounded_pais_uhlenbeck() -> (PaisUhlenbeck, retract::nalgebra::SVector<f64, 8>) {
+    use retract::LiftedSystem;
+    let system = PaisUhlenbeck {
+        w1: 1.0,
+        w2: 2f64.sqrt(),
+        eps: -0.05,
+    };
+    let jet = [0.3, 0.0, 0.0, 0.25, -0.1, 0.05, 0.0, 0.1];
+    let z0 = system.legendre(&retract::nalgebra::SVector::from_column_slice(&jet));
+    (system, z0)
+}
