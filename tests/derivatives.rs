@@ -374,7 +374,7 @@ fn reduced_agrees<Sys, const S: usize, const M: usize, const R: usize>(
     Sys: retract::ReducedScheme<S, M, R>,
 {
     let mut reduced = retract::ReducedStepper::new(sys);
-    for theta in [0.5, 0.3, 1.0] {
+    for theta in [0.5, 0.3, 1.0, 0.0] {
         let options = retract::StepOptions::default().with_theta(theta);
         let mut z = sys.legendre(&SVector::<f64, S>::from_column_slice(&jet[..S]));
         for i in 0..40 {

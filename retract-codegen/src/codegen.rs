@@ -146,15 +146,37 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     let inline: Vec<bool> = (0..len)
         .map(|i| top[i] && uses[i] == 1 && !pinned[i] && !is_leaf(g.node(Id(i as u32))))
         .collect();
+    // a denominator shared by several function-level divisions is inverted once:
+    // `let __rN = 1.0 / b;` and each `a / b` becomes `a * __rN`
+    let mut denominators = vec![0usize; len];
+    for i in 0..len {
+        if let Node::Div(_, b) = g.node(Id(i as u32))
+            && top[i]
+        {
+            denominators[b.0 as usize] += 1;
+        }
+    }
+    let reciprocal: Vec<bool> = denominators.iter().map(|&n| n >= 2).collect();
     let emitter = Emitter {
         g,
         leaves,
         inline: &inline,
+        reciprocal: &reciprocal,
     };
     let reference = |id: Id| emitter.reference(id, false);
     let value = |id: Id| emitter.value(id, false);
 
     let mut stmts = TokenStream::new();
+    let bind_reciprocal = |stmts: &mut TokenStream, id: Id| {
+        let (r, b) = (reciprocal_name(id), reference(id));
+        stmts.extend(quote!(let #r: f64 = 1.0 / #b;));
+    };
+    for i in 0..len {
+        let id = Id(i as u32);
+        if reciprocal[i] && is_leaf(g.node(id)) {
+            bind_reciprocal(&mut stmts, id);
+        }
+    }
     for i in 0..len {
         let id = Id(i as u32);
         let node = g.node(id);
@@ -187,6 +209,9 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
             let v = value(id);
             stmts.extend(quote!(let #t: f64 = #v;));
         }
+        if reciprocal[i] {
+            bind_reciprocal(&mut stmts, id);
+        }
     }
     Emitted {
         stmts,
@@ -194,11 +219,19 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     }
 }
 
+/// The temporary holding `1.0 / node`.
+fn reciprocal_name(id: Id) -> TokenStream {
+    let ident = format_ident!("__r{}", id.0);
+    quote!(#ident)
+}
+
 /// Expression tokens of nodes, with single-use nodes inlined.
 struct Emitter<'a> {
     g: &'a Graph,
     leaves: &'a dyn Leaves,
     inline: &'a [bool],
+    /// Denominators bound once as a reciprocal (function level only).
+    reciprocal: &'a [bool],
 }
 
 impl Emitter<'_> {
@@ -236,6 +269,10 @@ impl Emitter<'_> {
             }
             Node::Mul(a, b) => {
                 let (a, b) = (r(a), r(b));
+                quote!(#a * #b)
+            }
+            Node::Div(a, b) if !in_loop && self.reciprocal[b.0 as usize] => {
+                let (a, b) = (r(a), reciprocal_name(b));
                 quote!(#a * #b)
             }
             Node::Div(a, b) => {

@@ -2,7 +2,7 @@
 //! compiler's proc-macro bridge.
 
 use proc_macro2::{Literal, TokenStream};
-use quote::{ToTokens, quote};
+use quote::{ToTokens, format_ident, quote};
 use syn::ItemFn;
 
 use crate::codegen::{Leaves, emit};
@@ -89,6 +89,20 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
         &guards,
         reduced.as_ref(),
     ))
+}
+
+/// `t_0 +- t_1 +- ...` for terms `(negative, t)`; `0.0` for none.
+fn signed_sum(terms: &[(bool, TokenStream)]) -> TokenStream {
+    let mut out = TokenStream::new();
+    for (i, (negative, term)) in terms.iter().enumerate() {
+        out.extend(match (i, negative) {
+            (0, false) => quote!(#term),
+            (0, true) => quote!(-#term),
+            (_, false) => quote!(+ #term),
+            (_, true) => quote!(- #term),
+        });
+    }
+    if terms.is_empty() { quote!(0.0) } else { out }
 }
 
 /// `check_domain`: each guard at the three points of a step, one loop per slice guard.
@@ -526,24 +540,123 @@ fn generate(
         let r = red.core.len();
         let r_lit = index(r);
         let core_list = red.core.iter().map(|&c| index(c));
-        let affine = emit(g, &red.affine, &scheme);
-        let c_stmts = affine.stmts;
-        let c_sets = red
-            .affine
+        let forced_list = red.rows.iter().map(|&q| index(q));
+        let (a_stmts, a_sets) = matrix_sets(&red.linear, m);
+        let (b_stmts, b_sets) = matrix_sets(&red.initial, s);
+        // structural nonzeros of K = theta E A^{-1}, G = (1 - theta) E - K B, T = -A^{-1} B
+        let k_pattern: Vec<Vec<bool>> = red
+            .core
             .iter()
-            .enumerate()
-            .filter(|(_, id)| !g.is_const(**id, 0.0))
-            .map(|(e, _)| {
-                let v = &affine.exprs[e];
-                let e = index(e);
-                quote!(__out[#e] = #v;)
-            });
-        let (cj_stmts, cj_sets) = matrix_sets(&red.affine_jacobian, r);
+            .map(|&c| red.inverse_pattern[c].clone())
+            .collect();
+        let mut g_pattern = mechanics::product_pattern(&k_pattern, &red.initial_pattern);
+        for (row, &c) in g_pattern.iter_mut().zip(&red.core) {
+            row[c] = true;
+        }
+        let t_pattern = mechanics::product_pattern(&red.inverse_pattern, &red.initial_pattern);
+        // sum of factor[(row, c)] * value(c) over the pattern of one row
+        let dot = |factor: TokenStream, row: usize, cols: &[(usize, TokenStream)]| {
+            let terms: Vec<(bool, TokenStream)> = cols
+                .iter()
+                .map(|(c, value)| {
+                    let (r, c) = (index(row), index(*c));
+                    (false, quote!(#factor[(#r, #c)] * #value))
+                })
+                .collect();
+            signed_sum(&terms)
+        };
+        let z0_entry = |c: usize| {
+            let c = index(c);
+            quote!(z0[#c])
+        };
+        let offset_sets = g_pattern.iter().enumerate().map(|(row, pattern)| {
+            let cols: Vec<(usize, TokenStream)> = (0..s)
+                .filter(|&c| pattern[c])
+                .map(|c| (c, z0_entry(c)))
+                .collect();
+            dot(quote!(factors.g), row, &cols)
+        });
+
+        // n_q(y) as __n<q>, and dn_q/dy
+        let n_name = |q: usize| format_ident!("__n{}", q);
+        let forces = emit(g, &red.nonlinear, &scheme);
+        let force_stmts = &forces.stmts;
+        let force_lets: Vec<TokenStream> = red
+            .rows
+            .iter()
+            .zip(&forces.exprs)
+            .map(|(&q, e)| {
+                let name = n_name(q);
+                quote!(let #name: f64 = #e;)
+            })
+            .collect();
+        let mut roots = red.nonlinear.clone();
+        roots.extend(&red.nonlinear_jacobian);
+        let with_jacobian = emit(g, &roots, &scheme);
+        let wj_stmts = &with_jacobian.stmts;
+        let wj_lets = red.rows.iter().zip(&with_jacobian.exprs).map(|(&q, e)| {
+            let name = n_name(q);
+            quote!(let #name: f64 = #e;)
+        });
+        let dn = |q_pos: usize, l: usize| {
+            let id = red.nonlinear_jacobian[q_pos * r + l];
+            (!g.is_const(id, 0.0))
+                .then(|| with_jacobian.exprs[red.rows.len() + q_pos * r + l].clone())
+        };
+        let mut residual_entries = Vec::new();
+        let mut jacobian_entries = vec![Vec::new(); r];
+        for (mi, pattern) in k_pattern.iter().enumerate() {
+            let cols: Vec<(usize, TokenStream)> = red
+                .rows
+                .iter()
+                .filter(|&&q| pattern[q])
+                .map(|&q| {
+                    let name = n_name(q);
+                    (q, quote!(#name))
+                })
+                .collect();
+            let sum = dot(quote!(factors.k), mi, &cols);
+            let mi_lit = index(mi);
+            residual_entries.push(quote!(y[#mi_lit] - offset[#mi_lit] + #sum));
+            for (l, column) in jacobian_entries.iter_mut().enumerate() {
+                let cols: Vec<(usize, TokenStream)> = red
+                    .rows
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &q)| pattern[q])
+                    .filter_map(|(pos, &q)| dn(pos, l).map(|e| (q, quote!((#e)))))
+                    .collect();
+                let sum = dot(quote!(factors.k), mi, &cols);
+                let one = if l == mi { quote!(1.0 + ) } else { quote!() };
+                column.push(quote!(#one #sum));
+            }
+        }
+        let recover_sets = (0..m).map(|row| {
+            let mut terms: Vec<(bool, TokenStream)> = (0..s)
+                .filter(|&c| t_pattern[row][c])
+                .map(|c| {
+                    let (rl, cl, z) = (index(row), index(c), z0_entry(c));
+                    (false, quote!(factors.t[(#rl, #cl)] * #z))
+                })
+                .collect();
+            terms.extend(
+                red.rows
+                    .iter()
+                    .filter(|&&q| red.inverse_pattern[row][q])
+                    .map(|&q| {
+                        let (rl, ql, name) = (index(row), index(q), n_name(q));
+                        (true, quote!(factors.a_inv[(#rl, #ql)] * #name))
+                    }),
+            );
+            signed_sum(&terms)
+        });
         let vec_r = quote!(#na::SVector<f64, #r_lit>);
+        let factors_ty = quote!(#core::ReducedFactors<#s_lit, #m_lit, #r_lit>);
         let doc = format!(
             "The reduced step: the Hessian of L depends only on the jet components {:?} (flat \
-             indices j n + i), so Newton runs on {r} unknowns instead of {m}.",
-            red.core
+             indices j n + i), so Newton runs on {r} unknowns instead of {m}; forces act in rows \
+             {:?} of the residual.",
+            red.core, red.rows
         );
         quote! {
             #[doc = #doc]
@@ -551,29 +664,65 @@ fn generate(
             #allow
             impl #generics #core::ReducedScheme<#s_lit, #m_lit, #r_lit> for #ty_full {
                 const CORE: [usize; #r_lit] = [#(#core_list),*];
+                const FORCED: &'static [usize] = &[#(#forced_list),*];
 
-                /// c(z0, y) = F(z0, w) - A w.
-                fn affine_part(&self, z0: &#vec_s, y: &#vec_r, h: f64, theta: f64) -> #vec_m {
+                /// A = dF/dw at fixed y.
+                fn linear_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #m_lit> {
                     #float
-                    #c_stmts
-                    let mut __out = #vec_m_path::zeros();
-                    #(#c_sets)*
+                    #a_stmts
+                    let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
+                    #(#a_sets)*
                     __out
                 }
 
-                /// dc/dy.
-                fn affine_jacobian(
+                /// B = dF/dz0 at fixed y.
+                fn initial_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #s_lit> {
+                    #float
+                    #b_stmts
+                    let mut __out = #na::SMatrix::<f64, #m_lit, #s_lit>::zeros();
+                    #(#b_sets)*
+                    __out
+                }
+
+                /// G z0 over the structural nonzeros of G.
+                #[inline]
+                fn core_offset(&self, factors: &#factors_ty, z0: &#vec_s) -> #vec_r {
+                    #na::SVector::<f64, #r_lit>::from([#(#offset_sets),*])
+                }
+
+                /// r(y) = y - offset + K n(y) and I + K dn/dy over the structural nonzeros.
+                #[inline]
+                fn core_system(
                     &self,
+                    factors: &#factors_ty,
+                    offset: &#vec_r,
+                    y: &#vec_r,
+                    h: f64,
+                    theta: f64,
+                ) -> (#vec_r, #na::SMatrix<f64, #r_lit, #r_lit>) {
+                    #float
+                    #wj_stmts
+                    #(#wj_lets)*
+                    (
+                        #na::SVector::<f64, #r_lit>::from([#(#residual_entries),*]),
+                        #na::SMatrix::<f64, #r_lit, #r_lit>::from([#([#(#jacobian_entries),*]),*]),
+                    )
+                }
+
+                /// w = T z0 - A^{-1} n(y) over the structural nonzeros.
+                #[inline]
+                fn recover(
+                    &self,
+                    factors: &#factors_ty,
                     z0: &#vec_s,
                     y: &#vec_r,
                     h: f64,
                     theta: f64,
-                ) -> #na::SMatrix<f64, #m_lit, #r_lit> {
+                ) -> #vec_m {
                     #float
-                    #cj_stmts
-                    let mut __out = #na::SMatrix::<f64, #m_lit, #r_lit>::zeros();
-                    #(#cj_sets)*
-                    __out
+                    #force_stmts
+                    #(#force_lets)*
+                    #vec_m_path::from([#(#recover_sets),*])
                 }
             }
         }

@@ -304,16 +304,26 @@ fn scheme(
     (f, jacobian, jacobian_initial)
 }
 
-/// The reduced step: F(w) = A w + c(z0, y), with y the values at the evaluation point of the
-/// jet components on which the Hessian of L depends (the nonlinear core) and A depending on
-/// h, theta and parameters only.
+/// The reduced step: F(z0, w) = A w + B z0 + n(y), with y the values at the evaluation point
+/// of the jet components on which the Hessian of L depends (the nonlinear core) and A, B
+/// depending on h, theta and parameters only.
 pub struct Reduced {
     /// Jet index j * n + i (j < k) of each core variable.
     pub core: Vec<usize>,
-    /// c(z0, y), M entries.
-    pub affine: Vec<Id>,
-    /// dc/dy, row-major M x R.
-    pub affine_jacobian: Vec<Id>,
+    /// A = dF/dw at fixed y, row-major M x M.
+    pub linear: Vec<Id>,
+    /// B = dF/dz0 at fixed y, row-major M x S.
+    pub initial: Vec<Id>,
+    /// The rows q of F where n(y) is not identically zero, ascending.
+    pub rows: Vec<usize>,
+    /// n_q(y) for each q in `rows`.
+    pub nonlinear: Vec<Id>,
+    /// dn_q/dy, row-major |rows| x R.
+    pub nonlinear_jacobian: Vec<Id>,
+    /// Structural nonzeros of A^{-1}, M x M (a superset: entries in one irreducible block).
+    pub inverse_pattern: Vec<Vec<bool>>,
+    /// Structural nonzeros of B, M x S.
+    pub initial_pattern: Vec<Vec<bool>>,
 }
 
 /// The reduced step of L, if its Hessian depends on some jet components but on no component
@@ -347,33 +357,104 @@ pub fn reduce(
     let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
     let mut d = Differentiator::default();
     let mut linear = Vec::with_capacity(m * m);
+    let mut initial = Vec::with_capacity(m * s);
     for &row in &f {
         for c in 0..m {
             linear.push(d.diff(g, row, Var::W(c as u16)));
         }
-    }
-    // A must not depend on w or on the core (else the split is not affine)
-    let on_state = |v: &Var| matches!(v, Var::W(_) | Var::Core(_) | Var::Z0(_));
-    if linear.iter().any(|&e| depends_on(g, e, &on_state)) {
-        return None;
-    }
-    let zero_w = |g: &mut Graph, v: Var| matches!(v, Var::W(_)).then(|| g.constant(0.0));
-    let mut memo = HashMap::new();
-    let affine: Vec<Id> = f
-        .iter()
-        .map(|&e| substitute(g, e, &zero_w, &mut memo))
-        .collect();
-    let mut affine_jacobian = Vec::with_capacity(m * core.len());
-    for &row in &affine {
-        for c in 0..core.len() {
-            affine_jacobian.push(d.diff(g, row, Var::Core(c as u16)));
+        for c in 0..s {
+            initial.push(d.diff(g, row, Var::Z0(c as u16)));
         }
     }
+    // A and B must not depend on the state or the core (else the split is not affine)
+    let on_state = |v: &Var| matches!(v, Var::W(_) | Var::Core(_) | Var::Z0(_));
+    if linear
+        .iter()
+        .chain(&initial)
+        .any(|&e| depends_on(g, e, &on_state))
+    {
+        return None;
+    }
+    // n(y) = F at w = 0, z0 = 0
+    let zero_state =
+        |g: &mut Graph, v: Var| matches!(v, Var::W(_) | Var::Z0(_)).then(|| g.constant(0.0));
+    let mut memo = HashMap::new();
+    let mut rows = Vec::new();
+    let mut nonlinear = Vec::new();
+    for (q, &e) in f.iter().enumerate() {
+        let value = substitute(g, e, &zero_state, &mut memo);
+        if !g.is_const(value, 0.0) {
+            rows.push(q);
+            nonlinear.push(value);
+        }
+    }
+    let mut nonlinear_jacobian = Vec::with_capacity(rows.len() * core.len());
+    for &e in &nonlinear {
+        for c in 0..core.len() {
+            nonlinear_jacobian.push(d.diff(g, e, Var::Core(c as u16)));
+        }
+    }
+    let pattern = |entries: &[Id], cols: usize| -> Vec<Vec<bool>> {
+        entries
+            .chunks(cols)
+            .map(|row| row.iter().map(|&e| !g.is_const(e, 0.0)).collect())
+            .collect()
+    };
+    let inverse_pattern = inverse_pattern(&pattern(&linear, m));
+    let initial_pattern = pattern(&initial, s);
     Some(Reduced {
         core,
-        affine,
-        affine_jacobian,
+        linear,
+        initial,
+        rows,
+        nonlinear,
+        nonlinear_jacobian,
+        inverse_pattern,
+        initial_pattern,
     })
+}
+
+/// A superset of the nonzeros of A^{-1} from those of a square A: entry (c, r) can be nonzero
+/// only if column c and row r of A are connected through nonzeros of A (one block of its
+/// block-diagonal form).
+pub fn inverse_pattern(a: &[Vec<bool>]) -> Vec<Vec<bool>> {
+    let m = a.len();
+    // union-find over rows 0..m and columns m..2m
+    let mut parent: Vec<usize> = (0..2 * m).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for (r, row) in a.iter().enumerate() {
+        for (c, &nonzero) in row.iter().enumerate() {
+            if nonzero {
+                let (x, y) = (find(&mut parent, r), find(&mut parent, m + c));
+                parent[x] = y;
+            }
+        }
+    }
+    (0..m)
+        .map(|c| {
+            (0..m)
+                .map(|r| find(&mut parent, m + c) == find(&mut parent, r))
+                .collect()
+        })
+        .collect()
+}
+
+/// The nonzeros of the product of two patterns.
+pub fn product_pattern(a: &[Vec<bool>], b: &[Vec<bool>]) -> Vec<Vec<bool>> {
+    let cols = b.first().map_or(0, Vec::len);
+    a.iter()
+        .map(|row| {
+            (0..cols)
+                .map(|c| row.iter().zip(b).any(|(&x, brow)| x && brow[c]))
+                .collect()
+        })
+        .collect()
 }
 
 /// Whether a variable matching `target` is reachable from `id` (through sums too).
@@ -420,4 +501,34 @@ pub fn at_step_points(g: &mut Graph, node: Id, n: usize, k: usize) -> [Id; 3] {
         }
     };
     [0, 1, 2].map(|which| substitute(g, node, &point(which), &mut HashMap::new()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pattern(rows: &[&str]) -> Vec<Vec<bool>> {
+        rows.iter()
+            .map(|r| r.chars().map(|c| c == 'x').collect())
+            .collect()
+    }
+
+    #[test]
+    fn inverse_pattern_is_the_blocks_of_a_permuted_block_diagonal_matrix() {
+        // rows {0, 2} x columns {1, 2} and row 1 x column 0 are the two blocks
+        let a = pattern(&[".xx", "x..", ".x."]);
+        let inv = inverse_pattern(&a);
+        // A^{-1}[c][r] may be nonzero only within a block
+        assert_eq!(inv, pattern(&[".x.", "x.x", "x.x"]));
+        // a triangular matrix has a full (lower) inverse: one block, all entries
+        let lower = pattern(&["x..", "xx.", ".xx"]);
+        assert!(inverse_pattern(&lower).iter().flatten().all(|&v| v));
+    }
+
+    #[test]
+    fn product_pattern_is_the_boolean_product() {
+        let a = pattern(&["x.", ".x", "xx"]);
+        let b = pattern(&["x..", "..x"]);
+        assert_eq!(product_pattern(&a, &b), pattern(&["x..", "..x", "x.x"]));
+    }
 }

@@ -8,17 +8,38 @@ use nalgebra::SMatrix;
 /// Solves $A X = B$ in place (`b` becomes $X$) by Gaussian elimination with partial
 /// pivoting. Returns `false`, leaving `b` unspecified, if a pivot is zero or the result is
 /// not finite.
+///
+/// Column-oriented (the storage is column-major): each update runs down a contiguous column,
+/// and columns of $A$ or $B$ with a zero multiplier are skipped, so block-sparse systems
+/// cost less.
 pub fn solve_in_place<const M: usize, const C: usize>(
-    mut a: SMatrix<f64, M, M>,
+    a: SMatrix<f64, M, M>,
     b: &mut SMatrix<f64, M, C>,
 ) -> bool {
+    solve_columns(a, b.as_mut_slice(), &mut [])
+}
+
+/// Solves $A X = B$ and $A Y = D$ in place with one factorisation, as [`solve_in_place`].
+pub fn solve_pair_in_place<const M: usize, const C: usize, const E: usize>(
+    a: SMatrix<f64, M, M>,
+    b: &mut SMatrix<f64, M, C>,
+    d: &mut SMatrix<f64, M, E>,
+) -> bool {
+    solve_columns(a, b.as_mut_slice(), d.as_mut_slice())
+}
+
+/// [`solve_in_place`] on right-hand sides given as column-major slices (columns of length
+/// `M`) in two parts.
+fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &mut [f64]) -> bool {
+    // column-major storage: entry (r, c) at c * M + r
+    let a = a.as_mut_slice();
     for col in 0..M {
+        let pivot_column = &a[col * M..(col + 1) * M];
         let mut pivot_row = col;
-        let mut pivot_abs = a[(col, col)].abs();
-        for row in col + 1..M {
-            let v = a[(row, col)].abs();
-            if v > pivot_abs {
-                pivot_abs = v;
+        let mut pivot_abs = pivot_column[col].abs();
+        for (row, v) in pivot_column.iter().enumerate().skip(col + 1) {
+            if v.abs() > pivot_abs {
+                pivot_abs = v.abs();
                 pivot_row = row;
             }
         }
@@ -26,34 +47,56 @@ pub fn solve_in_place<const M: usize, const C: usize>(
             return false;
         }
         if pivot_row != col {
-            a.swap_rows(pivot_row, col);
-            b.swap_rows(pivot_row, col);
+            for part in [&mut a[..], &mut *b, &mut *d] {
+                for column in part.chunks_exact_mut(M) {
+                    column.swap(pivot_row, col);
+                }
+            }
         }
-        let pivot = a[(col, col)];
-        for row in col + 1..M {
-            let factor = a[(row, col)] / pivot;
-            if factor == 0.0 {
-                continue;
+        // multipliers l = a[col+1.., col] / pivot, stored in place
+        let (left, right) = a.split_at_mut((col + 1) * M);
+        let pivot_column = &mut left[col * M..];
+        let pivot = pivot_column[col];
+        for v in &mut pivot_column[col + 1..] {
+            *v /= pivot;
+        }
+        let l = &pivot_column[col + 1..];
+        for part in [right, &mut *b, &mut *d] {
+            for column in part.chunks_exact_mut(M) {
+                eliminate(&mut column[col..], l);
             }
-            for k in col + 1..M {
-                a[(row, k)] -= factor * a[(col, k)];
-            }
-            for k in 0..C {
-                b[(row, k)] -= factor * b[(col, k)];
+        }
+    }
+    // back substitution, one column of X at a time
+    for part in [&mut *b, &mut *d] {
+        for x in part.chunks_exact_mut(M) {
+            for col in (0..M).rev() {
+                let u = &a[col * M..col * M + col + 1];
+                let v = x[col] / u[col];
+                x[col] = v;
+                if v != 0.0 {
+                    for (xi, ui) in x[..col].iter_mut().zip(u) {
+                        *xi -= ui * v;
+                    }
+                }
             }
         }
     }
-    for col in (0..M).rev() {
-        let pivot = a[(col, col)];
-        for k in 0..C {
-            let mut v = b[(col, k)];
-            for j in col + 1..M {
-                v -= a[(col, j)] * b[(j, k)];
+    b.iter().chain(d.iter()).all(|v| v.is_finite())
+}
+
+/// `column[1..] -= column[0] * l` (one elimination update below a pivot), skipped when the
+/// pivot-row entry is zero.
+#[inline]
+fn eliminate(column: &mut [f64], l: &[f64]) {
+    if let Some((head, tail)) = column.split_first_mut() {
+        let head = *head;
+        if head != 0.0 {
+            for (t, li) in tail.iter_mut().zip(l) {
+                *t -= li * head;
             }
-            b[(col, k)] = v / pivot;
         }
     }
-    b.iter().all(|v| v.is_finite())
 }
 
 /// Solves $A X = B$, or `None` when [`solve_in_place`] reports a singular matrix.

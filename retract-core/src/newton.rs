@@ -89,7 +89,32 @@ impl NewtonOptions {
     }
 
     /// Checks every option is in its domain.
+    #[inline]
     pub fn validate(&self) -> Result<(), Error> {
+        let tolerance = |v: f64| (0.0..f64::INFINITY).contains(&v);
+        if tolerance(self.residual_abs)
+            && tolerance(self.residual_rel)
+            && tolerance(self.step_abs)
+            && tolerance(self.step_rel)
+            && self.max_iterations > 0
+            && self.armijo > 0.0
+            && self.armijo < 0.5
+        {
+            return Ok(());
+        }
+        self.invalid()
+    }
+
+    /// Whether a residual of max-norm `r_norm` meets the residual test, when the first
+    /// iterate's was `r_start`.
+    #[inline]
+    pub(crate) fn converged(&self, r_norm: f64, r_start: f64) -> bool {
+        r_norm <= self.residual_abs + self.residual_rel * r_start
+    }
+
+    /// The first option out of its domain, as an error (the slow path of `validate`).
+    #[cold]
+    fn invalid(&self) -> Result<(), Error> {
         let tolerances = [
             ("residual_abs", self.residual_abs),
             ("residual_rel", self.residual_rel),
@@ -131,8 +156,17 @@ pub struct Solution<const M: usize> {
     pub residual_norm: f64,
 }
 
-fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
-    m.iter().all(|v| v.is_finite())
+/// Whether every entry is finite (over the storage slice: nalgebra's element iterator is
+/// slow for small matrices, and this runs every step).
+#[inline]
+pub(crate) fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
+    m.as_slice().iter().fold(true, |ok, v| ok & v.is_finite())
+}
+
+/// $\max_i |m_i|$ (NaN entries are skipped, as by nalgebra's `amax`).
+#[inline]
+pub(crate) fn max_abs<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
+    m.as_slice().iter().fold(0.0, |max, v| max.max(v.abs()))
 }
 
 /// Solves $F(w) = 0$ from the guess `w0` (module docs give the method).
@@ -179,10 +213,10 @@ where
             location: "residual",
         });
     }
-    let mut r_norm = r.amax();
-    let residual_tol = options.residual_abs + options.residual_rel * r_norm;
+    let mut r_norm = max_abs(&r);
+    let r_start = r_norm;
     for iteration in 1..=options.max_iterations {
-        if r_norm <= residual_tol {
+        if options.converged(r_norm, r_start) {
             return Ok(Solution {
                 w,
                 iterations: iteration - 1,
@@ -200,7 +234,7 @@ where
             Some(delta) if all_finite(&delta) => delta,
             _ => return Err(Error::SingularJacobian { iteration }),
         };
-        if delta.amax() <= options.step_abs + options.step_rel * w.amax() {
+        if max_abs(&delta) <= options.step_abs + options.step_rel * max_abs(&w) {
             w += delta;
             r = problem.residual(&w);
             if !all_finite(&r) {
@@ -212,7 +246,7 @@ where
             return Ok(Solution {
                 w,
                 iterations: iteration,
-                residual_norm: r.amax(),
+                residual_norm: max_abs(&r),
             });
         }
         let phi = r.norm_squared();
@@ -237,9 +271,9 @@ where
                 residual_norm: r_norm,
             });
         }
-        r_norm = r.amax();
+        r_norm = max_abs(&r);
     }
-    if r_norm <= residual_tol {
+    if options.converged(r_norm, r_start) {
         return Ok(Solution {
             w,
             iterations: options.max_iterations,

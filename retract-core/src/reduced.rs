@@ -4,83 +4,196 @@
 //! of a body in a barrier potential) and on no component of the top derivative, the
 //! theta-scheme residual splits as
 //!
-//! $$F(z_0, w) = A(h, \theta)\, w + c(z_0, y), \qquad y = P w + y_0(z_0),$$
+//! $$F(z_0, w) = A\, w + B\, z_0 + n(y), \qquad y = P w + (1-\theta) E z_0,$$
 //!
-//! with $y$ the core values at the evaluation point ($P$ picks $\theta x_1$, $y_0 = (1-\theta) x_0$)
-//! and $A$ independent of the state. Then $w = -A^{-1} c(z_0, y)$ and $y$ solves the small
-//! system
+//! with $y$ the core values at the evaluation point ($E$ picks the core components of a
+//! state, $P = \theta E$ those of $w$), $A = A(h, \theta)$ and $B = B(h, \theta)$ independent
+//! of the state, and $n$ nonzero only in a few rows (the forces). Then
+//! $w = -A^{-1}(B z_0 + n(y))$, and $y$ solves the small system
 //!
-//! $$r(y) = y - y_0 + K c(z_0, y) = 0, \qquad K = P A^{-1}, \qquad
-//!   \partial r/\partial y = I + K\, \partial c/\partial y,$$
+//! $$r(y) = y - G z_0 + K n(y) = 0, \qquad K = P A^{-1}, \qquad
+//!   G = (1-\theta) E - K B, \qquad \partial r/\partial y = I + K\, \partial n/\partial y,$$
 //!
-//! $R$ unknowns instead of $M$. $A^{-1}$ and $K$ depend on $(h, \theta)$ only and are cached by
-//! [`ReducedStepper`]; $A$ itself is not generated but formed from the Jacobian of the general
-//! scheme, $A = \partial F/\partial w - (\partial c/\partial y) P$, at the first state stepped
-//! with that $(h, \theta)$ (the macro has checked that it does not depend on the state). The
-//! result is the same $z_1$ as the general step, to rounding.
+//! $R$ unknowns instead of $M$. After Newton the step is
+//!
+//! $$w = T z_0 - A^{-1} n(y), \qquad T = -A^{-1} B.$$
+//!
+//! $A^{-1}$, $K$, $G$ and $T$ depend on $(h, \theta)$ and the parameters only and are cached by
+//! [`ReducedStepper`] ([`ReducedFactors`]). The macro emits $A$, $B$, $n$ and
+//! $\partial n/\partial y$, and the products with the cached factors as straight-line code
+//! over their structural nonzeros (the blocks of $A$), so a step costs about as much as one
+//! written by hand. The result is the same $z_1$ as the general step, to rounding.
+
+use core::cell::Cell;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::newton::{self, Problem};
+use crate::newton::{self, Problem, all_finite, max_abs};
 use crate::step::StepReport;
 use crate::{Error, LiftedSystem, StepOptions};
 
-/// A system whose step reduces to its nonlinear core of `R` variables.
+/// A system whose step reduces to its nonlinear core of `R` variables (emitted by the macro;
+/// see the module docs for the formulas).
 pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
     LiftedSystem<S, M>
 {
     /// Flat index $j n + i$ (into $z$ and $w$) of the jet component of each core variable.
     const CORE: [usize; R];
 
-    /// $c(z_0, y) = F(z_0, w) - A w$ with the core values $y$ at the evaluation point.
-    fn affine_part(
+    /// The rows of $F$ where $n(y)$ is not identically zero (the forced rows), ascending.
+    const FORCED: &'static [usize];
+
+    /// $A = \partial F / \partial w$ at fixed $y$.
+    fn linear_part(&self, h: f64, theta: f64) -> SMatrix<f64, M, M>;
+
+    /// $B = \partial F / \partial z_0$ at fixed $y$.
+    fn initial_part(&self, h: f64, theta: f64) -> SMatrix<f64, M, S>;
+
+    /// $G z_0$, the core values of the step without forces.
+    fn core_offset(
         &self,
+        factors: &ReducedFactors<S, M, R>,
+        z0: &SVector<f64, S>,
+    ) -> SVector<f64, R>;
+
+    /// $r(y) = y - \text{offset} + K n(y)$ and $\partial r / \partial y = I + K\,\partial n/\partial y$.
+    fn core_system(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
+        offset: &SVector<f64, R>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
+    ) -> (SVector<f64, R>, SMatrix<f64, R, R>);
+
+    /// $w = T z_0 - A^{-1} n(y)$.
+    fn recover(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
         z0: &SVector<f64, S>,
         y: &SVector<f64, R>,
         h: f64,
         theta: f64,
     ) -> SVector<f64, M>;
-
-    /// $\partial c / \partial y$.
-    fn affine_jacobian(
-        &self,
-        z0: &SVector<f64, S>,
-        y: &SVector<f64, R>,
-        h: f64,
-        theta: f64,
-    ) -> SMatrix<f64, M, R>;
 }
 
-/// Cached factors for one $(h, \theta)$.
-#[derive(Clone, Debug)]
-struct Factors<const M: usize, const R: usize> {
-    h: f64,
-    theta: f64,
-    a_inv: SMatrix<f64, M, M>,
-    k: SMatrix<f64, R, M>,
+/// The factors of the reduced step for one $(h, \theta)$ (formulas in the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReducedFactors<const S: usize, const M: usize, const R: usize> {
+    /// Step size.
+    pub h: f64,
+    /// Theta of the scheme.
+    pub theta: f64,
+    /// The columns of $A^{-1}$ at the forced rows ([`ReducedScheme::FORCED`]); the other
+    /// columns are zero (the step never multiplies them).
+    pub a_inv: SMatrix<f64, M, M>,
+    /// $K = \theta\, E A^{-1}$ (rows of $A^{-1}$ at the core components, times $\theta$), at
+    /// the forced columns as `a_inv`.
+    pub k: SMatrix<f64, R, M>,
+    /// $G = (1-\theta) E - K B = (1-\theta) E + \theta E T$.
+    pub g: SMatrix<f64, R, S>,
+    /// $T = -A^{-1} B$.
+    pub t: SMatrix<f64, M, S>,
+}
+
+impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
+    /// The factors of `system` for $(h, \theta)$.
+    ///
+    /// # Errors
+    /// [`Error::SingularJacobian`] (iteration 0) if $A$ is singular (only for degenerate
+    /// $h$ and $\theta$); [`Error::NonFinite`] if a parameter makes $A$ or $B$ non-finite.
+    pub fn new<Sys>(system: &Sys, h: f64, theta: f64) -> Result<Self, Error>
+    where
+        Sys: ReducedScheme<S, M, R> + ?Sized,
+    {
+        let a = system.linear_part(h, theta);
+        let b = system.initial_part(h, theta);
+        if !(all_finite(&a) && all_finite(&b)) {
+            return Err(Error::NonFinite {
+                iteration: 0,
+                location: "linear part of the reduced step",
+            });
+        }
+        // A [a_inv, -t] = [E_forced, B]: one factorisation, sparse right-hand sides
+        let mut a_inv = SMatrix::<f64, M, M>::zeros();
+        for &q in Sys::FORCED {
+            a_inv[(q, q)] = 1.0;
+        }
+        let mut t = b;
+        if !crate::linalg::solve_pair_in_place(a, &mut a_inv, &mut t) {
+            return Err(Error::SingularJacobian { iteration: 0 });
+        }
+        t = -t;
+        let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
+        let g = SMatrix::<f64, R, S>::from_fn(|m, c| {
+            let core = Sys::CORE[m];
+            theta * t[(core, c)] + if c == core { 1.0 - theta } else { 0.0 }
+        });
+        Ok(Self {
+            h,
+            theta,
+            a_inv,
+            k,
+            g,
+            t,
+        })
+    }
 }
 
 /// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps (a composition of
 /// order 4 or more alternates between two or three step sizes).
 const CACHED: usize = 4;
 
-/// Steps a [`ReducedScheme`] with Newton on its core; caches $A^{-1}$ for the last
+/// Steps a [`ReducedScheme`] with Newton on its core; caches [`ReducedFactors`] for the last
 /// few step sizes. No heap.
 #[derive(Clone, Debug)]
 pub struct ReducedStepper<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,
-    factors: [Option<Factors<M, R>>; CACHED],
+    factors: [Option<ReducedFactors<S, M, R>>; CACHED],
     next_slot: usize,
 }
 
-/// $r(y)$ of the module docs as a Newton problem.
+/// $r(y)$ of the module docs as a Newton problem. One call computes $r$ and its Jacobian; the
+/// last point is kept, since the solver asks for the Jacobian where it evaluated the residual.
 struct CoreProblem<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,
-    z0: &'a SVector<f64, S>,
-    y0: SVector<f64, R>,
-    k: &'a SMatrix<f64, R, M>,
-    h: f64,
-    theta: f64,
+    factors: &'a ReducedFactors<S, M, R>,
+    offset: SVector<f64, R>,
+    last: Cell<Evaluation<R>>,
+}
+
+/// $y$, $r(y)$ and $\partial r/\partial y$.
+type Evaluation<const R: usize> = (SVector<f64, R>, SVector<f64, R>, SMatrix<f64, R, R>);
+
+impl<Sys, const S: usize, const M: usize, const R: usize> CoreProblem<'_, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    fn evaluate(&self, y: &SVector<f64, R>) -> Evaluation<R> {
+        let last = self.last.get();
+        if last.0 == *y {
+            return last;
+        }
+        let f = self.factors;
+        let (r, j) = self.system.core_system(f, &self.offset, y, f.h, f.theta);
+        self.last.set((*y, r, j));
+        (*y, r, j)
+    }
+
+    /// The first guess: the fixed-point predictor $y = G z_0 - K n(G z_0)$ (exact up to
+    /// $O(|K\,\partial n/\partial y|^2)$, so most steps need no Newton iteration) if it lowers
+    /// the residual, else $G z_0$ itself (stiff forces).
+    fn predictor(&self) -> SVector<f64, R> {
+        let (_, r0, j0) = self.evaluate(&self.offset);
+        let guess = self.offset - r0;
+        let (_, r1, _) = self.evaluate(&guess);
+        if all_finite(&r1) && max_abs(&r1) < max_abs(&r0) {
+            guess
+        } else {
+            self.last.set((self.offset, r0, j0));
+            self.offset
+        }
+    }
 }
 
 impl<Sys, const S: usize, const M: usize, const R: usize> Problem<R>
@@ -89,11 +202,11 @@ where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
     fn residual(&self, y: &SVector<f64, R>) -> SVector<f64, R> {
-        y - self.y0 + self.k * self.system.affine_part(self.z0, y, self.h, self.theta)
+        self.evaluate(y).1
     }
 
     fn jacobian(&self, y: &SVector<f64, R>) -> SMatrix<f64, R, R> {
-        SMatrix::identity() + self.k * self.system.affine_jacobian(self.z0, y, self.h, self.theta)
+        self.evaluate(y).2
     }
 }
 
@@ -110,14 +223,8 @@ where
         }
     }
 
-    /// The cached factors for $(h, \theta)$, formed at `z0` with the first guess `y` if new.
-    fn factors(
-        &mut self,
-        z0: &SVector<f64, S>,
-        y: &SVector<f64, R>,
-        h: f64,
-        theta: f64,
-    ) -> Result<&Factors<M, R>, Error> {
+    /// The cached factors for $(h, \theta)$, computed if new.
+    fn factors(&mut self, h: f64, theta: f64) -> Result<&ReducedFactors<S, M, R>, Error> {
         let slot = match self
             .factors
             .iter()
@@ -125,25 +232,8 @@ where
         {
             Some(slot) => slot,
             None => {
-                // A = dF/dw - (dc/dy) P at any state: here z0 and w with w[CORE] = x_1 from y
-                let mut w = SVector::<f64, M>::zeros();
-                for (m, &c) in Sys::CORE.iter().enumerate() {
-                    if theta != 0.0 {
-                        w[c] = (y[m] - (1.0 - theta) * z0[c]) / theta;
-                    }
-                }
-                let dc = self.system.affine_jacobian(z0, y, h, theta);
-                let mut a = self.system.jacobian(z0, &w, h, theta);
-                for (m, &c) in Sys::CORE.iter().enumerate() {
-                    for r in 0..M {
-                        a[(r, c)] -= dc[(r, m)] * theta;
-                    }
-                }
-                let a_inv = crate::linalg::solve(&a, &SMatrix::<f64, M, M>::identity())
-                    .ok_or(Error::SingularJacobian { iteration: 0 })?;
-                let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
                 let slot = self.next_slot;
-                self.factors[slot] = Some(Factors { h, theta, a_inv, k });
+                self.factors[slot] = Some(ReducedFactors::new(self.system, h, theta)?);
                 self.next_slot = (slot + 1) % CACHED;
                 slot
             }
@@ -165,51 +255,55 @@ where
         options: &StepOptions,
     ) -> Result<(SVector<f64, S>, StepReport), Error> {
         options.validate(h)?;
-        if !z0.iter().all(|v| v.is_finite()) {
-            return Err(Error::NonFinite {
-                iteration: 0,
-                location: "state",
-            });
-        }
         let theta = options.theta;
         let system = self.system;
-        let y0 = SVector::<f64, R>::from_fn(|m, _| (1.0 - theta) * z0[Sys::CORE[m]]);
-        // first guess: x_theta ~ x_0 + theta h x_0' (the next jet block), x_0 for the last block
-        let n = Sys::DIMENSION;
-        let y_guess = SVector::<f64, R>::from_fn(|m, _| {
-            let c = Sys::CORE[m];
-            let rate = if c + n < S / 2 { z0[c + n] } else { 0.0 };
-            z0[c] + theta * h * rate
-        });
-        let factors = self.factors(z0, &y_guess, h, theta)?;
+        let factors = self.factors(h, theta)?;
+        let offset = system.core_offset(factors, z0);
         let problem = CoreProblem {
             system,
-            z0,
-            y0,
-            k: &factors.k,
-            h,
-            theta,
+            factors,
+            offset,
+            last: Cell::new((
+                SVector::from_element(f64::NAN),
+                SVector::zeros(),
+                SMatrix::zeros(),
+            )),
         };
-        let solution = newton::solve_validated(&problem, y_guess, &options.newton)?;
-        let c = system.affine_part(z0, &solution.w, h, theta);
-        let z1: SVector<f64, S> = -(factors.a_inv.fixed_rows::<S>(0) * c);
-        if !z1.iter().all(|v| v.is_finite()) {
-            return Err(Error::NonFinite {
-                iteration: solution.iterations,
-                location: "reduced step",
+        // a non-finite state shows as a non-finite guess or step, and is named as such below
+        let state_error = || Error::NonFinite {
+            iteration: 0,
+            location: "state",
+        };
+        let guess = problem.predictor();
+        let (_, r, _) = problem.evaluate(&guess);
+        let r_norm = max_abs(&r);
+        let solution = if all_finite(&r) && options.newton.converged(r_norm, r_norm) {
+            // the predictor already solves r(y) = 0 (Newton would return it with 0 iterations)
+            newton::Solution {
+                w: guess,
+                iterations: 0,
+                residual_norm: r_norm,
+            }
+        } else {
+            newton::solve_validated(&problem, guess, &options.newton)
+                .map_err(|e| if all_finite(z0) { e } else { state_error() })?
+        };
+        let w = system.recover(factors, z0, &solution.w, h, theta);
+        if !all_finite(&w) {
+            return Err(if all_finite(z0) {
+                Error::NonFinite {
+                    iteration: solution.iterations,
+                    location: "reduced step",
+                }
+            } else {
+                state_error()
             });
         }
         if options.check_domain {
-            // the domain check reads x_1 from w and u from its tail
-            let mut w = SVector::<f64, M>::zeros();
-            w.fixed_rows_mut::<S>(0).copy_from(&z1);
-            for r in S..M {
-                w[r] = -(0..M).map(|k| factors.a_inv[(r, k)] * c[k]).sum::<f64>();
-            }
             system.check_domain(z0, &w, theta).map_err(Error::Domain)?;
         }
         Ok((
-            z1,
+            w.fixed_rows::<S>(0).into_owned(),
             StepReport {
                 iterations: solution.iterations,
                 residual_norm: solution.residual_norm,

@@ -73,7 +73,17 @@ impl StepOptions {
         self
     }
 
+    #[inline]
     pub(crate) fn validate(&self, h: f64) -> Result<(), Error> {
+        if (0.0..=1.0).contains(&self.theta) && h.is_finite() && h != 0.0 {
+            return self.newton.validate();
+        }
+        self.invalid(h)
+    }
+
+    /// Why `theta` or `h` is invalid (the slow path of `validate`).
+    #[cold]
+    fn invalid(&self, h: f64) -> Result<(), Error> {
         if !(0.0..=1.0).contains(&self.theta) {
             return Err(Error::InvalidArgument {
                 name: "theta",
