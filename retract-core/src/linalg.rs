@@ -33,6 +33,7 @@ pub fn solve_pair_in_place<const M: usize, const C: usize, const E: usize>(
 fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &mut [f64]) -> bool {
     // column-major storage: entry (r, c) at c * M + r
     let a = a.as_mut_slice();
+    let mut inverse_pivots = [0.0; M];
     for col in 0..M {
         let pivot_column = &a[col * M..(col + 1) * M];
         let mut pivot_row = col;
@@ -53,12 +54,14 @@ fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &m
                 }
             }
         }
-        // multipliers l = a[col+1.., col] / pivot, stored in place
+        // multipliers l = a[col+1.., col] / pivot, stored in place (times the reciprocal pivot,
+        // which is kept for the back substitution)
         let (left, right) = a.split_at_mut((col + 1) * M);
         let pivot_column = &mut left[col * M..];
-        let pivot = pivot_column[col];
+        let inverse = 1.0 / pivot_column[col];
+        inverse_pivots[col] = inverse;
         for v in &mut pivot_column[col + 1..] {
-            *v /= pivot;
+            *v *= inverse;
         }
         let l = &pivot_column[col + 1..];
         for part in [right, &mut *b, &mut *d] {
@@ -70,9 +73,12 @@ fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &m
     // back substitution, one column of X at a time
     for part in [&mut *b, &mut *d] {
         for x in part.chunks_exact_mut(M) {
+            if x.iter().all(|&v| v == 0.0) {
+                continue;
+            }
             for col in (0..M).rev() {
-                let u = &a[col * M..col * M + col + 1];
-                let v = x[col] / u[col];
+                let u = &a[col * M..col * M + col];
+                let v = x[col] * inverse_pivots[col];
                 x[col] = v;
                 if v != 0.0 {
                     for (xi, ui) in x[..col].iter_mut().zip(u) {

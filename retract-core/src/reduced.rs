@@ -140,9 +140,10 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     }
 }
 
-/// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps (a composition of
-/// order 4 or more alternates between two or three step sizes).
-const CACHED: usize = 4;
+/// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps: a composition cycles
+/// through its distinct stage sizes (2 for order 4, 5 and 8 for the Kahan-Li methods of
+/// orders 6 and 8), and each miss costs a factorisation.
+const CACHED: usize = 8;
 
 /// Steps a [`ReducedScheme`] with Newton on its core; caches [`ReducedFactors`] for the last
 /// few step sizes. No heap.
