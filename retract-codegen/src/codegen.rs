@@ -149,10 +149,8 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     // a denominator shared by several function-level divisions is inverted once:
     // `let __rN = 1.0 / b;` and each `a / b` becomes `a * __rN`
     let mut denominators = vec![0usize; len];
-    for i in 0..len {
-        if let Node::Div(_, b) = g.node(Id(i as u32))
-            && top[i]
-        {
+    for (i, _) in top.iter().enumerate().filter(|(_, t)| **t) {
+        if let Node::Div(_, b) = g.node(Id(i as u32)) {
             denominators[b.0 as usize] += 1;
         }
     }
@@ -171,9 +169,9 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
         let (r, b) = (reciprocal_name(id), reference(id));
         stmts.extend(quote!(let #r: f64 = 1.0 / #b;));
     };
-    for i in 0..len {
+    for (i, _) in reciprocal.iter().enumerate().filter(|(_, r)| **r) {
         let id = Id(i as u32);
-        if reciprocal[i] && is_leaf(g.node(id)) {
+        if is_leaf(g.node(id)) {
             bind_reciprocal(&mut stmts, id);
         }
     }

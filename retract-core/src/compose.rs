@@ -23,7 +23,9 @@ use crate::{Error, LiftedSystem, StepOptions};
 /// Most stages of a supported composition (the order-8 triple jump).
 pub const MAX_STAGES: usize = 27;
 
-/// Kahan-Li s9odr6a: $\gamma_1, \dots, \gamma_5$ ($\gamma_{10-i} = \gamma_i$).
+/// Kahan-Li s9odr6a: $\gamma_1, \dots, \gamma_5$ ($\gamma_{10-i} = \gamma_i$), with the
+/// published digits.
+#[allow(clippy::excessive_precision)]
 const KAHAN_LI_6: [f64; 5] = [
     0.392_161_444_007_314_139_279_250_56,
     0.332_599_136_789_359_438_599_748_64,
@@ -32,7 +34,9 @@ const KAHAN_LI_6: [f64; 5] = [
     0.798_543_990_934_829_963_398_950_35,
 ];
 
-/// Kahan-Li s15odr8: $\gamma_1, \dots, \gamma_8$ ($\gamma_{16-i} = \gamma_i$).
+/// Kahan-Li s15odr8: $\gamma_1, \dots, \gamma_8$ ($\gamma_{16-i} = \gamma_i$), with the
+/// published digits.
+#[allow(clippy::excessive_precision)]
 const KAHAN_LI_8: [f64; 8] = [
     0.741_670_364_350_612_953_448_227_80,
     -0.409_100_825_800_031_593_997_300_10,
