@@ -541,6 +541,13 @@ fn generate(
         let r_lit = index(r);
         let core_list = red.core.iter().map(|&c| index(c));
         let forced_list = red.rows.iter().map(|&q| index(q));
+        let block_list = red.blocks.iter().map(|(rows, cols)| {
+            let (rows, cols) = (
+                rows.iter().map(|&i| index(i)),
+                cols.iter().map(|&i| index(i)),
+            );
+            quote!((&[#(#rows),*], &[#(#cols),*]))
+        });
         let (a_stmts, a_sets) = matrix_sets(&red.linear, m);
         let (b_stmts, b_sets) = matrix_sets(&red.initial, s);
         // structural nonzeros of K = theta E A^{-1}, G = (1 - theta) E - K B, T = -A^{-1} B
@@ -665,6 +672,7 @@ fn generate(
             impl #generics #core::ReducedScheme<#s_lit, #m_lit, #r_lit> for #ty_full {
                 const CORE: [usize; #r_lit] = [#(#core_list),*];
                 const FORCED: &'static [usize] = &[#(#forced_list),*];
+                const BLOCKS: &'static [(&'static [usize], &'static [usize])] = &[#(#block_list),*];
 
                 /// A = dF/dw at fixed y.
                 fn linear_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #m_lit> {

@@ -320,6 +320,8 @@ pub struct Reduced {
     pub nonlinear: Vec<Id>,
     /// dn_q/dy, row-major |rows| x R.
     pub nonlinear_jacobian: Vec<Id>,
+    /// The irreducible blocks of A: (rows, columns), ascending.
+    pub blocks: Vec<(Vec<usize>, Vec<usize>)>,
     /// Structural nonzeros of A^{-1}, M x M (a superset: entries in one irreducible block).
     pub inverse_pattern: Vec<Vec<bool>>,
     /// Structural nonzeros of B, M x S.
@@ -400,7 +402,13 @@ pub fn reduce(
             .map(|row| row.iter().map(|&e| !g.is_const(e, 0.0)).collect())
             .collect()
     };
-    let inverse_pattern = inverse_pattern(&pattern(&linear, m));
+    let linear_pattern = pattern(&linear, m);
+    let blocks = blocks(&linear_pattern);
+    // a block with more rows than columns (or fewer) makes A singular for every h
+    if blocks.iter().any(|(rows, cols)| rows.len() != cols.len()) {
+        return None;
+    }
+    let inverse_pattern = inverse_pattern(&linear_pattern);
     let initial_pattern = pattern(&initial, s);
     Some(Reduced {
         core,
@@ -409,15 +417,16 @@ pub fn reduce(
         rows,
         nonlinear,
         nonlinear_jacobian,
+        blocks,
         inverse_pattern,
         initial_pattern,
     })
 }
 
-/// A superset of the nonzeros of A^{-1} from those of a square A: entry (c, r) can be nonzero
-/// only if column c and row r of A are connected through nonzeros of A (one block of its
-/// block-diagonal form).
-pub fn inverse_pattern(a: &[Vec<bool>]) -> Vec<Vec<bool>> {
+/// The irreducible blocks of a square pattern: rows and columns (ascending) connected through
+/// nonzeros, in the order of their first row. A is block diagonal after permuting rows and
+/// columns by them.
+pub fn blocks(a: &[Vec<bool>]) -> Vec<(Vec<usize>, Vec<usize>)> {
     let m = a.len();
     // union-find over rows 0..m and columns m..2m
     let mut parent: Vec<usize> = (0..2 * m).collect();
@@ -436,13 +445,40 @@ pub fn inverse_pattern(a: &[Vec<bool>]) -> Vec<Vec<bool>> {
             }
         }
     }
-    (0..m)
-        .map(|c| {
-            (0..m)
-                .map(|r| find(&mut parent, m + c) == find(&mut parent, r))
-                .collect()
-        })
+    let mut out: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::new();
+    for node in 0..2 * m {
+        let root = find(&mut parent, node);
+        let slot = match out.iter().position(|(r, _, _)| *r == root) {
+            Some(slot) => slot,
+            None => {
+                out.push((root, Vec::new(), Vec::new()));
+                out.len() - 1
+            }
+        };
+        if node < m {
+            out[slot].1.push(node);
+        } else {
+            out[slot].2.push(node - m);
+        }
+    }
+    out.into_iter()
+        .map(|(_, rows, cols)| (rows, cols))
         .collect()
+}
+
+/// A superset of the nonzeros of A^{-1} from those of a square A: entry (c, r) can be nonzero
+/// only if column c and row r of A lie in one of its [`blocks`].
+pub fn inverse_pattern(a: &[Vec<bool>]) -> Vec<Vec<bool>> {
+    let m = a.len();
+    let mut inverse = vec![vec![false; m]; m];
+    for (rows, cols) in blocks(a) {
+        for &c in &cols {
+            for &r in &rows {
+                inverse[c][r] = true;
+            }
+        }
+    }
+    inverse
 }
 
 /// The nonzeros of the product of two patterns.
@@ -523,6 +559,10 @@ mod tests {
         // a triangular matrix has a full (lower) inverse: one block, all entries
         let lower = pattern(&["x..", "xx.", ".xx"]);
         assert!(inverse_pattern(&lower).iter().flatten().all(|&v| v));
+        assert_eq!(
+            blocks(&a),
+            vec![(vec![0, 2], vec![1, 2]), (vec![1], vec![0])]
+        );
     }
 
     #[test]

@@ -16,7 +16,7 @@ pub fn solve_in_place<const M: usize, const C: usize>(
     a: SMatrix<f64, M, M>,
     b: &mut SMatrix<f64, M, C>,
 ) -> bool {
-    solve_columns(a, b.as_mut_slice(), &mut [])
+    solve_columns(a, M, b.as_mut_slice(), &mut [])
 }
 
 /// Solves $A X = B$ and $A Y = D$ in place with one factorisation, as [`solve_in_place`].
@@ -25,17 +25,35 @@ pub fn solve_pair_in_place<const M: usize, const C: usize, const E: usize>(
     b: &mut SMatrix<f64, M, C>,
     d: &mut SMatrix<f64, M, E>,
 ) -> bool {
-    solve_columns(a, b.as_mut_slice(), d.as_mut_slice())
+    solve_leading_in_place(a, M, b, d)
 }
 
-/// [`solve_in_place`] on right-hand sides given as column-major slices (columns of length
-/// `M`) in two parts.
-fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &mut [f64]) -> bool {
+/// As [`solve_pair_in_place`] for the leading `n x n` block of `a` and the first `n` rows of
+/// `b` and `d` (`n <= M`; the other entries are not read, and rows `n..` of `b` and `d` are
+/// left as they are).
+pub fn solve_leading_in_place<const M: usize, const C: usize, const E: usize>(
+    a: SMatrix<f64, M, M>,
+    n: usize,
+    b: &mut SMatrix<f64, M, C>,
+    d: &mut SMatrix<f64, M, E>,
+) -> bool {
+    n <= M && solve_columns(a, n, b.as_mut_slice(), d.as_mut_slice())
+}
+
+/// The elimination on the leading `n x n` block (`n <= M`) with right-hand sides given as
+/// column-major slices (columns of length `M`, of which the first `n` rows are used) in two
+/// parts.
+pub(crate) fn solve_columns<const M: usize>(
+    mut a: SMatrix<f64, M, M>,
+    n: usize,
+    b: &mut [f64],
+    d: &mut [f64],
+) -> bool {
     // column-major storage: entry (r, c) at c * M + r
     let a = a.as_mut_slice();
     let mut inverse_pivots = [0.0; M];
-    for col in 0..M {
-        let pivot_column = &a[col * M..(col + 1) * M];
+    for col in 0..n {
+        let pivot_column = &a[col * M..col * M + n];
         let mut pivot_row = col;
         let mut pivot_abs = pivot_column[col].abs();
         for (row, v) in pivot_column.iter().enumerate().skip(col + 1) {
@@ -48,7 +66,7 @@ fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &m
             return false;
         }
         if pivot_row != col {
-            for part in [&mut a[..], &mut *b, &mut *d] {
+            for part in [&mut a[..n * M], &mut *b, &mut *d] {
                 for column in part.chunks_exact_mut(M) {
                     column.swap(pivot_row, col);
                 }
@@ -57,26 +75,27 @@ fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &m
         // multipliers l = a[col+1.., col] / pivot, stored in place (times the reciprocal pivot,
         // which is kept for the back substitution)
         let (left, right) = a.split_at_mut((col + 1) * M);
-        let pivot_column = &mut left[col * M..];
+        let pivot_column = &mut left[col * M..col * M + n];
         let inverse = 1.0 / pivot_column[col];
         inverse_pivots[col] = inverse;
         for v in &mut pivot_column[col + 1..] {
             *v *= inverse;
         }
         let l = &pivot_column[col + 1..];
-        for part in [right, &mut *b, &mut *d] {
+        for part in [&mut right[..(n - col - 1) * M], &mut *b, &mut *d] {
             for column in part.chunks_exact_mut(M) {
-                eliminate(&mut column[col..], l);
+                eliminate(&mut column[col..n], l);
             }
         }
     }
     // back substitution, one column of X at a time
     for part in [&mut *b, &mut *d] {
         for x in part.chunks_exact_mut(M) {
+            let x = &mut x[..n];
             if x.iter().all(|&v| v == 0.0) {
                 continue;
             }
-            for col in (0..M).rev() {
+            for col in (0..n).rev() {
                 let u = &a[col * M..col * M + col];
                 let v = x[col] * inverse_pivots[col];
                 x[col] = v;
@@ -88,7 +107,11 @@ fn solve_columns<const M: usize>(mut a: SMatrix<f64, M, M>, b: &mut [f64], d: &m
             }
         }
     }
-    b.iter().chain(d.iter()).all(|v| v.is_finite())
+    let finite = |part: &[f64]| {
+        part.chunks_exact(M)
+            .all(|x| x[..n].iter().all(|v| v.is_finite()))
+    };
+    finite(b) && finite(d)
 }
 
 /// `column[1..] -= column[0] * l` (one elimination update below a pivot), skipped when the
@@ -125,6 +148,23 @@ mod tests {
         let x = Vector3::new(1.0, -2.0, 0.5);
         let got = solve(&a, &(a * x)).unwrap();
         assert!((got - x).amax() < 1e-14, "{got}");
+    }
+
+    #[test]
+    fn leading_block_is_solved_and_the_rest_left_alone() {
+        // the 2 x 2 leading block needs a row swap; row 2 of the right-hand sides is untouched
+        let a = Matrix3::new(0.0, 2.0, 9.0, 3.0, 1.0, 9.0, 9.0, 9.0, 9.0);
+        let mut b = Matrix3::new(2.0, 4.0, 0.0, 4.0, 7.0, 0.0, 5.0, 5.0, 5.0);
+        let mut d = Vector3::new(2.0, 3.0, 7.0);
+        assert!(solve_leading_in_place(a, 2, &mut b, &mut d));
+        // [0 2; 3 1] x = (2, 4): x = (1, 1); (4, 7): x = (5/3, 2); (2, 3): x = (2/3, 1)
+        let expected = Matrix3::new(1.0, 5.0 / 3.0, 0.0, 1.0, 2.0, 0.0, 5.0, 5.0, 5.0);
+        assert!((b - expected).amax() < 1e-15, "{b}");
+        assert!(
+            (d - Vector3::new(2.0 / 3.0, 1.0, 7.0)).amax() < 1e-15,
+            "{d}"
+        );
+        assert!(!solve_leading_in_place(a, 4, &mut b, &mut d));
     }
 
     #[test]

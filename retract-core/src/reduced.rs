@@ -43,6 +43,10 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
     /// The rows of $F$ where $n(y)$ is not identically zero (the forced rows), ascending.
     const FORCED: &'static [usize];
 
+    /// The irreducible blocks of $A$ as (rows, columns), ascending: $A$ is block diagonal after
+    /// permuting rows and columns by them, so each block is factorised on its own.
+    const BLOCKS: &'static [(&'static [usize], &'static [usize])];
+
     /// $A = \partial F / \partial w$ at fixed $y$.
     fn linear_part(&self, h: f64, theta: f64) -> SMatrix<f64, M, M>;
 
@@ -114,16 +118,69 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
                 location: "linear part of the reduced step",
             });
         }
-        // A [a_inv, -t] = [E_forced, B]: one factorisation, sparse right-hand sides
+        // A [a_inv, -t] = [E_forced, B], block by block: the rows of a block of A, times its
+        // columns of the unknowns, give the block's rows of the right-hand sides; only the
+        // right-hand-side columns that are nonzero on those rows are solved for
         let mut a_inv = SMatrix::<f64, M, M>::zeros();
-        for &q in Sys::FORCED {
-            a_inv[(q, q)] = 1.0;
+        let mut t = SMatrix::<f64, M, S>::zeros();
+        let mut covered = 0;
+        let mut block = SMatrix::<f64, M, M>::zeros();
+        let mut rhs = SMatrix::<f64, M, S>::zeros();
+        let mut unit = SMatrix::<f64, M, M>::zeros();
+        for &(rows, cols) in Sys::BLOCKS {
+            let n = rows.len();
+            if n != cols.len() || n > M {
+                return Err(Error::SingularJacobian { iteration: 0 });
+            }
+            covered += n;
+            for (i, &r) in rows.iter().enumerate() {
+                for (j, &c) in cols.iter().enumerate() {
+                    block[(i, j)] = a[(r, c)];
+                }
+            }
+            // the columns of B (initial components) and of E (forced rows) touching the block
+            let mut b_cols = [0usize; S];
+            let mut nb = 0;
+            for c in 0..S {
+                if rows.iter().any(|&r| b[(r, c)] != 0.0) {
+                    for (i, &r) in rows.iter().enumerate() {
+                        rhs[(i, nb)] = b[(r, c)];
+                    }
+                    b_cols[nb] = c;
+                    nb += 1;
+                }
+            }
+            let mut forced = [0usize; M];
+            let mut ne = 0;
+            for (i, &r) in rows.iter().enumerate() {
+                if Sys::FORCED.contains(&r) {
+                    unit.column_mut(ne).fill(0.0);
+                    unit[(i, ne)] = 1.0;
+                    forced[ne] = r;
+                    ne += 1;
+                }
+            }
+            let solved = crate::linalg::solve_columns(
+                block,
+                n,
+                &mut rhs.as_mut_slice()[..nb * M],
+                &mut unit.as_mut_slice()[..ne * M],
+            );
+            if !solved {
+                return Err(Error::SingularJacobian { iteration: 0 });
+            }
+            for (i, &c) in cols.iter().enumerate() {
+                for (k, &col) in b_cols[..nb].iter().enumerate() {
+                    t[(c, col)] = -rhs[(i, k)];
+                }
+                for (k, &q) in forced[..ne].iter().enumerate() {
+                    a_inv[(c, q)] = unit[(i, k)];
+                }
+            }
         }
-        let mut t = b;
-        if !crate::linalg::solve_pair_in_place(a, &mut a_inv, &mut t) {
+        if covered != M {
             return Err(Error::SingularJacobian { iteration: 0 });
         }
-        t = -t;
         let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
         let g = SMatrix::<f64, R, S>::from_fn(|m, c| {
             let core = Sys::CORE[m];
@@ -181,18 +238,19 @@ where
         (*y, r, j)
     }
 
-    /// The first guess: the fixed-point predictor $y = G z_0 - K n(G z_0)$ (exact up to
-    /// $O(|K\,\partial n/\partial y|^2)$, so most steps need no Newton iteration) if it lowers
-    /// the residual, else $G z_0$ itself (stiff forces).
-    fn predictor(&self) -> SVector<f64, R> {
-        let (_, r0, j0) = self.evaluate(&self.offset);
-        let guess = self.offset - r0;
-        let (_, r1, _) = self.evaluate(&guess);
+    /// The first guess with its residual and Jacobian: the fixed-point predictor
+    /// $y = G z_0 - K n(G z_0)$ (exact up to $O(|K\,\partial n/\partial y|^2)$, so most steps
+    /// need no Newton iteration) if it lowers the residual, else $G z_0$ itself (stiff forces).
+    fn predictor(&self) -> Evaluation<R> {
+        let f = self.factors;
+        let offset = self.offset;
+        let (r0, j0) = self.system.core_system(f, &offset, &offset, f.h, f.theta);
+        let guess = offset - r0;
+        let (r1, j1) = self.system.core_system(f, &offset, &guess, f.h, f.theta);
         if all_finite(&r1) && max_abs(&r1) < max_abs(&r0) {
-            guess
+            (guess, r1, j1)
         } else {
-            self.last.set((self.offset, r0, j0));
-            self.offset
+            (offset, r0, j0)
         }
     }
 }
@@ -275,8 +333,7 @@ where
             iteration: 0,
             location: "state",
         };
-        let guess = problem.predictor();
-        let (_, r, _) = problem.evaluate(&guess);
+        let (guess, r, j) = problem.predictor();
         let r_norm = max_abs(&r);
         let solution = if all_finite(&r) && options.newton.converged(r_norm, r_norm) {
             // the predictor already solves r(y) = 0 (Newton would return it with 0 iterations)
@@ -286,6 +343,7 @@ where
                 residual_norm: r_norm,
             }
         } else {
+            problem.last.set((guess, r, j));
             newton::solve_validated(&problem, guess, &options.newton)
                 .map_err(|e| if all_finite(z0) { e } else { state_error() })?
         };

@@ -75,7 +75,8 @@ impl StepOptions {
 
     #[inline]
     pub(crate) fn validate(&self, h: f64) -> Result<(), Error> {
-        if (0.0..=1.0).contains(&self.theta) && h.is_finite() && h != 0.0 {
+        // plain comparisons (NaN fails each): this runs every step
+        if self.theta >= 0.0 && self.theta <= 1.0 && h * 0.0 == 0.0 && h != 0.0 {
             return self.newton.validate();
         }
         self.invalid(h)
