@@ -5,7 +5,9 @@
 mod common;
 
 use common::models::Scene;
-use retract::bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess, continuation};
+use retract::bvp::{
+    BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver, continuation,
+};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{DMatrix, DVector, SVector};
 use retract::{Error, StepOptions, trajectory};
@@ -385,4 +387,59 @@ fn invalid_boundary_data_is_rejected() {
     assert!(matches!(e, Err(Error::InvalidArgument { .. })));
     let e = BoundaryValueProblem::new(&system, &START, &GOAL, 4.0, 0).solve(Guess::Spline);
     assert!(matches!(e, Err(Error::InvalidArgument { .. })));
+}
+
+/// The three ways to the Newton direction (condensed through dense step maps, condensed
+/// through the reduced step's factors, banded LU of the whole Jacobian) give the same
+/// iterates: the same iteration count and the same plan, on the scenes above.
+#[test]
+fn linear_solvers_agree() {
+    // (obstacles, tau, start, goal, T, N)
+    type Case<'a> = (&'a [[f64; 3]], f64, [f64; 6], [f64; 6], f64, usize);
+    let scenes: [Case<'_>; 3] = [
+        (&ONE_DISC, 0.05, START, GOAL, 4.0, 200),
+        (
+            &[[0.0, 1.15, 1.0], [0.0, -1.15, 1.0]],
+            1e-3,
+            [-3.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            6.0,
+            300,
+        ),
+        (
+            &ONE_DISC,
+            0.05,
+            START,
+            [2.0, 0.5, 0.0, 0.0, 0.0, 0.0],
+            20.0,
+            2000,
+        ),
+    ];
+    for (obstacles, tau, start, goal, t_end, steps) in scenes {
+        let system = Scene { tau, obstacles };
+        let problem = |solver| {
+            BoundaryValueProblem::new(&system, &start, &goal, t_end, steps)
+                .with_options(BvpOptions::default().with_linear_solver(solver))
+        };
+        let condensed = problem(LinearSolver::Condensed)
+            .solve(Guess::Spline)
+            .expect("condensed");
+        let reduced = problem(LinearSolver::Condensed)
+            .solve_reduced(Guess::Spline)
+            .expect("reduced");
+        let banded = problem(LinearSolver::Banded)
+            .solve(Guess::Spline)
+            .expect("banded");
+        for other in [&reduced, &banded] {
+            assert_eq!(other.iterations, condensed.iterations);
+            let gap = condensed
+                .states
+                .iter()
+                .zip(&other.states)
+                .map(|(a, b)| (a - b).amax())
+                .fold(0.0, f64::max);
+            assert!(gap < 1e-9, "T = {t_end}: solutions differ by {gap:e}");
+            assert!((other.cost - condensed.cost).abs() < 1e-9 * condensed.cost.abs());
+        }
+    }
 }

@@ -657,6 +657,19 @@ fn generate(
             );
             signed_sum(&terms)
         });
+        let forcing = emit(g, &red.nonlinear_jacobian, &scheme);
+        let dn_stmts = forcing.stmts;
+        let dn_sets: Vec<TokenStream> = red
+            .nonlinear_jacobian
+            .iter()
+            .enumerate()
+            .filter(|(_, id)| !g.is_const(**id, 0.0))
+            .map(|(e, _)| {
+                let value = &forcing.exprs[e];
+                let (q, l) = (index(red.rows[e / r]), index(e % r));
+                quote!(__out[(#q, #l)] = #value;)
+            })
+            .collect();
         let vec_r = quote!(#na::SVector<f64, #r_lit>);
         let factors_ty = quote!(#core::ReducedFactors<#s_lit, #m_lit, #r_lit>);
         let doc = format!(
@@ -715,6 +728,20 @@ fn generate(
                         #na::SVector::<f64, #r_lit>::from([#(#residual_entries),*]),
                         #na::SMatrix::<f64, #r_lit, #r_lit>::from([#([#(#jacobian_entries),*]),*]),
                     )
+                }
+
+                /// dn/dy, nonzero in the forced rows only.
+                fn forcing_jacobian(
+                    &self,
+                    y: &#vec_r,
+                    h: f64,
+                    theta: f64,
+                ) -> #na::SMatrix<f64, #m_lit, #r_lit> {
+                    #float
+                    #dn_stmts
+                    let mut __out = #na::SMatrix::<f64, #m_lit, #r_lit>::zeros();
+                    #(#dn_sets)*
+                    __out
                 }
 
                 /// w = T z0 - A^{-1} n(y) over the structural nonzeros.

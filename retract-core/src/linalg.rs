@@ -28,6 +28,41 @@ pub fn solve_pair_in_place<const M: usize, const C: usize, const E: usize>(
     solve_leading_in_place(a, M, b, d)
 }
 
+/// As [`solve_pair_in_place`], by Cramer's rule for `M` = 1 or 2 (a core of one or two
+/// variables, where the general elimination's bookkeeping costs more than the arithmetic).
+/// Returns `false` for a zero determinant or a non-finite result.
+pub fn solve_small_pair_in_place<const M: usize, const C: usize, const E: usize>(
+    a: SMatrix<f64, M, M>,
+    b: &mut SMatrix<f64, M, C>,
+    d: &mut SMatrix<f64, M, E>,
+) -> bool {
+    match M {
+        1 => {
+            let inverse = 1.0 / a[(0, 0)];
+            *b *= inverse;
+            *d *= inverse;
+        }
+        2 => {
+            let det = a[(0, 0)] * a[(1, 1)] - a[(0, 1)] * a[(1, 0)];
+            let inverse = 1.0 / det;
+            let apply = |x0: f64, x1: f64| {
+                (
+                    (a[(1, 1)] * x0 - a[(0, 1)] * x1) * inverse,
+                    (a[(0, 0)] * x1 - a[(1, 0)] * x0) * inverse,
+                )
+            };
+            for mut column in b.column_iter_mut() {
+                (column[0], column[1]) = apply(column[0], column[1]);
+            }
+            for mut column in d.column_iter_mut() {
+                (column[0], column[1]) = apply(column[0], column[1]);
+            }
+        }
+        _ => return solve_pair_in_place(a, b, d),
+    }
+    b.iter().chain(d.iter()).all(|v| v.is_finite())
+}
+
 /// As [`solve_pair_in_place`] for the leading `n x n` block of `a` and the first `n` rows of
 /// `b` and `d` (`n <= M`; the other entries are not read, and rows `n..` of `b` and `d` are
 /// left as they are).
@@ -165,6 +200,24 @@ mod tests {
             "{d}"
         );
         assert!(!solve_leading_in_place(a, 4, &mut b, &mut d));
+    }
+
+    #[test]
+    fn small_systems_match_the_elimination() {
+        let a = nalgebra::Matrix2::new(0.5, 2.0, 3.0, -1.0);
+        let b = nalgebra::Matrix2x3::new(1.0, 2.0, 3.0, -4.0, 5.0, 0.5);
+        let d = nalgebra::Vector2::new(0.25, -7.0);
+        let (mut b1, mut d1, mut b2, mut d2) = (b, d, b, d);
+        assert!(solve_small_pair_in_place(a, &mut b1, &mut d1));
+        assert!(solve_pair_in_place(a, &mut b2, &mut d2));
+        assert!((b1 - b2).amax() < 1e-14 && (d1 - d2).amax() < 1e-14);
+        let one = nalgebra::Matrix1::new(4.0);
+        let mut x = nalgebra::Matrix1::new(2.0);
+        let mut y = nalgebra::Matrix1x2::new(1.0, -8.0);
+        assert!(solve_small_pair_in_place(one, &mut y, &mut x));
+        assert_eq!((x[0], y[1]), (0.5, -2.0));
+        let singular = nalgebra::Matrix2::new(1.0, 2.0, 2.0, 4.0);
+        assert!(!solve_small_pair_in_place(singular, &mut b1, &mut d1));
     }
 
     #[test]

@@ -70,6 +70,9 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         theta: f64,
     ) -> (SVector<f64, R>, SMatrix<f64, R, R>);
 
+    /// $\partial n / \partial y$ (zero outside the rows [`Self::FORCED`]).
+    fn forcing_jacobian(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SMatrix<f64, M, R>;
+
     /// $w = T z_0 - A^{-1} n(y)$.
     fn recover(
         &self,
