@@ -169,7 +169,12 @@ pub fn solve<const M: usize, const C: usize>(
     b: &SMatrix<f64, M, C>,
 ) -> Option<SMatrix<f64, M, C>> {
     let mut x = *b;
-    solve_in_place(*a, &mut x).then_some(x)
+    let solved = if M <= 2 {
+        solve_small_pair_in_place(*a, &mut x, &mut SMatrix::<f64, M, 0>::zeros())
+    } else {
+        solve_in_place(*a, &mut x)
+    };
+    solved.then_some(x)
 }
 
 #[cfg(test)]
