@@ -36,31 +36,27 @@ pub fn solve_small_pair_in_place<const M: usize, const C: usize, const E: usize>
     b: &mut SMatrix<f64, M, C>,
     d: &mut SMatrix<f64, M, E>,
 ) -> bool {
+    let (b, d) = (b.as_mut_slice(), d.as_mut_slice());
     match M {
         1 => {
             let inverse = 1.0 / a[(0, 0)];
-            *b *= inverse;
-            *d *= inverse;
+            for v in b.iter_mut().chain(d.iter_mut()) {
+                *v *= inverse;
+            }
         }
         2 => {
             let det = a[(0, 0)] * a[(1, 1)] - a[(0, 1)] * a[(1, 0)];
             let inverse = 1.0 / det;
-            let apply = |x0: f64, x1: f64| {
-                (
-                    (a[(1, 1)] * x0 - a[(0, 1)] * x1) * inverse,
-                    (a[(0, 0)] * x1 - a[(1, 0)] * x0) * inverse,
-                )
-            };
-            for mut column in b.column_iter_mut() {
-                (column[0], column[1]) = apply(column[0], column[1]);
-            }
-            for mut column in d.column_iter_mut() {
-                (column[0], column[1]) = apply(column[0], column[1]);
+            for column in b.chunks_exact_mut(2).chain(d.chunks_exact_mut(2)) {
+                let (x0, x1) = (column[0], column[1]);
+                column[0] = (a[(1, 1)] * x0 - a[(0, 1)] * x1) * inverse;
+                column[1] = (a[(0, 0)] * x1 - a[(1, 0)] * x0) * inverse;
             }
         }
-        _ => return solve_pair_in_place(a, b, d),
+        _ => return solve_columns(a, M, b, d),
     }
-    b.iter().chain(d.iter()).all(|v| v.is_finite())
+    // 0 * v is NaN exactly for the non-finite v
+    b.iter().chain(d.iter()).fold(0.0, |acc, v| acc + v * 0.0) == 0.0
 }
 
 /// As [`solve_pair_in_place`] for the leading `n x n` block of `a` and the first `n` rows of

@@ -241,14 +241,31 @@ where
         (*y, r, j)
     }
 
-    /// The first guess with its residual and Jacobian: the fixed-point predictor
-    /// $y = G z_0 - K n(G z_0)$ (exact up to $O(|K\,\partial n/\partial y|^2)$, so most steps
-    /// need no Newton iteration) if it lowers the residual, else $G z_0$ itself (stiff forces).
-    fn predictor(&self) -> Evaluation<R> {
+    /// The first guess with its residual and Jacobian. From $y_0 = G z_0$ (the force-free
+    /// step), with $r_0 = r(y_0) = K n(y_0)$ and $J_0 = I + K\,\partial n/\partial y$:
+    /// - the fixed-point step $y_0 - r_0$, whose error is about $|J_0 - I|\,|r_0|$, when that
+    ///   is below the residual tolerance `tolerance` (small steps: no solve);
+    /// - else the Newton step $y_0 - J_0^{-1} r_0$ (large steps, where the fixed-point step
+    ///   would leave a Newton iteration to do).
+    ///
+    /// The guess is kept if it lowers the residual, else $y_0$ itself (stiff forces).
+    fn predictor(&self, tolerance: f64) -> Evaluation<R> {
         let f = self.factors;
         let offset = self.offset;
         let (r0, j0) = self.system.core_system(f, &offset, &offset, f.h, f.theta);
-        let guess = offset - r0;
+        // max |J_0 - I| entrywise
+        let coupling = j0
+            .as_slice()
+            .iter()
+            .enumerate()
+            .map(|(e, v)| if e % (R + 1) == 0 { v - 1.0 } else { *v })
+            .fold(0.0, |m: f64, v| m.max(v.abs()));
+        let newton = if coupling * max_abs(&r0) <= tolerance {
+            None
+        } else {
+            crate::linalg::solve(&j0, &r0)
+        };
+        let guess = offset - newton.unwrap_or(r0);
         let (r1, j1) = self.system.core_system(f, &offset, &guess, f.h, f.theta);
         if all_finite(&r1) && max_abs(&r1) < max_abs(&r0) {
             (guess, r1, j1)
@@ -336,7 +353,7 @@ where
             iteration: 0,
             location: "state",
         };
-        let (guess, r, j) = problem.predictor();
+        let (guess, r, j) = problem.predictor(options.newton.residual_abs);
         let r_norm = max_abs(&r);
         let solution = if all_finite(&r) && options.newton.converged(r_norm, r_norm) {
             // the predictor already solves r(y) = 0 (Newton would return it with 0 iterations)
