@@ -1,6 +1,7 @@
 //! Speed of one step of the paper's SE(2) obstacle system (tau = 1e-2, h = 0.01, midpoint)
 //! near its closest approach to the disc, and of the 400-step run, for:
-//! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`);
+//! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`), with and without
+//!   the domain check (the hand-written steps have none);
 //! - generated, general (Newton on all 15 unknowns, `retract::step`);
 //! - hand-written dense 12x12 Newton (u = p_1,theta eliminated by hand, Jacobian by hand);
 //! - hand-written reduced 3x3 Newton on q_theta (the limit);
@@ -283,11 +284,23 @@ fn print_ratios(system: &RigidBody, z: &Z) {
         println!("  {name:<40} {ns:>9.1} ns");
     }
 
-    let steps: [(&str, f64); 6] = [
+    let unguarded = options.with_domain_check(false);
+    let steps: [(&str, f64); 7] = [
         (
             "generated, reduced",
             best_ns(2_000, || {
                 black_box(reduced.step(black_box(z), H, &options).map(|s| s.0[0]).ok());
+            }),
+        ),
+        (
+            "generated, reduced, domain check off",
+            best_ns(2_000, || {
+                black_box(
+                    reduced
+                        .step(black_box(z), H, &unguarded)
+                        .map(|s| s.0[0])
+                        .ok(),
+                );
             }),
         ),
         (

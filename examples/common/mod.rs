@@ -133,6 +133,8 @@ pub fn panels(
                 .configure_mesh()
                 .x_desc(x_label)
                 .y_desc(*y_label)
+                .x_label_formatter(&|v| power_of_ten(*v))
+                .y_label_formatter(&|v| power_of_ten(*v))
                 .draw()?;
             draw_curves(&mut chart, curves, Markers::Points)?;
         } else {
@@ -147,6 +149,17 @@ pub fn panels(
     }
     root.present()?;
     Ok(())
+}
+
+/// A log-axis tick label: `1e-5` rather than the rounded `9.999999999999998e-6`.
+fn power_of_ten(v: f64) -> String {
+    let exponent = v.log10().round();
+    let mantissa = v / 10f64.powf(exponent);
+    if (mantissa - 1.0).abs() < 1e-6 {
+        format!("1e{exponent}")
+    } else {
+        format!("{v:.1e}")
+    }
 }
 
 /// Which points of a curve get a marker.
