@@ -391,6 +391,52 @@ fn reduced_agrees<Sys, const S: usize, const M: usize, const R: usize>(
     }
 }
 
+/// The factors from the macro's closed form (symbolic elimination of the blocks of A) equal
+/// the LU ones to rounding.
+fn closed_form_agrees<Sys, const S: usize, const M: usize, const R: usize>(
+    sys: &Sys,
+    expected: retract::ClosedForm,
+) where
+    Sys: retract::ReducedScheme<S, M, R>,
+{
+    use retract::nalgebra::SMatrix;
+    let (mut t, mut a_inv) = (SMatrix::<f64, M, S>::zeros(), SMatrix::<f64, M, M>::zeros());
+    assert_eq!(
+        sys.closed_form_factors(0.1, 0.5, &mut t, &mut a_inv),
+        expected
+    );
+    for (h, theta) in [(0.01, 0.5), (0.3, 0.5), (0.05, 0.3), (0.2, 1.0), (0.1, 0.0)] {
+        let closed = retract::ReducedFactors::new(sys, h, theta).expect("closed form");
+        let lu = retract::ReducedFactors::factorised(sys, h, theta).expect("LU");
+        let scale = 1.0 + lu.t.amax();
+        assert!(
+            (closed.t - lu.t).amax() < 1e-13 * scale,
+            "h {h}, theta {theta}: T"
+        );
+        assert!((closed.a_inv - lu.a_inv).amax() < 1e-13 * (1.0 + lu.a_inv.amax()));
+        assert!((closed.g - lu.g).amax() < 1e-13 * scale && (closed.k - lu.k).amax() < 1e-13);
+    }
+}
+
+#[test]
+fn closed_form_factors_equal_the_lu_ones() {
+    use retract::ClosedForm::{Polynomial, Rational};
+    // the mass parameter m is a pivot of the elimination: a rational closed form, checked
+    closed_form_agrees(&Pendulum { m: 1.3, g: 9.81 }, Rational);
+    closed_form_agrees(&Anharmonic { w: 1.5 }, Polynomial);
+    let obstacles = [[0.0, 0.0, 1.0]];
+    closed_form_agrees(
+        &Se2Barrier {
+            tau: 0.3,
+            obstacles: &obstacles,
+        },
+        Polynomial,
+    );
+    // lower-order quadratic terms (0.1 |q'|^2; q'' . q''') make some pivots expressions
+    closed_form_agrees(&Jerk { kappa: 0.7 }, Rational);
+    closed_form_agrees(&Snap {}, Rational);
+}
+
 #[test]
 fn reduced_step_is_chosen_where_it_applies() {
     // the Hessian depends on q (and q' for snap), never on the top derivative

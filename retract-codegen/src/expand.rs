@@ -670,6 +670,49 @@ fn generate(
                 quote!(__out[(#q, #l)] = #value;)
             })
             .collect();
+        let closed_form = red.closed_form.as_ref().map(|(t, a_inv, polynomial)| {
+            let kind = if *polynomial {
+                quote!(Polynomial)
+            } else {
+                quote!(Rational)
+            };
+            let mut roots = t.clone();
+            roots.extend(a_inv);
+            let code = emit(g, &roots, &scheme);
+            let stmts = &code.stmts;
+            let forced = red.rows.len();
+            let sets = roots
+                .iter()
+                .enumerate()
+                .filter(|(_, id)| !g.is_const(**id, 0.0))
+                .map(|(e, _)| {
+                    let value = &code.exprs[e];
+                    if e < m * s {
+                        let (row, col) = (index(e / s), index(e % s));
+                        quote!(t[(#row, #col)] = #value;)
+                    } else {
+                        let e = e - m * s;
+                        let (row, col) = (index(e / forced), index(red.rows[e % forced]));
+                        quote!(a_inv[(#row, #col)] = #value;)
+                    }
+                });
+            quote! {
+                /// T = -A^{-1} B and the forced columns of A^{-1}, from a symbolic elimination
+                /// of the blocks of A at compile time.
+                fn closed_form_factors(
+                    &self,
+                    h: f64,
+                    theta: f64,
+                    t: &mut #na::SMatrix<f64, #m_lit, #s_lit>,
+                    a_inv: &mut #na::SMatrix<f64, #m_lit, #m_lit>,
+                ) -> #core::ClosedForm {
+                    #float
+                    #stmts
+                    #(#sets)*
+                    #core::ClosedForm::#kind
+                }
+            }
+        });
         let vec_r = quote!(#na::SVector<f64, #r_lit>);
         let factors_ty = quote!(#core::ReducedFactors<#s_lit, #m_lit, #r_lit>);
         let doc = format!(
@@ -729,6 +772,8 @@ fn generate(
                         #na::SMatrix::<f64, #r_lit, #r_lit>::from([#([#(#jacobian_entries),*]),*]),
                     )
                 }
+
+                #closed_form
 
                 /// dn/dy, nonzero in the forced rows only.
                 fn forcing_jacobian(

@@ -326,6 +326,110 @@ pub struct Reduced {
     pub inverse_pattern: Vec<Vec<bool>>,
     /// Structural nonzeros of B, M x S.
     pub initial_pattern: Vec<Vec<bool>>,
+    /// T = -A^{-1} B (row-major M x S) and the columns of A^{-1} at the forced rows
+    /// (row-major M x |rows|) as expressions in h, theta and the parameters, from a symbolic
+    /// elimination of each block, and whether every pivot was a nonzero constant (then the
+    /// expressions are polynomials: no division); `None` when an elimination grows too large.
+    pub closed_form: Option<(Vec<Id>, Vec<Id>, bool)>,
+}
+
+/// Nodes a symbolic block elimination may add before the closed form is given up.
+const CLOSED_FORM_BUDGET: usize = 20_000;
+
+/// X with A X = Y for a small square A of graph nodes, by Gauss-Jordan elimination with
+/// structural pivoting: in each column the pivot is the nonzero constant of largest magnitude
+/// among the remaining rows if there is one, else the first structurally nonzero entry (whose
+/// value the run-time check of the factors guards). `None` if a column has no structurally
+/// nonzero candidate or the graph grows past `budget` nodes. The flag says whether every
+/// pivot was a nonzero constant.
+fn symbolic_solve(
+    g: &mut Graph,
+    mut a: Vec<Vec<Id>>,
+    mut y: Vec<Vec<Id>>,
+    budget: usize,
+) -> Option<(Vec<Vec<Id>>, bool)> {
+    let n = a.len();
+    let start = g.len();
+    let mut constant_pivots = true;
+    for col in 0..n {
+        let candidates = (col..n).filter(|&r| !g.is_const(a[r][col], 0.0));
+        let constant = candidates
+            .clone()
+            .filter_map(|r| g.as_const(a[r][col]).map(|v| (r, v.abs())))
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+            .map(|(r, _)| r);
+        constant_pivots &= constant.is_some();
+        let pivot_row = constant.or_else(|| candidates.clone().next())?;
+        a.swap(col, pivot_row);
+        y.swap(col, pivot_row);
+        let pivot = a[col][col];
+        for entry in a[col][col..].iter_mut().chain(y[col].iter_mut()) {
+            *entry = g.div(*entry, pivot);
+        }
+        let (pivot_a, pivot_y) = (a[col].clone(), y[col].clone());
+        for (r, (row_a, row_y)) in a.iter_mut().zip(y.iter_mut()).enumerate() {
+            let factor = row_a[col];
+            if r == col || g.is_const(factor, 0.0) {
+                continue;
+            }
+            for (entry, &p) in row_a[col..]
+                .iter_mut()
+                .chain(row_y.iter_mut())
+                .zip(pivot_a[col..].iter().chain(&pivot_y))
+            {
+                let update = g.mul(factor, p);
+                *entry = g.sub(*entry, update);
+            }
+        }
+        if g.len() - start > budget {
+            return None;
+        }
+    }
+    Some((y, constant_pivots))
+}
+
+/// T = -A^{-1} B and the columns of A^{-1} at the forced rows, block by block.
+fn closed_form(
+    g: &mut Graph,
+    linear: &[Id],
+    initial: &[Id],
+    forced: &[usize],
+    blocks: &[(Vec<usize>, Vec<usize>)],
+    m: usize,
+    s: usize,
+) -> Option<(Vec<Id>, Vec<Id>, bool)> {
+    let zero = g.constant(0.0);
+    let mut polynomial = true;
+    let one = g.constant(1.0);
+    let mut t = vec![zero; m * s];
+    let mut a_inv = vec![zero; m * forced.len()];
+    let budget_start = g.len();
+    for (rows, cols) in blocks {
+        let a: Vec<Vec<Id>> = rows
+            .iter()
+            .map(|&r| cols.iter().map(|&c| linear[r * m + c]).collect())
+            .collect();
+        let y: Vec<Vec<Id>> = rows
+            .iter()
+            .map(|&r| {
+                let mut row: Vec<Id> = initial[r * s..(r + 1) * s].to_vec();
+                row.extend(forced.iter().map(|&q| if q == r { one } else { zero }));
+                row
+            })
+            .collect();
+        let used = g.len() - budget_start;
+        let (x, constant_pivots) = symbolic_solve(g, a, y, CLOSED_FORM_BUDGET.checked_sub(used)?)?;
+        polynomial &= constant_pivots;
+        for (j, &c) in cols.iter().enumerate() {
+            for col in 0..s {
+                t[c * s + col] = g.neg(x[j][col]);
+            }
+            for f in 0..forced.len() {
+                a_inv[c * forced.len() + f] = x[j][s + f];
+            }
+        }
+    }
+    Some((t, a_inv, polynomial))
 }
 
 /// The reduced step of L, if its Hessian depends on some jet components but on no component
@@ -410,6 +514,7 @@ pub fn reduce(
     }
     let inverse_pattern = inverse_pattern(&linear_pattern);
     let initial_pattern = pattern(&initial, s);
+    let closed_form = closed_form(g, &linear, &initial, &rows, &blocks, m, s);
     Some(Reduced {
         core,
         linear,
@@ -420,6 +525,7 @@ pub fn reduce(
         blocks,
         inverse_pattern,
         initial_pattern,
+        closed_form,
     })
 }
 

@@ -52,7 +52,7 @@ pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
 pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
-pub use reduced::{ReducedFactors, ReducedScheme, ReducedStepper};
+pub use reduced::{ClosedForm, ReducedFactors, ReducedScheme, ReducedStepper};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};

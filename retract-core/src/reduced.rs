@@ -70,6 +70,22 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         theta: f64,
     ) -> (SVector<f64, R>, SMatrix<f64, R, R>);
 
+    /// Writes $T = -A^{-1} B$ and the columns of $A^{-1}$ at [`Self::FORCED`] into the zero
+    /// matrices `t` and `a_inv` from closed-form expressions in $h$, $\theta$ and the
+    /// parameters (the macro eliminates the blocks of $A$ symbolically), and says what they
+    /// are; [`ClosedForm::None`] (the default) where there is no closed form.
+    /// [`ReducedFactors::new`] checks the result and factorises numerically otherwise.
+    fn closed_form_factors(
+        &self,
+        h: f64,
+        theta: f64,
+        t: &mut SMatrix<f64, M, S>,
+        a_inv: &mut SMatrix<f64, M, M>,
+    ) -> ClosedForm {
+        let _ = (h, theta, t, a_inv);
+        ClosedForm::None
+    }
+
     /// $\partial n / \partial y$ (zero outside the rows [`Self::FORCED`]).
     fn forcing_jacobian(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SMatrix<f64, M, R>;
 
@@ -82,6 +98,19 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         h: f64,
         theta: f64,
     ) -> SVector<f64, M>;
+}
+
+/// What [`ReducedScheme::closed_form_factors`] wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClosedForm {
+    /// Nothing: factorise numerically.
+    None,
+    /// Polynomials in $h$, $\theta$ and the parameters (every pivot of the symbolic
+    /// elimination was a nonzero constant): exact up to rounding when finite.
+    Polynomial,
+    /// Rational functions: a pivot was an expression, which may nearly vanish for some
+    /// $(h, \theta)$, so the result is checked against $A$ and $B$ before use.
+    Rational,
 }
 
 /// The factors of the reduced step for one $(h, \theta)$ (formulas in the module docs).
@@ -113,91 +142,184 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let a = system.linear_part(h, theta);
-        let b = system.initial_part(h, theta);
+        let linear = || {
+            let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
+            if all_finite(&a) && all_finite(&b) {
+                Ok((a, b))
+            } else {
+                Err(Error::NonFinite {
+                    iteration: 0,
+                    location: "linear part of the reduced step",
+                })
+            }
+        };
+        let mut t = SMatrix::<f64, M, S>::zeros();
+        let mut a_inv = SMatrix::<f64, M, M>::zeros();
+        let closed = match system.closed_form_factors(h, theta, &mut t, &mut a_inv) {
+            ClosedForm::None => false,
+            ClosedForm::Polynomial => all_finite(&t) && all_finite(&a_inv),
+            ClosedForm::Rational => {
+                let (a, b) = linear()?;
+                solves_linear_part::<Sys, S, M, R>(&a, &b, &t, &a_inv)
+            }
+        };
+        if !closed {
+            let (a, b) = linear()?;
+            (t, a_inv) = factorise::<Sys, S, M, R>(&a, &b)?;
+        }
+        Ok(Self::from_parts::<Sys>(h, theta, t, a_inv))
+    }
+
+    /// The factors by LU of the blocks of $A$, never from the closed form (to check it).
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn factorised<Sys>(system: &Sys, h: f64, theta: f64) -> Result<Self, Error>
+    where
+        Sys: ReducedScheme<S, M, R> + ?Sized,
+    {
+        let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
         if !(all_finite(&a) && all_finite(&b)) {
             return Err(Error::NonFinite {
                 iteration: 0,
                 location: "linear part of the reduced step",
             });
         }
-        // A [a_inv, -t] = [E_forced, B], block by block: the rows of a block of A, times its
-        // columns of the unknowns, give the block's rows of the right-hand sides; only the
-        // right-hand-side columns that are nonzero on those rows are solved for
-        let mut a_inv = SMatrix::<f64, M, M>::zeros();
-        let mut t = SMatrix::<f64, M, S>::zeros();
-        let mut covered = 0;
-        let mut block = SMatrix::<f64, M, M>::zeros();
-        let mut rhs = SMatrix::<f64, M, S>::zeros();
-        let mut unit = SMatrix::<f64, M, M>::zeros();
-        for &(rows, cols) in Sys::BLOCKS {
-            let n = rows.len();
-            if n != cols.len() || n > M {
-                return Err(Error::SingularJacobian { iteration: 0 });
-            }
-            covered += n;
-            for (i, &r) in rows.iter().enumerate() {
-                for (j, &c) in cols.iter().enumerate() {
-                    block[(i, j)] = a[(r, c)];
-                }
-            }
-            // the columns of B (initial components) and of E (forced rows) touching the block
-            let mut b_cols = [0usize; S];
-            let mut nb = 0;
-            for c in 0..S {
-                if rows.iter().any(|&r| b[(r, c)] != 0.0) {
-                    for (i, &r) in rows.iter().enumerate() {
-                        rhs[(i, nb)] = b[(r, c)];
-                    }
-                    b_cols[nb] = c;
-                    nb += 1;
-                }
-            }
-            let mut forced = [0usize; M];
-            let mut ne = 0;
-            for (i, &r) in rows.iter().enumerate() {
-                if Sys::FORCED.contains(&r) {
-                    unit.column_mut(ne).fill(0.0);
-                    unit[(i, ne)] = 1.0;
-                    forced[ne] = r;
-                    ne += 1;
-                }
-            }
-            let solved = crate::linalg::solve_columns(
-                block,
-                n,
-                &mut rhs.as_mut_slice()[..nb * M],
-                &mut unit.as_mut_slice()[..ne * M],
-            );
-            if !solved {
-                return Err(Error::SingularJacobian { iteration: 0 });
-            }
-            for (i, &c) in cols.iter().enumerate() {
-                for (k, &col) in b_cols[..nb].iter().enumerate() {
-                    t[(c, col)] = -rhs[(i, k)];
-                }
-                for (k, &q) in forced[..ne].iter().enumerate() {
-                    a_inv[(c, q)] = unit[(i, k)];
-                }
-            }
-        }
-        if covered != M {
-            return Err(Error::SingularJacobian { iteration: 0 });
-        }
+        let (t, a_inv) = factorise::<Sys, S, M, R>(&a, &b)?;
+        Ok(Self::from_parts::<Sys>(h, theta, t, a_inv))
+    }
+
+    /// $K$ and $G$ from $T$ and $A^{-1}$.
+    fn from_parts<Sys>(h: f64, theta: f64, t: SMatrix<f64, M, S>, a_inv: SMatrix<f64, M, M>) -> Self
+    where
+        Sys: ReducedScheme<S, M, R> + ?Sized,
+    {
         let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
         let g = SMatrix::<f64, R, S>::from_fn(|m, c| {
             let core = Sys::CORE[m];
             theta * t[(core, c)] + if c == core { 1.0 - theta } else { 0.0 }
         });
-        Ok(Self {
+        Self {
             h,
             theta,
             a_inv,
             k,
             g,
             t,
-        })
+        }
     }
+}
+
+/// $T = -A^{-1} B$ and the columns of $A^{-1}$ at the forced rows by LU with partial pivoting
+/// of each block of $A$.
+fn factorise<Sys, const S: usize, const M: usize, const R: usize>(
+    a: &SMatrix<f64, M, M>,
+    b: &SMatrix<f64, M, S>,
+) -> Result<(SMatrix<f64, M, S>, SMatrix<f64, M, M>), Error>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    // A [a_inv, -t] = [E_forced, B], block by block: the rows of a block of A, times its
+    // columns of the unknowns, give the block's rows of the right-hand sides; only the
+    // right-hand-side columns that are nonzero on those rows are solved for
+    let mut a_inv = SMatrix::<f64, M, M>::zeros();
+    let mut t = SMatrix::<f64, M, S>::zeros();
+    let mut covered = 0;
+    let mut block = SMatrix::<f64, M, M>::zeros();
+    let mut rhs = SMatrix::<f64, M, S>::zeros();
+    let mut unit = SMatrix::<f64, M, M>::zeros();
+    for &(rows, cols) in Sys::BLOCKS {
+        let n = rows.len();
+        if n != cols.len() || n > M {
+            return Err(Error::SingularJacobian { iteration: 0 });
+        }
+        covered += n;
+        for (i, &r) in rows.iter().enumerate() {
+            for (j, &c) in cols.iter().enumerate() {
+                block[(i, j)] = a[(r, c)];
+            }
+        }
+        // the columns of B (initial components) and of E (forced rows) touching the block
+        let mut b_cols = [0usize; S];
+        let mut nb = 0;
+        for c in 0..S {
+            if rows.iter().any(|&r| b[(r, c)] != 0.0) {
+                for (i, &r) in rows.iter().enumerate() {
+                    rhs[(i, nb)] = b[(r, c)];
+                }
+                b_cols[nb] = c;
+                nb += 1;
+            }
+        }
+        let mut forced = [0usize; M];
+        let mut ne = 0;
+        for (i, &r) in rows.iter().enumerate() {
+            if Sys::FORCED.contains(&r) {
+                unit.column_mut(ne).fill(0.0);
+                unit[(i, ne)] = 1.0;
+                forced[ne] = r;
+                ne += 1;
+            }
+        }
+        let solved = crate::linalg::solve_columns(
+            block,
+            n,
+            &mut rhs.as_mut_slice()[..nb * M],
+            &mut unit.as_mut_slice()[..ne * M],
+        );
+        if !solved {
+            return Err(Error::SingularJacobian { iteration: 0 });
+        }
+        for (i, &c) in cols.iter().enumerate() {
+            for (k, &col) in b_cols[..nb].iter().enumerate() {
+                t[(c, col)] = -rhs[(i, k)];
+            }
+            for (k, &q) in forced[..ne].iter().enumerate() {
+                a_inv[(c, q)] = unit[(i, k)];
+            }
+        }
+    }
+    if covered != M {
+        return Err(Error::SingularJacobian { iteration: 0 });
+    }
+    Ok((t, a_inv))
+}
+
+/// Whether `t` and `a_inv` (from [`ReducedScheme::closed_form_factors`]) solve
+/// $A T = -B$ and $A\,a^{-1}_q = e_q$ for the forced rows $q$, checked on one test vector each
+/// to a relative $10^{-10}$; a closed form whose elimination divided by a nearly vanishing
+/// pivot, or any non-finite entry, fails.
+fn solves_linear_part<Sys, const S: usize, const M: usize, const R: usize>(
+    a: &SMatrix<f64, M, M>,
+    b: &SMatrix<f64, M, S>,
+    t: &SMatrix<f64, M, S>,
+    a_inv: &SMatrix<f64, M, M>,
+) -> bool
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    if !(all_finite(t) && all_finite(a_inv)) {
+        return false;
+    }
+    // distinct weights, so that no cancellation hides an error
+    let x = SVector::<f64, S>::from_fn(|i, _| 1.0 + 0.1 * i as f64);
+    let tx = t * x;
+    let residual = a * tx + b * x;
+    let scale = max_abs(&(a.abs() * tx.abs())) + max_abs(&(b.abs() * x));
+    if max_abs(&residual) > 1e-10 * scale {
+        return false;
+    }
+    let e = SVector::<f64, M>::from_fn(|q, _| {
+        if Sys::FORCED.contains(&q) {
+            1.0 + 0.1 * q as f64
+        } else {
+            0.0
+        }
+    });
+    let inverse_e = a_inv * e;
+    let residual = a * inverse_e - e;
+    let scale = max_abs(&(a.abs() * inverse_e.abs())) + max_abs(&e);
+    max_abs(&residual) <= 1e-10 * scale
 }
 
 /// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps: a composition cycles
