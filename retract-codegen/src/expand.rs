@@ -550,17 +550,57 @@ fn generate(
         });
         let (a_stmts, a_sets) = matrix_sets(&red.linear, m);
         let (b_stmts, b_sets) = matrix_sets(&red.initial, s);
-        // structural nonzeros of K = theta E A^{-1}, G = (1 - theta) E - K B, T = -A^{-1} B
+        // structural nonzeros of T = -A^{-1} B, of A^{-1} (its forced columns are used), of
+        // K = theta E A^{-1} and of G = (1 - theta) E + theta E T; where the closed form is
+        // known, its zeros refine them and its constants are written in place of cached values
+        let forced_count = red.rows.len();
+        let closed_t =
+            |row: usize, c: usize| red.closed_form.as_ref().map(|(t, _, _)| t[row * s + c]);
+        let closed_a_inv = |row: usize, q: usize| {
+            let f = red.rows.iter().position(|&r| r == q)?;
+            red.closed_form
+                .as_ref()
+                .map(|(_, a_inv, _)| a_inv[row * forced_count + f])
+        };
+        let known_zero = |id: Option<crate::graph::Id>| id.is_some_and(|id| g.is_const(id, 0.0));
+        let structural_t = mechanics::product_pattern(&red.inverse_pattern, &red.initial_pattern);
+        let t_pattern: Vec<Vec<bool>> = (0..m)
+            .map(|row| {
+                (0..s)
+                    .map(|c| structural_t[row][c] && !known_zero(closed_t(row, c)))
+                    .collect()
+            })
+            .collect();
+        let inverse_pattern: Vec<Vec<bool>> = (0..m)
+            .map(|row| {
+                (0..m)
+                    .map(|q| red.inverse_pattern[row][q] && !known_zero(closed_a_inv(row, q)))
+                    .collect()
+            })
+            .collect();
         let k_pattern: Vec<Vec<bool>> = red
             .core
             .iter()
-            .map(|&c| red.inverse_pattern[c].clone())
+            .map(|&c| inverse_pattern[c].clone())
             .collect();
-        let mut g_pattern = mechanics::product_pattern(&k_pattern, &red.initial_pattern);
-        for (row, &c) in g_pattern.iter_mut().zip(&red.core) {
-            row[c] = true;
-        }
-        let t_pattern = mechanics::product_pattern(&red.inverse_pattern, &red.initial_pattern);
+        let g_pattern: Vec<Vec<bool>> = red
+            .core
+            .iter()
+            .map(|&core| (0..s).map(|c| c == core || t_pattern[core][c]).collect())
+            .collect();
+        // a cached factor entry times a value, or the known constant times it
+        let coefficient =
+            |cached: TokenStream, known: Option<crate::graph::Id>, value: TokenStream| match known
+                .and_then(|id| g.as_const(id))
+            {
+                Some(1.0) => (false, value),
+                Some(-1.0) => (true, value),
+                Some(v) => {
+                    let v = crate::codegen::constant(v);
+                    (false, quote!(#v * #value))
+                }
+                None => (false, quote!(#cached * #value)),
+            };
         // sum of factor[(row, c)] * value(c) over the pattern of one row
         let dot = |factor: TokenStream, row: usize, cols: &[(usize, TokenStream)]| {
             let terms: Vec<(bool, TokenStream)> = cols
@@ -643,16 +683,21 @@ fn generate(
                 .filter(|&c| t_pattern[row][c])
                 .map(|c| {
                     let (rl, cl, z) = (index(row), index(c), z0_entry(c));
-                    (false, quote!(factors.t[(#rl, #cl)] * #z))
+                    coefficient(quote!(factors.t[(#rl, #cl)]), closed_t(row, c), z)
                 })
                 .collect();
             terms.extend(
                 red.rows
                     .iter()
-                    .filter(|&&q| red.inverse_pattern[row][q])
+                    .filter(|&&q| inverse_pattern[row][q])
                     .map(|&q| {
                         let (rl, ql, name) = (index(row), index(q), n_name(q));
-                        (true, quote!(factors.a_inv[(#rl, #ql)] * #name))
+                        let (negative, term) = coefficient(
+                            quote!(factors.a_inv[(#rl, #ql)]),
+                            closed_a_inv(row, q),
+                            quote!(#name),
+                        );
+                        (!negative, term)
                     }),
             );
             signed_sum(&terms)

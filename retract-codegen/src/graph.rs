@@ -189,6 +189,17 @@ impl Graph {
         if let Node::Neg(na) = *self.node(a) {
             return self.sub(b, na);
         }
+        // (x - b) + b = x
+        if let Node::Sub(x, c) = *self.node(a)
+            && c == b
+        {
+            return x;
+        }
+        if let Node::Sub(x, c) = *self.node(b)
+            && c == a
+        {
+            return x;
+        }
         let (a, b) = if a <= b { (a, b) } else { (b, a) };
         self.add(Node::Add(a, b))
     }
@@ -205,6 +216,17 @@ impl Graph {
         }
         if let Node::Neg(nb) = *self.node(b) {
             return self.add_op(a, nb);
+        }
+        // a - (a - c) = c and (a - c) - a = -c
+        if let Node::Sub(x, c) = *self.node(b)
+            && x == a
+        {
+            return c;
+        }
+        if let Node::Sub(x, c) = *self.node(a)
+            && x == b
+        {
+            return self.neg(c);
         }
         self.add(Node::Sub(a, b))
     }
