@@ -220,6 +220,22 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
         }
         curves.push(common::Curve::new(label, points));
     }
+    println!("\nWall time at a final error of 1e-8 (log-log interpolation between sweep points):");
+    let at_target: Vec<(&str, f64)> = curves
+        .iter()
+        .filter_map(|c| time_at_error(&c.points, 1e-8).map(|t| (c.label.as_str(), t)))
+        .collect();
+    for (label, time) in &at_target {
+        println!("  {label:<22} {:>7.1} us", time * 1e6);
+    }
+    let dop = at_target.iter().find(|(label, _)| *label == "DOP853");
+    let best = at_target
+        .iter()
+        .filter(|(label, _)| label.starts_with("composition"))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    if let (Some((_, dop)), Some((label, best))) = (dop, best) {
+        println!("  best composition ({label}) / DOP853: {:.1}x", best / dop);
+    }
     let figure = common::docs_path("work_precision.svg");
     common::panels(
         &figure,
@@ -230,6 +246,18 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     println!("\nfigure: {}", figure.display());
     Ok(())
+}
+
+/// The wall time at which a sweep of (time, error) points reaches `target`, interpolating
+/// log error against log time between the two points that bracket it.
+fn time_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
+    points.windows(2).find_map(|pair| {
+        let ((t0, e0), (t1, e1)) = (pair[0], pair[1]);
+        (e0 >= target && e1 <= target && e0 > e1).then(|| {
+            let s = (e0 / target).ln() / (e0 / e1).ln();
+            (t0.ln() + s * (t1 / t0).ln()).exp()
+        })
+    })
 }
 
 /// max |H - H(0)| so far, sampled at t = 10^(k/4).
