@@ -834,6 +834,22 @@ fn generate(
                     __out
                 }
 
+                /// r(y) = y - offset + K n(y) alone.
+                #[inline]
+                fn core_residual(
+                    &self,
+                    factors: &#factors_ty,
+                    offset: &#vec_r,
+                    y: &#vec_r,
+                    h: f64,
+                    theta: f64,
+                ) -> #vec_r {
+                    #float
+                    #force_stmts
+                    #(#force_lets)*
+                    #na::SVector::<f64, #r_lit>::from([#(#residual_entries),*])
+                }
+
                 /// w = T z0 - A^{-1} n(y) over the structural nonzeros.
                 #[inline]
                 fn recover(

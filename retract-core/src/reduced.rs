@@ -89,6 +89,16 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
     /// $\partial n / \partial y$ (zero outside the rows [`Self::FORCED`]).
     fn forcing_jacobian(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SMatrix<f64, M, R>;
 
+    /// $r(y) = y - \text{offset} + K n(y)$ alone.
+    fn core_residual(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
+        offset: &SVector<f64, R>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
+    ) -> SVector<f64, R>;
+
     /// $w = T z_0 - A^{-1} n(y)$.
     fn recover(
         &self,
@@ -371,10 +381,17 @@ where
     ///   would leave a Newton iteration to do).
     ///
     /// The guess is kept if it lowers the residual, else $y_0$ itself (stiff forces).
-    fn predictor(&self, tolerance: f64) -> Evaluation<R> {
-        let f = self.factors;
-        let offset = self.offset;
-        let (r0, j0) = self.system.core_system(f, &offset, &offset, f.h, f.theta);
+    ///
+    /// Returns the guess, its residual, and the Jacobian there if it was computed (the
+    /// residual at the fixed-point guess is evaluated without it: most steps stop there).
+    fn predictor(
+        system: &Sys,
+        f: &ReducedFactors<S, M, R>,
+        offset: SVector<f64, R>,
+        tolerance: f64,
+    ) -> Prediction<R> {
+        let (r0, j0) = system.core_system(f, &offset, &offset, f.h, f.theta);
+        let norm0 = max_abs(&r0);
         // max |J_0 - I| entrywise
         let coupling = j0
             .as_slice()
@@ -382,19 +399,43 @@ where
             .enumerate()
             .map(|(e, v)| if e % (R + 1) == 0 { v - 1.0 } else { *v })
             .fold(0.0, |m: f64, v| m.max(v.abs()));
-        let newton = if coupling * max_abs(&r0) <= tolerance {
+        let newton = if coupling * norm0 <= tolerance {
             None
         } else {
             crate::linalg::solve(&j0, &r0)
         };
         let guess = offset - newton.unwrap_or(r0);
-        let (r1, j1) = self.system.core_system(f, &offset, &guess, f.h, f.theta);
-        if all_finite(&r1) && max_abs(&r1) < max_abs(&r0) {
-            (guess, r1, j1)
+        let r1 = system.core_residual(f, &offset, &guess, f.h, f.theta);
+        let norm1 = max_abs(&r1);
+        let finite1 = all_finite(&r1);
+        if finite1 && norm1 < norm0 {
+            Prediction {
+                y: guess,
+                residual: r1,
+                norm: norm1,
+                finite: true,
+                jacobian: None,
+            }
         } else {
-            (offset, r0, j0)
+            Prediction {
+                y: offset,
+                residual: r0,
+                norm: norm0,
+                finite: all_finite(&r0),
+                jacobian: Some(j0),
+            }
         }
     }
+}
+
+/// The first guess of a reduced step: $y$, $r(y)$, $|r(y)|_\infty$, whether $r(y)$ is finite,
+/// and the Jacobian at $y$ if it was computed.
+struct Prediction<const R: usize> {
+    y: SVector<f64, R>,
+    residual: SVector<f64, R>,
+    norm: f64,
+    finite: bool,
+    jacobian: Option<SMatrix<f64, R, R>>,
 }
 
 impl<Sys, const S: usize, const M: usize, const R: usize> Problem<R>
@@ -460,33 +501,34 @@ where
         let system = self.system;
         let factors = self.factors(h, theta)?;
         let offset = system.core_offset(factors, z0);
-        let problem = CoreProblem {
-            system,
-            factors,
-            offset,
-            last: Cell::new((
-                SVector::from_element(f64::NAN),
-                SVector::zeros(),
-                SMatrix::zeros(),
-            )),
-        };
         // a non-finite state shows as a non-finite guess or step, and is named as such below
         let state_error = || Error::NonFinite {
             iteration: 0,
             location: "state",
         };
-        let (guess, r, j) = problem.predictor(options.newton.residual_abs);
-        let r_norm = max_abs(&r);
-        let solution = if all_finite(&r) && options.newton.converged(r_norm, r_norm) {
+        let prediction = CoreProblem::predictor(system, factors, offset, options.newton.residual_abs);
+        let solution = if prediction.finite
+            && options.newton.converged(prediction.norm, prediction.norm)
+        {
             // the predictor already solves r(y) = 0 (Newton would return it with 0 iterations)
             newton::Solution {
-                w: guess,
+                w: prediction.y,
                 iterations: 0,
-                residual_norm: r_norm,
+                residual_norm: prediction.norm,
             }
         } else {
-            problem.last.set((guess, r, j));
-            newton::solve_validated(&problem, guess, &options.newton)
+            let j = prediction.jacobian.unwrap_or_else(|| {
+                system
+                    .core_system(factors, &offset, &prediction.y, h, theta)
+                    .1
+            });
+            let problem = CoreProblem {
+                system,
+                factors,
+                offset,
+                last: Cell::new((prediction.y, prediction.residual, j)),
+            };
+            newton::solve_validated(&problem, prediction.y, &options.newton)
                 .map_err(|e| if all_finite(z0) { e } else { state_error() })?
         };
         let w = system.recover(factors, z0, &solution.w, h, theta);
