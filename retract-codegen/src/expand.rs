@@ -628,6 +628,23 @@ fn generate(
         let n_name = |q: usize| format_ident!("__n{}", q);
         let forces = emit(g, &red.nonlinear, &scheme);
         let force_stmts = &forces.stmts;
+        // the forcing given as a vector: its forced rows under the names __n<q>
+        let forcing_lets: Vec<TokenStream> = red
+            .rows
+            .iter()
+            .map(|&q| {
+                let (name, q) = (n_name(q), index(q));
+                quote!(let #name: f64 = forcing[#q];)
+            })
+            .collect();
+        let forcing_sets: Vec<TokenStream> = red
+            .rows
+            .iter()
+            .map(|&q| {
+                let (name, q) = (n_name(q), index(q));
+                quote!(__out[#q] = #name;)
+            })
+            .collect();
         let force_lets: Vec<TokenStream> = red
             .rows
             .iter()
@@ -834,20 +851,28 @@ fn generate(
                     __out
                 }
 
-                /// r(y) = y - offset + K n(y) alone.
+                /// r(y) = y - offset + K n for the given forcing n = n(y).
                 #[inline]
                 fn core_residual(
                     &self,
                     factors: &#factors_ty,
                     offset: &#vec_r,
                     y: &#vec_r,
-                    h: f64,
-                    theta: f64,
+                    forcing: &#vec_m,
                 ) -> #vec_r {
+                    #(#forcing_lets)*
+                    #na::SVector::<f64, #r_lit>::from([#(#residual_entries),*])
+                }
+
+                /// n(y), nonzero in the forced rows only.
+                #[inline]
+                fn forcing(&self, y: &#vec_r, h: f64, theta: f64) -> #vec_m {
                     #float
                     #force_stmts
                     #(#force_lets)*
-                    #na::SVector::<f64, #r_lit>::from([#(#residual_entries),*])
+                    let mut __out = #vec_m_path::zeros();
+                    #(#forcing_sets)*
+                    __out
                 }
 
                 /// w = T z0 - A^{-1} n(y) over the structural nonzeros.
@@ -856,13 +881,9 @@ fn generate(
                     &self,
                     factors: &#factors_ty,
                     z0: &#vec_s,
-                    y: &#vec_r,
-                    h: f64,
-                    theta: f64,
+                    forcing: &#vec_m,
                 ) -> #vec_m {
-                    #float
-                    #force_stmts
-                    #(#force_lets)*
+                    #(#forcing_lets)*
                     #vec_m_path::from([#(#recover_sets),*])
                 }
             }

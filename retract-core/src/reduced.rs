@@ -89,24 +89,24 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
     /// $\partial n / \partial y$ (zero outside the rows [`Self::FORCED`]).
     fn forcing_jacobian(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SMatrix<f64, M, R>;
 
-    /// $r(y) = y - \text{offset} + K n(y)$ alone.
+    /// $r(y) = y - \text{offset} + K n$ for the forcing $n = n(y)$ given (no evaluation).
     fn core_residual(
         &self,
         factors: &ReducedFactors<S, M, R>,
         offset: &SVector<f64, R>,
         y: &SVector<f64, R>,
-        h: f64,
-        theta: f64,
+        forcing: &SVector<f64, M>,
     ) -> SVector<f64, R>;
 
-    /// $w = T z_0 - A^{-1} n(y)$.
+    /// $n(y)$ (zero outside the rows [`Self::FORCED`]).
+    fn forcing(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SVector<f64, M>;
+
+    /// $w = T z_0 - A^{-1} n$ for the forcing $n = n(y)$ at the solved core.
     fn recover(
         &self,
         factors: &ReducedFactors<S, M, R>,
         z0: &SVector<f64, S>,
-        y: &SVector<f64, R>,
-        h: f64,
-        theta: f64,
+        forcing: &SVector<f64, M>,
     ) -> SVector<f64, M>;
 }
 
@@ -389,7 +389,7 @@ where
         f: &ReducedFactors<S, M, R>,
         offset: SVector<f64, R>,
         tolerance: f64,
-    ) -> Prediction<R> {
+    ) -> Prediction<M, R> {
         let (r0, j0) = system.core_system(f, &offset, &offset, f.h, f.theta);
         let norm0 = max_abs(&r0);
         // max |J_0 - I| entrywise
@@ -405,7 +405,8 @@ where
             crate::linalg::solve(&j0, &r0)
         };
         let guess = offset - newton.unwrap_or(r0);
-        let r1 = system.core_residual(f, &offset, &guess, f.h, f.theta);
+        let n1 = system.forcing(&guess, f.h, f.theta);
+        let r1 = system.core_residual(f, &offset, &guess, &n1);
         let norm1 = max_abs(&r1);
         let finite1 = all_finite(&r1);
         if finite1 && norm1 < norm0 {
@@ -415,6 +416,7 @@ where
                 norm: norm1,
                 finite: true,
                 jacobian: None,
+                forcing: Some(n1),
             }
         } else {
             Prediction {
@@ -423,19 +425,21 @@ where
                 norm: norm0,
                 finite: all_finite(&r0),
                 jacobian: Some(j0),
+                forcing: None,
             }
         }
     }
 }
 
 /// The first guess of a reduced step: $y$, $r(y)$, $|r(y)|_\infty$, whether $r(y)$ is finite,
-/// and the Jacobian at $y$ if it was computed.
-struct Prediction<const R: usize> {
+/// and the Jacobian and the forcing $n(y)$ at $y$ where they were computed.
+struct Prediction<const M: usize, const R: usize> {
     y: SVector<f64, R>,
     residual: SVector<f64, R>,
     norm: f64,
     finite: bool,
     jacobian: Option<SMatrix<f64, R, R>>,
+    forcing: Option<SVector<f64, M>>,
 }
 
 impl<Sys, const S: usize, const M: usize, const R: usize> Problem<R>
@@ -506,16 +510,19 @@ where
             iteration: 0,
             location: "state",
         };
-        let prediction = CoreProblem::predictor(system, factors, offset, options.newton.residual_abs);
-        let solution = if prediction.finite
+        let prediction =
+            CoreProblem::predictor(system, factors, offset, options.newton.residual_abs);
+        let (solution, forcing) = if prediction.finite
             && options.newton.converged(prediction.norm, prediction.norm)
+            && let Some(forcing) = prediction.forcing
         {
             // the predictor already solves r(y) = 0 (Newton would return it with 0 iterations)
-            newton::Solution {
+            let solution = newton::Solution {
                 w: prediction.y,
                 iterations: 0,
                 residual_norm: prediction.norm,
-            }
+            };
+            (solution, forcing)
         } else {
             let j = prediction.jacobian.unwrap_or_else(|| {
                 system
@@ -528,10 +535,11 @@ where
                 offset,
                 last: Cell::new((prediction.y, prediction.residual, j)),
             };
-            newton::solve_validated(&problem, prediction.y, &options.newton)
-                .map_err(|e| if all_finite(z0) { e } else { state_error() })?
+            let solution = newton::solve_validated(&problem, prediction.y, &options.newton)
+                .map_err(|e| if all_finite(z0) { e } else { state_error() })?;
+            (solution, system.forcing(&solution.w, h, theta))
         };
-        let w = system.recover(factors, z0, &solution.w, h, theta);
+        let w = system.recover(factors, z0, &forcing);
         if !all_finite(&w) {
             return Err(if all_finite(z0) {
                 Error::NonFinite {
