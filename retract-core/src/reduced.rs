@@ -373,50 +373,52 @@ where
         (*y, r, j)
     }
 
-    /// The first guess with its residual and Jacobian. From $y_0 = G z_0$ (the force-free
-    /// step), with $r_0 = r(y_0) = K n(y_0)$ and $J_0 = I + K\,\partial n/\partial y$:
-    /// - the fixed-point step $y_0 - r_0$, whose error is about $|J_0 - I|\,|r_0|$, when that
-    ///   is below the residual tolerance `tolerance` (small steps: no solve);
-    /// - else the Newton step $y_0 - J_0^{-1} r_0$ (large steps, where the fixed-point step
-    ///   would leave a Newton iteration to do).
-    ///
-    /// The guess is kept if it lowers the residual, else $y_0$ itself (stiff forces).
-    ///
-    /// Returns the guess, its residual, and the Jacobian there if it was computed (the
-    /// residual at the fixed-point guess is evaluated without it: most steps stop there).
+    /// The first guess, from $y_0 = G z_0$ (the force-free step) with $r_0 = r(y_0) = K n(y_0)$:
+    /// - the fixed-point step $y_1 = y_0 - r_0$, exact up to $O(|K\,\partial n/\partial y|\,|r_0|)$;
+    ///   its residual is evaluated without the Jacobian, and for small steps it already meets
+    ///   the residual test, so most steps stop here;
+    /// - else (large steps) the Newton step $y_0 - J_0^{-1} r_0$ if it lowers the residual,
+    ///   else $y_0$ with its Jacobian (stiff forces).
     fn predictor(
         system: &Sys,
         f: &ReducedFactors<S, M, R>,
         offset: SVector<f64, R>,
-        tolerance: f64,
+        newton: &crate::NewtonOptions,
     ) -> Prediction<M, R> {
-        let (r0, j0) = system.core_system(f, &offset, &offset, f.h, f.theta);
+        let n0 = system.forcing(&offset, f.h, f.theta);
+        let r0 = system.core_residual(f, &offset, &offset, &n0);
         let norm0 = max_abs(&r0);
-        // max |J_0 - I| entrywise
-        let coupling = j0
-            .as_slice()
-            .iter()
-            .enumerate()
-            .map(|(e, v)| if e % (R + 1) == 0 { v - 1.0 } else { *v })
-            .fold(0.0, |m: f64, v| m.max(v.abs()));
-        let newton = if coupling * norm0 <= tolerance {
-            None
-        } else {
-            crate::linalg::solve(&j0, &r0)
-        };
-        let guess = offset - newton.unwrap_or(r0);
-        let n1 = system.forcing(&guess, f.h, f.theta);
-        let r1 = system.core_residual(f, &offset, &guess, &n1);
+        let fixed_point = offset - r0;
+        let n1 = system.forcing(&fixed_point, f.h, f.theta);
+        let r1 = system.core_residual(f, &offset, &fixed_point, &n1);
         let norm1 = max_abs(&r1);
-        let finite1 = all_finite(&r1);
-        if finite1 && norm1 < norm0 {
-            Prediction {
-                y: guess,
+        if all_finite(&r1) && newton.converged(norm1, norm1) {
+            return Prediction {
+                y: fixed_point,
                 residual: r1,
                 norm: norm1,
                 finite: true,
                 jacobian: None,
                 forcing: Some(n1),
+            };
+        }
+        // a large step: the Newton step from the force-free guess
+        let (r0, j0) = system.core_system(f, &offset, &offset, f.h, f.theta);
+        let guess = match crate::linalg::solve(&j0, &r0) {
+            Some(step) => offset - step,
+            None => fixed_point,
+        };
+        let n2 = system.forcing(&guess, f.h, f.theta);
+        let r2 = system.core_residual(f, &offset, &guess, &n2);
+        let norm2 = max_abs(&r2);
+        if all_finite(&r2) && norm2 < norm0 {
+            Prediction {
+                y: guess,
+                residual: r2,
+                norm: norm2,
+                finite: true,
+                jacobian: None,
+                forcing: Some(n2),
             }
         } else {
             Prediction {
@@ -510,8 +512,7 @@ where
             iteration: 0,
             location: "state",
         };
-        let prediction =
-            CoreProblem::predictor(system, factors, offset, options.newton.residual_abs);
+        let prediction = CoreProblem::predictor(system, factors, offset, &options.newton);
         let (solution, forcing) = if prediction.finite
             && options.newton.converged(prediction.norm, prediction.norm)
             && let Some(forcing) = prediction.forcing
