@@ -472,6 +472,16 @@ where
     }
 
     /// The cached factors for $(h, \theta)$, computed if new.
+    /// Factorises for a new $(h, \theta)$ into the next slot (out of line: the cold path).
+    #[cold]
+    #[inline(never)]
+    fn insert(&mut self, h: f64, theta: f64) -> Result<usize, Error> {
+        let slot = self.next_slot;
+        self.factors[slot] = Some(ReducedFactors::new(self.system, h, theta)?);
+        self.next_slot = (slot + 1) % CACHED;
+        Ok(slot)
+    }
+
     fn factors(&mut self, h: f64, theta: f64) -> Result<&ReducedFactors<S, M, R>, Error> {
         let slot = match self
             .factors
@@ -479,12 +489,7 @@ where
             .position(|f| matches!(f, Some(f) if f.h == h && f.theta == theta))
         {
             Some(slot) => slot,
-            None => {
-                let slot = self.next_slot;
-                self.factors[slot] = Some(ReducedFactors::new(self.system, h, theta)?);
-                self.next_slot = (slot + 1) % CACHED;
-                slot
-            }
+            None => self.insert(h, theta)?,
         };
         self.factors[slot]
             .as_ref()
