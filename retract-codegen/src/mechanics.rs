@@ -271,6 +271,27 @@ fn gradient_at(
         .collect()
 }
 
+/// dF/dw (row-major M x M) and dF/dz0 (row-major M x S) of residual rows `f`.
+fn jacobians(
+    g: &mut Graph,
+    d: &mut Differentiator,
+    f: &[Id],
+    m: usize,
+    s: usize,
+) -> (Vec<Id>, Vec<Id>) {
+    let mut by_w = Vec::with_capacity(m * m);
+    let mut by_z0 = Vec::with_capacity(m * s);
+    for &row in f {
+        for c in 0..m {
+            by_w.push(d.diff(g, row, Var::W(c as u16)));
+        }
+        for c in 0..s {
+            by_z0.push(d.diff(g, row, Var::Z0(c as u16)));
+        }
+    }
+    (by_w, by_z0)
+}
+
 /// Residual F(z0, w) of the theta-scheme and its Jacobians.
 fn scheme(
     g: &mut Graph,
@@ -291,16 +312,7 @@ fn scheme(
     };
     let g_at = gradient_at(g, gradient, &at);
     let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
-    let mut jacobian = Vec::with_capacity(m * m);
-    let mut jacobian_initial = Vec::with_capacity(m * s);
-    for &row in &f {
-        for c in 0..m {
-            jacobian.push(d.diff(g, row, Var::W(c as u16)));
-        }
-        for c in 0..s {
-            jacobian_initial.push(d.diff(g, row, Var::Z0(c as u16)));
-        }
-    }
+    let (jacobian, jacobian_initial) = jacobians(g, d, &f, m, s);
     (f, jacobian, jacobian_initial)
 }
 
@@ -462,16 +474,7 @@ pub fn reduce(
     let g_at = gradient_at(g, gradient, &at);
     let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
     let mut d = Differentiator::default();
-    let mut linear = Vec::with_capacity(m * m);
-    let mut initial = Vec::with_capacity(m * s);
-    for &row in &f {
-        for c in 0..m {
-            linear.push(d.diff(g, row, Var::W(c as u16)));
-        }
-        for c in 0..s {
-            initial.push(d.diff(g, row, Var::Z0(c as u16)));
-        }
-    }
+    let (linear, initial) = jacobians(g, &mut d, &f, m, s);
     // A and B must not depend on the state or the core (else the split is not affine)
     let on_state = |v: &Var| matches!(v, Var::W(_) | Var::Core(_) | Var::Z0(_));
     if linear

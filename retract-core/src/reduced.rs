@@ -152,17 +152,7 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let linear = || {
-            let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
-            if all_finite(&a) && all_finite(&b) {
-                Ok((a, b))
-            } else {
-                Err(Error::NonFinite {
-                    iteration: 0,
-                    location: "linear part of the reduced step",
-                })
-            }
-        };
+        let linear = || linear_parts(system, h, theta);
         let mut t = SMatrix::<f64, M, S>::zeros();
         let mut a_inv = SMatrix::<f64, M, M>::zeros();
         let closed = match system.closed_form_factors(h, theta, &mut t, &mut a_inv) {
@@ -188,13 +178,7 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
-        if !(all_finite(&a) && all_finite(&b)) {
-            return Err(Error::NonFinite {
-                iteration: 0,
-                location: "linear part of the reduced step",
-            });
-        }
+        let (a, b) = linear_parts(system, h, theta)?;
         let (t, a_inv) = factorise::<Sys, S, M, R>(&a, &b)?;
         Ok(Self::from_parts::<Sys>(h, theta, t, a_inv))
     }
@@ -217,6 +201,26 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
             g,
             t,
         }
+    }
+}
+
+/// $A$ and $B$, or [`Error::NonFinite`] if a parameter makes an entry non-finite.
+fn linear_parts<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    h: f64,
+    theta: f64,
+) -> Result<(SMatrix<f64, M, M>, SMatrix<f64, M, S>), Error>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
+    if all_finite(&a) && all_finite(&b) {
+        Ok((a, b))
+    } else {
+        Err(Error::NonFinite {
+            iteration: 0,
+            location: "linear part of the reduced step",
+        })
     }
 }
 
