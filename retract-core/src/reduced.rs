@@ -20,9 +20,12 @@
 //!
 //! $A^{-1}$, $K$, $G$ and $T$ depend on $(h, \theta)$ and the parameters only and are cached by
 //! [`ReducedStepper`] ([`ReducedFactors`]). The macro emits $A$, $B$, $n$ and
-//! $\partial n/\partial y$, and the products with the cached factors as straight-line code
-//! over their structural nonzeros (the blocks of $A$), so a step costs about as much as one
-//! written by hand. The result is the same $z_1$ as the general step, to rounding.
+//! $\partial n/\partial y$, the irreducible blocks of $A$, the factors in closed form where a
+//! symbolic elimination of the blocks finds one ([`ClosedForm`]), and the products with the
+//! cached factors as straight-line code over their nonzeros, with the factors' constant
+//! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
+//! obstacle system a step takes 1.2x to 1.7x the time of one written by hand for $h$ and
+//! $\theta$ fixed at compile time (`cargo bench --bench step`).
 
 use core::cell::Cell;
 
