@@ -485,10 +485,10 @@ where
         )
     }
 
-    fn solve_with<L: Linearization<S, M>>(
+    fn solve_with(
         &self,
         guess: Guess<'_, S, M>,
-        linearize: StepMap<'_, L, S, M>,
+        linearize: StepMap<'_, S, M>,
     ) -> Result<BvpSolution<S, M>, Error> {
         self.validate()?;
         let mut v = match guess {
@@ -671,45 +671,40 @@ where
 
 /// The linearisation of step $i$ from $z_i$, $w_i$ and the step's residual $F_i$; `None` if
 /// singular.
-type StepMap<'a, L, const S: usize, const M: usize> =
-    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<L>;
+type StepMap<'a, const S: usize, const M: usize> =
+    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<Linearized<S, M>>;
 
 /// The linearised map of one step at the current iterate, $\delta w = \Phi \delta z + c$, with
 /// $\Phi$ and $c$ solving $\partial_z F\, \delta z + \partial_w F\, \delta w = -F$.
-trait Linearization<const S: usize, const M: usize> {
-    /// $\Phi\, \delta z + c$.
-    fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M>;
-    /// The $z$ rows of $\Phi x$.
-    fn linear_z(&self, x: &SVector<f64, S>) -> SVector<f64, S>;
-}
-
-/// Dense $\Phi$ and $c$.
-struct Dense<const S: usize, const M: usize> {
+struct Linearized<const S: usize, const M: usize> {
     phi: SMatrix<f64, M, S>,
     c: SVector<f64, M>,
 }
 
-impl<const S: usize, const M: usize> Linearization<S, M> for Dense<S, M> {
+impl<const S: usize, const M: usize> Linearized<S, M> {
+    /// $\Phi\, \delta z + c$.
     fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M> {
         let mut out = self.c;
-        for (column, &weight) in self.phi.as_slice().chunks_exact(M).zip(dz.iter()) {
+        self.add_product(&mut out, dz);
+        out
+    }
+
+    /// The $z$ rows of $\Phi x$.
+    fn linear_z(&self, x: &SVector<f64, S>) -> SVector<f64, S> {
+        let mut out = SVector::<f64, S>::zeros();
+        self.add_product(&mut out, x);
+        out
+    }
+
+    /// `out += ` the first `LEN` rows of $\Phi x$, column by column over slices of constant
+    /// length: the inner loop runs down a contiguous column and vectorises (nalgebra's generic
+    /// product on a row view does not).
+    fn add_product<const LEN: usize>(&self, out: &mut SVector<f64, LEN>, x: &SVector<f64, S>) {
+        for (column, &weight) in self.phi.as_slice().chunks_exact(M).zip(x.iter()) {
             for (o, p) in out.as_mut_slice().iter_mut().zip(column) {
                 *o += p * weight;
             }
         }
-        out
-    }
-
-    fn linear_z(&self, x: &SVector<f64, S>) -> SVector<f64, S> {
-        // column by column over slices of constant length: the inner loop runs down a
-        // contiguous column and vectorises (nalgebra's generic product on a row view does not)
-        let mut out = SVector::<f64, S>::zeros();
-        for (column, &weight) in self.phi.as_slice().chunks_exact(M).zip(x.iter()) {
-            for (o, p) in out.as_mut_slice().iter_mut().zip(&column[..S]) {
-                *o += p * weight;
-            }
-        }
-        out
     }
 }
 
@@ -721,14 +716,14 @@ fn general_step_map<Sys, const S: usize, const M: usize>(
     f: &SVector<f64, M>,
     h: f64,
     theta: f64,
-) -> Option<Dense<S, M>>
+) -> Option<Linearized<S, M>>
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     let mut phi = -system.jacobian_initial(z, w, h, theta);
     let mut c = -f;
     crate::linalg::solve_pair_in_place(system.jacobian(z, w, h, theta), &mut phi, &mut c)
-        .then_some(Dense { phi, c })
+        .then_some(Linearized { phi, c })
 }
 
 /// The step maps of a [`ReducedScheme`]. With $F = A w + B z + n(y)$,
@@ -767,7 +762,7 @@ where
         z: &SVector<f64, S>,
         w: &SVector<f64, M>,
         f: &SVector<f64, M>,
-    ) -> Option<Dense<S, M>> {
+    ) -> Option<Linearized<S, M>> {
         let ReducedFactors { h, theta, .. } = self.factors;
         let y = SVector::<f64, R>::from_fn(|m, _| {
             let c = Sys::CORE[m];
@@ -818,7 +813,7 @@ where
                 c[r] -= hm[(r, m)] * x0[m];
             }
         }
-        Some(Dense { phi, c })
+        Some(Linearized { phi, c })
     }
 }
 
@@ -830,17 +825,16 @@ where
 /// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\, nk\, S M)$, no banded matrix.
 /// Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or the end
 /// system is singular or the direction is not finite.
-fn condensed_direction<Sys, L, const S: usize, const M: usize>(
+fn condensed_direction<Sys, const S: usize, const M: usize>(
     problem: &BoundaryValueProblem<'_, Sys, S, M>,
     v: &[f64],
     r: &[f64],
     delta: &mut [f64],
-    linearize: StepMap<'_, L, S, M>,
-    maps: &mut Vec<L>,
+    linearize: StepMap<'_, S, M>,
+    maps: &mut Vec<Linearized<S, M>>,
 ) -> bool
 where
     Sys: LiftedSystem<S, M> + ?Sized,
-    L: Linearization<S, M>,
 {
     let layout = problem.layout();
     let (nk, steps) = (layout.nk, problem.steps);
@@ -937,8 +931,9 @@ mod tests {
         };
         let (start, goal) = ([-2.0, 1.5, 1.0, 0.0], [2.0, 1.5, 1.0, 0.0]);
         let problem = BoundaryValueProblem::new(&system, &start, &goal, 4.0, 100);
-        let never =
-            |_: &SVector<f64, 8>, _: &SVector<f64, 10>, _: &SVector<f64, 10>| None::<Dense<8, 10>>;
+        let never = |_: &SVector<f64, 8>, _: &SVector<f64, 10>, _: &SVector<f64, 10>| {
+            None::<Linearized<8, 10>>
+        };
         let fallback = problem.solve_with(Guess::Spline, &never).unwrap();
         let condensed = problem.solve(Guess::Spline).unwrap();
         assert_eq!(fallback.iterations, condensed.iterations);
