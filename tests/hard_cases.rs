@@ -7,7 +7,8 @@ use common::models::{RigidBody, bounded_pais_uhlenbeck};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{
-    Error, Interrupted, LiftedSystem, NewtonOptions, StepOptions, Trajectory, step, trajectory,
+    Error, Interrupted, LiftedSystem, NewtonOptions, ReducedStepper, StepOptions, Trajectory, step,
+    trajectory,
 };
 
 /// Minimum snap with a potential, k = 4.
@@ -142,6 +143,47 @@ fn nan_and_infinite_inputs_and_parameters() {
             Err(Error::InvalidArgument { .. })
         ));
     }
+}
+
+#[test]
+fn reduced_step_on_non_finite_and_overflowing_states_is_an_error() {
+    let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let (system, z0) = body(1e-2, jet);
+    let options = StepOptions::default();
+    let mut stepper = ReducedStepper::new(&system);
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let mut z = z0;
+        z[4] = bad;
+        assert!(matches!(
+            stepper.step(&z, 0.01, &options),
+            Err(Error::NonFinite {
+                location: "state",
+                ..
+            })
+        ));
+    }
+    // finite, but v + h p1 overflows in the recovered velocity while the core stays finite
+    let mut z = z0;
+    z[3] = f64::MAX;
+    z[9] = f64::MAX;
+    let result = stepper.step(&z, 0.01, &options);
+    assert!(matches!(result, Err(Error::NonFinite { .. })), "{result:?}");
+    // near the overflow threshold: a finite step or an error, never a non-finite state
+    for size in [1e300, 1e307, f64::MAX / 4.0, f64::MAX / 2.0] {
+        for (i, j) in [(3, 9), (0, 3), (9, 6), (2, 11)] {
+            let mut z = z0;
+            z[i] = size;
+            z[j] = size;
+            if let Ok((z1, _)) = stepper.step(&z, 0.01, &options) {
+                assert!(z1.iter().all(|v| v.is_finite()), "{size:e} at {i}, {j}");
+            }
+        }
+    }
+    // large and representable: a finite step
+    let mut z = z0;
+    z[3] = 1e150;
+    let (z1, _) = stepper.step(&z, 0.01, &options).expect("finite");
+    assert!(z1.iter().all(|v| v.is_finite()));
 }
 
 #[test]

@@ -6,11 +6,18 @@
 //! constants, named consts) are inlined. A [`Node::Sum`] becomes a run-time loop over its
 //! slice parameter; the nodes of its body that depend on the loop element are emitted inside
 //! the loop, the others are hoisted before it.
+//!
+//! Chains of one operation through inlined nodes (`a * b * c`, `a - b + c`) are emitted as
+//! balanced trees that combine the earliest available operands first (tree-height reduction
+//! on an estimate of each value's latency), so a long chain does not wait on its slowest
+//! operand at every step: `h * ((t * y) * r)` with `r = 1/s` late becomes
+//! `((h * y) * t) * r`. This reassociates floating-point operations, which changes results
+//! in the last bits only.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::graph::{Graph, Id, Node, Var, children};
+use crate::graph::{Func, Graph, Id, Node, Var, children};
 
 /// How a function names the leaves: symbol -> expression tokens.
 pub trait Leaves {
@@ -155,12 +162,17 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
         }
     }
     let reciprocal: Vec<bool> = denominators.iter().map(|&n| n >= 2).collect();
-    let emitter = Emitter {
+    let mut emitter = Emitter {
         g,
         leaves,
         inline: &inline,
         reciprocal: &reciprocal,
+        latency: Vec::new(),
     };
+    emitter.latency = (0..len).map(|_| 0).collect();
+    for i in 0..len {
+        emitter.latency[i] = emitter.estimate(Id(i as u32));
+    }
     let reference = |id: Id| emitter.reference(id, false);
     let value = |id: Id| emitter.value(id, false);
 
@@ -230,9 +242,171 @@ struct Emitter<'a> {
     inline: &'a [bool],
     /// Denominators bound once as a reciprocal (function level only).
     reciprocal: &'a [bool],
+    /// Estimated cycles from the function's inputs to each node's value.
+    latency: Vec<u32>,
+}
+
+/// Latencies (cycles) of the operations on a current x86 core, for the balancing only.
+const ADD: u32 = 4;
+const DIV: u32 = 14;
+const SQRT: u32 = 18;
+const CALL: u32 = 40;
+
+/// The two operations whose chains are balanced.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Chain {
+    /// `+` and `-`: operands with a sign.
+    Sum,
+    /// `*` and division by a bound reciprocal: operands with an overall sign.
+    Product,
+}
+
+/// An operand of a chain: a node, or the bound reciprocal of a node.
+#[derive(Clone, Copy)]
+enum Operand {
+    Node(Id),
+    Reciprocal(Id),
 }
 
 impl Emitter<'_> {
+    /// The chain `id` heads, if it is a sum or a product (a function-level `Neg` heads the
+    /// chain of its operand).
+    fn chain(&self, id: Id, in_loop: bool) -> Option<Chain> {
+        match *self.g.node(id) {
+            Node::Add(..) | Node::Sub(..) => Some(Chain::Sum),
+            Node::Mul(..) => Some(Chain::Product),
+            Node::Div(_, b) if !in_loop && self.reciprocal[b.0 as usize] => Some(Chain::Product),
+            _ => None,
+        }
+    }
+
+    /// The operands of the chain of `kind` at `id` with their signs (`true`: negated), through
+    /// inlined nodes of the same chain and negations; `Neg` of a node of the other kind (or a
+    /// bound one) is an operand with a sign.
+    fn operands(
+        &self,
+        id: Id,
+        kind: Chain,
+        in_loop: bool,
+        negate: bool,
+        out: &mut Vec<(Operand, bool)>,
+    ) {
+        let through = |c: Id| !in_loop && self.inline[c.0 as usize];
+        let push = |this: &Self, c: Id, negate: bool, out: &mut Vec<(Operand, bool)>| {
+            if through(c)
+                && (this.chain(c, in_loop) == Some(kind) || matches!(this.g.node(c), Node::Neg(_)))
+            {
+                this.operands(c, kind, in_loop, negate, out);
+            } else {
+                out.push((Operand::Node(c), negate));
+            }
+        };
+        match *self.g.node(id) {
+            Node::Neg(a) => push(self, a, !negate, out),
+            Node::Add(a, b) if kind == Chain::Sum => {
+                push(self, a, negate, out);
+                push(self, b, negate, out);
+            }
+            Node::Sub(a, b) if kind == Chain::Sum => {
+                push(self, a, negate, out);
+                push(self, b, !negate, out);
+            }
+            Node::Mul(a, b) if kind == Chain::Product => {
+                push(self, a, negate, out);
+                push(self, b, false, out);
+            }
+            Node::Div(a, b) if kind == Chain::Product => {
+                push(self, a, negate, out);
+                out.push((Operand::Reciprocal(b), false));
+            }
+            _ => out.push((Operand::Node(id), negate)),
+        }
+    }
+
+    fn operand_latency(&self, op: Operand) -> u32 {
+        match op {
+            Operand::Node(id) => self.latency[id.0 as usize],
+            Operand::Reciprocal(id) => self.latency[id.0 as usize] + DIV,
+        }
+    }
+
+    /// The chain emitted at `id`: its own, or for a negation of an inlined chain, that chain.
+    fn head(&self, id: Id, in_loop: bool) -> Option<Chain> {
+        match *self.g.node(id) {
+            Node::Neg(a) if !in_loop && self.inline[a.0 as usize] => self.chain(a, in_loop),
+            _ => self.chain(id, in_loop),
+        }
+    }
+
+    /// Latency of `id` as emitted (function level), from its children's.
+    fn estimate(&self, id: Id) -> u32 {
+        let l = |c: Id| self.latency[c.0 as usize];
+        if let Some(kind) = self.head(id, false) {
+            let mut ops = Vec::new();
+            self.operands(id, kind, false, false, &mut ops);
+            return balanced_latency(
+                ops.iter()
+                    .map(|&(op, _)| self.operand_latency(op))
+                    .collect(),
+            );
+        }
+        match *self.g.node(id) {
+            Node::Const(_) | Node::Var(_) | Node::Named(_) => 0,
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => l(a).max(l(b)) + ADD,
+            Node::Div(a, b) => l(a).max(l(b)) + DIV,
+            Node::Neg(a) => l(a) + 1,
+            Node::Powi(a, n) => l(a) + ADD * (32 - n.unsigned_abs().leading_zeros()).max(1),
+            Node::Unary(Func::Sqrt, a) => l(a) + SQRT,
+            Node::Unary(Func::Abs | Func::Signum, a) => l(a) + 1,
+            Node::Unary(_, a) => l(a) + CALL,
+            Node::Powf(a, b) | Node::Atan2(a, b) | Node::Hypot(a, b) => l(a).max(l(b)) + CALL,
+            Node::Sum { .. } => CALL,
+        }
+    }
+
+    /// A chain as a balanced tree: repeatedly combines the two operands available first.
+    fn balanced(&self, id: Id, kind: Chain, in_loop: bool) -> TokenStream {
+        let mut ops = Vec::new();
+        self.operands(id, kind, in_loop, false, &mut ops);
+        // (tokens, latency, negated), combined in order of latency, then position
+        let mut terms: Vec<(TokenStream, u32, bool)> = ops
+            .iter()
+            .map(|&(op, negate)| {
+                let tokens = match op {
+                    Operand::Node(c) => self.reference(c, in_loop),
+                    Operand::Reciprocal(b) => reciprocal_name(b),
+                };
+                (tokens, self.operand_latency(op), negate)
+            })
+            .collect();
+        if kind == Chain::Product {
+            // the sign of a product is carried to its end
+            let negate = terms.iter().filter(|t| t.2).count() % 2 == 1;
+            for t in &mut terms {
+                t.2 = false;
+            }
+            if let Some(first) = terms.first_mut() {
+                first.2 = negate;
+            }
+        }
+        while terms.len() > 1 {
+            let first = take_earliest(&mut terms);
+            let second = take_earliest(&mut terms);
+            let ((a, la, na), (b, lb, nb)) = (first, second);
+            let latency = la.max(lb) + ADD;
+            let combined = match (kind, na, nb) {
+                (Chain::Product, ..) => (quote!((#a * #b)), latency, na ^ nb),
+                (Chain::Sum, false, false) => (quote!((#a + #b)), latency, false),
+                (Chain::Sum, false, true) => (quote!((#a - #b)), latency, false),
+                (Chain::Sum, true, false) => (quote!((#b - #a)), latency, false),
+                (Chain::Sum, true, true) => (quote!((#a + #b)), latency, true),
+            };
+            terms.push(combined);
+        }
+        let (tokens, _, negate) = terms.pop().unwrap_or((quote!(0.0), 0, false));
+        if negate { quote!(-#tokens) } else { tokens }
+    }
+
     /// How a parent refers to `id`: a leaf, a temporary, or (inlined) its parenthesised value.
     /// `in_loop`: inside a loop body every non-leaf is a temporary.
     fn reference(&self, id: Id, in_loop: bool) -> TokenStream {
@@ -256,6 +430,9 @@ impl Emitter<'_> {
     /// The expression computing `id` from its children.
     fn value(&self, id: Id, in_loop: bool) -> TokenStream {
         let r = |c: Id| self.reference(c, in_loop);
+        if let Some(kind) = self.head(id, in_loop) {
+            return self.balanced(id, kind, in_loop);
+        }
         match self.g.node(id).clone() {
             Node::Add(a, b) => {
                 let (a, b) = (r(a), r(b));
@@ -303,6 +480,238 @@ impl Emitter<'_> {
                 quote!(#a.hypot(#b))
             }
             _ => self.reference(id, in_loop),
+        }
+    }
+}
+
+/// The latency of a balanced chain over operands of the given latencies.
+fn balanced_latency(mut latencies: Vec<u32>) -> u32 {
+    latencies.sort_unstable();
+    while latencies.len() > 1 {
+        let (a, b) = (latencies.remove(0), latencies.remove(0));
+        let combined = a.max(b) + ADD;
+        let at = latencies.partition_point(|&l| l <= combined);
+        latencies.insert(at, combined);
+    }
+    latencies.pop().unwrap_or(0)
+}
+
+/// Removes the term of least latency (the first such).
+fn take_earliest(terms: &mut Vec<(TokenStream, u32, bool)>) -> (TokenStream, u32, bool) {
+    let at = (0..terms.len())
+        .min_by_key(|&i| (terms[i].1, i))
+        .unwrap_or(0);
+    terms.remove(at)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+
+    use proptest::prelude::*;
+    use quote::ToTokens;
+
+    use super::*;
+
+    /// `x0`, `x1`, ... for the components of z0.
+    struct Names;
+
+    impl Leaves for Names {
+        fn var(&self, var: Var) -> TokenStream {
+            let Var::Z0(i) = var else {
+                return quote!(::core::f64::NAN);
+            };
+            let name = format_ident!("x{}", i);
+            quote!(#name)
+        }
+
+        fn slice(&self, _param: u16) -> TokenStream {
+            quote!(slice)
+        }
+    }
+
+    /// The value of a node by recursion over the graph (no emission).
+    fn direct(g: &Graph, id: Id, x: &[f64]) -> f64 {
+        let v = |c: Id| direct(g, c, x);
+        match *g.node(id) {
+            Node::Const(bits) => f64::from_bits(bits),
+            Node::Var(Var::Z0(i)) => x[i as usize],
+            Node::Add(a, b) => v(a) + v(b),
+            Node::Sub(a, b) => v(a) - v(b),
+            Node::Mul(a, b) => v(a) * v(b),
+            Node::Div(a, b) => v(a) / v(b),
+            Node::Neg(a) => -v(a),
+            Node::Powi(a, n) => v(a).powi(n),
+            Node::Unary(Func::Sqrt, a) => v(a).sqrt(),
+            ref n => panic!("not in the test grammar: {n:?}"),
+        }
+    }
+
+    /// Evaluates an emitted expression: literals, names, `+ - * /`, negation, parentheses,
+    /// `.powi(n)` and `.sqrt()`.
+    fn evaluate(e: &syn::Expr, env: &HashMap<String, f64>) -> f64 {
+        use syn::{BinOp, Expr, Lit, UnOp};
+        match e {
+            Expr::Paren(p) => evaluate(&p.expr, env),
+            Expr::Group(g) => evaluate(&g.expr, env),
+            Expr::Lit(l) => match &l.lit {
+                Lit::Float(f) => f.base10_parse().expect("float"),
+                Lit::Int(i) => i.base10_parse().expect("int"),
+                other => panic!("literal {other:?}"),
+            },
+            Expr::Path(p) => env[&p.path.segments.last().expect("name").ident.to_string()],
+            Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => -evaluate(&u.expr, env),
+            Expr::Binary(b) => {
+                let (l, r) = (evaluate(&b.left, env), evaluate(&b.right, env));
+                match b.op {
+                    BinOp::Add(_) => l + r,
+                    BinOp::Sub(_) => l - r,
+                    BinOp::Mul(_) => l * r,
+                    BinOp::Div(_) => l / r,
+                    _ => panic!("operator {:?}", b.op),
+                }
+            }
+            Expr::MethodCall(m) => {
+                let receiver = evaluate(&m.receiver, env);
+                match m.method.to_string().as_str() {
+                    "sqrt" => receiver.sqrt(),
+                    "powi" => receiver.powi(evaluate(&m.args[0], env) as i32),
+                    other => panic!("method {other}"),
+                }
+            }
+            other => panic!("expression {other:?}"),
+        }
+    }
+
+    /// The roots as emitted, evaluated at `x`.
+    fn emitted(g: &Graph, roots: &[Id], x: &[f64]) -> Vec<f64> {
+        let code = emit(g, roots, &Names);
+        let stmts = &code.stmts;
+        let block: syn::Block = syn::parse2(quote!({ #stmts })).expect("statements");
+        let mut env: HashMap<String, f64> = (0..x.len()).map(|i| (format!("x{i}"), x[i])).collect();
+        for stmt in &block.stmts {
+            let syn::Stmt::Local(local) = stmt else {
+                panic!("not a let: {stmt:?}")
+            };
+            let syn::Pat::Type(typed) = &local.pat else {
+                panic!("untyped let")
+            };
+            let syn::Pat::Ident(name) = &*typed.pat else {
+                panic!("pattern")
+            };
+            let init = &local.init.as_ref().expect("initialiser").expr;
+            env.insert(name.ident.to_string(), evaluate(init, &env));
+        }
+        code.exprs
+            .iter()
+            .map(|e| evaluate(&syn::parse2(e.clone()).expect("expression"), &env))
+            .collect()
+    }
+
+    #[test]
+    fn a_late_factor_is_multiplied_last() {
+        let mut g = Graph::default();
+        let x: Vec<Id> = (0..4).map(|i| g.var(Var::Z0(i))).collect();
+        let late = g.unary(Func::Sqrt, x[0]);
+        // ((sqrt(x0) * x1) * x2) * x3: the chain as written waits on the square root thrice
+        let a = g.mul(late, x[1]);
+        let b = g.mul(a, x[2]);
+        let root = g.mul(b, x[3]);
+        let code = emit(&g, &[root], &Names);
+        let stmts = &code.stmts;
+        let block: syn::Block = syn::parse2(quote!({ #stmts })).expect("statements");
+        // the root is bound last
+        let Some(syn::Stmt::Local(local)) = block.stmts.last() else {
+            panic!("no binding: {stmts}")
+        };
+        let expr = &local.init.as_ref().expect("initialiser").expr;
+        let mut top = &**expr;
+        while let syn::Expr::Paren(p) = top {
+            top = &p.expr;
+        }
+        let syn::Expr::Binary(product) = top else {
+            panic!("not a product: {stmts}")
+        };
+        let (left, right) = (
+            product.left.to_token_stream().to_string(),
+            product.right.to_token_stream().to_string(),
+        );
+        // the square root is one operand of the last product, the other three the other
+        assert_eq!(
+            [left.contains("sqrt"), right.contains("sqrt")]
+                .iter()
+                .filter(|&&s| s)
+                .count(),
+            1,
+            "{stmts}"
+        );
+        assert!(!left.contains("sqrt") || !left.contains('*'), "{stmts}");
+        assert!(!right.contains("sqrt") || !right.contains('*'), "{stmts}");
+    }
+
+    /// A random expression over x0..x3: each op combines two earlier nodes (op 0..5: add,
+    /// sub, mul, division by 1 + b^2, negation, a shared reciprocal); several roots.
+    fn random_graph(ops: &[(u8, usize, usize)]) -> (Graph, Vec<Id>) {
+        let mut g = Graph::default();
+        let mut nodes: Vec<Id> = (0..4).map(|i| g.var(Var::Z0(i))).collect();
+        nodes.push(g.constant(2.5));
+        nodes.push(g.constant(-0.75));
+        for &(op, i, j) in ops {
+            let (a, b) = (nodes[i % nodes.len()], nodes[j % nodes.len()]);
+            let one = g.constant(1.0);
+            let node = match op % 6 {
+                0 => g.add_op(a, b),
+                1 => g.sub(a, b),
+                2 => g.mul(a, b),
+                3 => {
+                    let square = g.mul(b, b);
+                    let d = g.add_op(one, square);
+                    g.div(a, d)
+                }
+                4 => g.neg(a),
+                _ => {
+                    // the same denominator twice: emitted as one reciprocal
+                    let d = g.add_op(one, nodes[0]);
+                    let p = g.div(a, d);
+                    let q = g.div(b, d);
+                    g.sub(p, q)
+                }
+            };
+            nodes.push(node);
+        }
+        let len = nodes.len();
+        (g, nodes[len.saturating_sub(3)..].to_vec())
+    }
+
+    /// |value| with every operation on magnitudes: bounds the rounding of any association.
+    fn magnitude(g: &Graph, id: Id, x: &[f64]) -> f64 {
+        let m = |c: Id| magnitude(g, c, x);
+        match *g.node(id) {
+            Node::Add(a, b) | Node::Sub(a, b) => m(a) + m(b),
+            Node::Mul(a, b) => m(a) * m(b),
+            Node::Div(a, b) => m(a) / direct(g, b, x).abs(),
+            Node::Neg(a) => m(a),
+            Node::Powi(a, n) => m(a).powi(n),
+            _ => direct(g, id, x).abs(),
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn balanced_chains_compute_the_same_values(
+            ops in proptest::collection::vec((0u8..6, 0usize..64, 0usize..64), 1..24),
+            x in proptest::array::uniform4(0.5f64..2.0),
+        ) {
+            let (g, roots) = random_graph(&ops);
+            let got = emitted(&g, &roots, &x);
+            for (&root, got) in roots.iter().zip(got) {
+                let want = direct(&g, root, &x);
+                let scale = magnitude(&g, root, &x);
+                prop_assert!(
+                    (got - want).abs() <= 1e-12 * scale,
+                    "{got} vs {want} (scale {scale})"
+                );
+            }
         }
     }
 }

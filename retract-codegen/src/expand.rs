@@ -118,9 +118,11 @@ fn domain_check(
         let text = &guard.text;
         let (condition, kind) = match guard.kind {
             GuardKind::Denominator => (
-                quote!(#a.is_finite() && #b.is_finite() && #c.is_finite() && #a != 0.0 && #b != 0.0
-                    && #c != 0.0 && #a.is_sign_positive() == #b.is_sign_positive()
-                    && #a.is_sign_positive() == #c.is_sign_positive()),
+                // finite, non-zero and of one sign (NaN fails every comparison)
+                quote!((#a > 0.0 && #b > 0.0 && #c > 0.0 && #a < ::core::f64::INFINITY
+                        && #b < ::core::f64::INFINITY && #c < ::core::f64::INFINITY)
+                    || (#a < 0.0 && #b < 0.0 && #c < 0.0 && #a > ::core::f64::NEG_INFINITY
+                        && #b > ::core::f64::NEG_INFINITY && #c > ::core::f64::NEG_INFINITY)),
                 quote!(Denominator),
             ),
             GuardKind::SqrtArgument => (

@@ -165,22 +165,32 @@ pub struct Solution<const M: usize> {
 /// Whether every entry is finite (over the storage slice: nalgebra's element iterator is
 /// slow for small matrices, and this runs every step).
 ///
-/// $\sum_i 0 \cdot m_i$ is $\pm 0$ when every entry is finite and NaN otherwise; summed in four
-/// lanes, so the check vectorises.
+/// $\sum_i 0 \cdot m_i$ is $\pm 0$ when every entry is finite and NaN otherwise.
 #[inline]
 pub(crate) fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
-    let entries = m.as_slice();
+    lane_sum(m.as_slice(), |v| v * 0.0) == 0.0
+}
+
+/// $\sum_i |m_i|$: NaN if an entry is NaN, infinite if one is or the sum overflows.
+#[inline]
+pub(crate) fn sum_abs<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
+    lane_sum(m.as_slice(), f64::abs)
+}
+
+/// $\sum_i f(v_i)$, summed in four lanes so that it vectorises.
+#[inline]
+fn lane_sum(entries: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     let mut lanes = [0.0f64; 4];
     let mut chunks = entries.chunks_exact(4);
     for chunk in &mut chunks {
-        for (lane, v) in lanes.iter_mut().zip(chunk) {
-            *lane += v * 0.0;
+        for (lane, &v) in lanes.iter_mut().zip(chunk) {
+            *lane += f(v);
         }
     }
-    for (lane, v) in lanes.iter_mut().zip(chunks.remainder()) {
-        *lane += v * 0.0;
+    for (lane, &v) in lanes.iter_mut().zip(chunks.remainder()) {
+        *lane += f(v);
     }
-    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) == 0.0
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
 }
 
 /// $\max_i |m_i|$ (NaN entries are skipped, as by nalgebra's `amax`).
