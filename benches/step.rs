@@ -1,10 +1,11 @@
 //! Speed of one step of the paper's SE(2) obstacle system (tau = 1e-2, h = 0.01, midpoint)
 //! near its closest approach to the disc, and of the 400-step run, for:
 //! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`), with and without
-//!   the domain check (the hand-written steps have none);
+//!   the domain check;
 //! - generated, general (Newton on all 15 unknowns, `retract::step`);
 //! - hand-written dense 12x12 Newton (u = p_1,theta eliminated by hand, Jacobian by hand);
-//! - hand-written reduced 3x3 Newton on q_theta (the limit);
+//! - hand-written reduced 3x3 Newton on q_theta (the limit), without and with the generated
+//!   step's domain check;
 //! - the dense 12x12 residual with a forward-mode dual-number Jacobian (num-dual);
 //! - the dense 12x12 residual with a central finite-difference Jacobian.
 //!
@@ -183,6 +184,21 @@ fn hand_reduced_step(z0: &Z) -> Z {
     z1
 }
 
+/// The hand-written step with the generated step's domain check: s = x^2 + y^2 - 1 is finite,
+/// non-zero and of one sign at q_0, q_theta and q_1 (`None` otherwise).
+fn hand_guarded_step(z0: &Z) -> Option<Z> {
+    let z1 = hand_reduced_step(z0);
+    let s = |x: f64, y: f64| x * x + y * y - 1.0;
+    let (a, b, c) = (
+        s(z0[0], z0[1]),
+        s(0.5 * (z0[0] + z1[0]), 0.5 * (z0[1] + z1[1])),
+        s(z1[0], z1[1]),
+    );
+    let positive = a > 0.0 && b > 0.0 && c > 0.0 && a.max(b).max(c) < f64::INFINITY;
+    let negative = a < 0.0 && b < 0.0 && c < 0.0 && a.min(b).min(c) > f64::NEG_INFINITY;
+    (positive || negative).then_some(z1)
+}
+
 fn setup() -> (RigidBody, Z) {
     let system = RigidBody { tau: TAU, r: 1.0 };
     let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
@@ -233,6 +249,10 @@ fn print_ratios(system: &RigidBody, z: &Z) {
     same("reduced", &reduced.step(z, H, &options).expect("regular").0);
     same("hand dense", &dense_step(z, Jacobian::Hand));
     same("hand reduced", &hand_reduced_step(z));
+    same(
+        "hand guarded",
+        &hand_guarded_step(z).expect("outside the disc"),
+    );
     same("dual", &dense_step(z, Jacobian::Dual));
 
     let w = system.predictor(z, H, 0.5).expect("regular");
@@ -376,17 +396,23 @@ fn print_ratios(system: &RigidBody, z: &Z) {
             &mut || {
                 black_box(hand_reduced_step(black_box(z)));
             },
+            &mut || {
+                black_box(hand_guarded_step(black_box(z)));
+            },
         ],
     );
     println!(
-        "\nInterleaved (60 rounds of 2000 calls each, best): generated reduced {:.1} ns \
-         ({:.2}x the hand-written reduced step), domain check off {:.1} ns ({:.2}x), \
-         hand-written reduced {:.1} ns",
-        best[0],
-        best[0] / best[2],
+        "\nInterleaved (60 rounds of 2000 calls each, best):\n  \
+         domain check off: generated reduced {:.1} ns, hand-written reduced {:.1} ns ({:.2}x)\n  \
+         domain check on:  generated reduced {:.1} ns, hand-written reduced {:.1} ns ({:.2}x; \
+         {:.2}x the hand-written step without it)",
         best[1],
+        best[2],
         best[1] / best[2],
-        best[2]
+        best[0],
+        best[3],
+        best[0] / best[3],
+        best[0] / best[2],
     );
     let (system0, z0) = {
         let s = RigidBody { tau: TAU, r: 1.0 };
@@ -394,14 +420,6 @@ fn print_ratios(system: &RigidBody, z: &Z) {
         let z0 = s.legendre(&Z::from_column_slice(&jet));
         (s, z0)
     };
-    let run_reduced = best_ns(50, || {
-        let mut stepper = ReducedStepper::new(&system0);
-        let mut z = z0;
-        for _ in 0..400 {
-            z = stepper.step(&z, H, &options).expect("regular").0;
-        }
-        black_box(z);
-    });
     let run_general = best_ns(50, || {
         let mut z = z0;
         for _ in 0..400 {
@@ -409,19 +427,48 @@ fn print_ratios(system: &RigidBody, z: &Z) {
         }
         black_box(z);
     });
-    let run_hand = best_ns(50, || {
+    // each step waits on the last here; the reduced runs start from a fresh stepper
+    let reduced_run = |options: &StepOptions| {
+        let mut stepper = ReducedStepper::new(&system0);
         let mut z = z0;
         for _ in 0..400 {
-            z = hand_reduced_step(&z);
+            z = stepper.step(&z, H, options).expect("regular").0;
         }
         black_box(z);
-    });
+    };
+    let runs = interleaved_best_ns(
+        200,
+        3,
+        &mut [
+            &mut || reduced_run(&options),
+            &mut || {
+                let mut z = z0;
+                for _ in 0..400 {
+                    z = hand_guarded_step(&z).expect("outside the disc");
+                }
+                black_box(z);
+            },
+            &mut || reduced_run(&unguarded),
+            &mut || {
+                let mut z = z0;
+                for _ in 0..400 {
+                    z = hand_reduced_step(&z);
+                }
+                black_box(z);
+            },
+        ],
+    );
     println!(
-        "\nThe paper's 400-step run (tau = 1e-2): reduced {:.1} us ({:.2}x the hand-written \
-         reduced steps, {:.1} us), general {:.1} us\n",
-        run_reduced / 1e3,
-        run_reduced / run_hand,
-        run_hand / 1e3,
+        "\nThe paper's 400-step run (tau = 1e-2, interleaved, best of 200 rounds of 3 runs):\n  \
+         domain check on:  generated reduced {:.1} us, hand-written reduced {:.1} us ({:.2}x)\n  \
+         domain check off: generated reduced {:.1} us, hand-written reduced {:.1} us ({:.2}x)\n  \
+         generated general (domain check on) {:.1} us\n",
+        runs[0] / 1e3,
+        runs[1] / 1e3,
+        runs[0] / runs[1],
+        runs[2] / 1e3,
+        runs[3] / 1e3,
+        runs[2] / runs[3],
         run_general / 1e3
     );
 }

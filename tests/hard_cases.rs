@@ -179,6 +179,19 @@ fn reduced_step_on_non_finite_and_overflowing_states_is_an_error() {
             }
         }
     }
+    // invalid step sizes and theta, also after a valid step cached its factors
+    for h in [f64::NAN, f64::INFINITY, 0.0] {
+        assert!(matches!(
+            stepper.step(&z0, h, &options),
+            Err(Error::InvalidArgument { name: "h", .. })
+        ));
+    }
+    for theta in [f64::NAN, -0.5, 1.5] {
+        assert!(matches!(
+            stepper.step(&z0, 0.01, &options.with_theta(theta)),
+            Err(Error::InvalidArgument { name: "theta", .. })
+        ));
+    }
     // large and representable: a finite step
     let mut z = z0;
     z[3] = 1e150;

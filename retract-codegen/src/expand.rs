@@ -91,18 +91,30 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
     ))
 }
 
-/// `t_0 +- t_1 +- ...` for terms `(negative, t)`; `0.0` for none.
+/// `t_0 +- t_1 +- ...` for terms `(negative, t)` as a balanced tree (adjacent terms paired,
+/// so the additions of a long row run in parallel); `0.0` for none.
 fn signed_sum(terms: &[(bool, TokenStream)]) -> TokenStream {
-    let mut out = TokenStream::new();
-    for (i, (negative, term)) in terms.iter().enumerate() {
-        out.extend(match (i, negative) {
-            (0, false) => quote!(#term),
-            (0, true) => quote!(-#term),
-            (_, false) => quote!(+ #term),
-            (_, true) => quote!(- #term),
-        });
+    match sum_tree(terms) {
+        None => quote!(0.0),
+        Some((false, sum)) => sum,
+        Some((true, sum)) => quote!(-#sum),
     }
-    if terms.is_empty() { quote!(0.0) } else { out }
+}
+
+/// The balanced sum of `terms` as `(negative, tokens)`: the value is the tokens, negated if
+/// `negative`.
+fn sum_tree(terms: &[(bool, TokenStream)]) -> Option<(bool, TokenStream)> {
+    if terms.len() <= 1 {
+        return terms.first().cloned();
+    }
+    let (left, right) = terms.split_at(terms.len() / 2);
+    let ((na, a), (nb, b)) = (sum_tree(left)?, sum_tree(right)?);
+    Some(match (na, nb) {
+        (false, false) => (false, quote!((#a + #b))),
+        (false, true) => (false, quote!((#a - #b))),
+        (true, false) => (false, quote!((#b - #a))),
+        (true, true) => (true, quote!((#a + #b))),
+    })
 }
 
 /// `check_domain`: each guard at the three points of a step, one loop per slice guard.
@@ -698,28 +710,33 @@ fn generate(
             }
         }
         let recover_sets = (0..m).map(|row| {
-            let mut terms: Vec<(bool, TokenStream)> = (0..s)
+            let terms: Vec<(bool, TokenStream)> = (0..s)
                 .filter(|&c| t_pattern[row][c])
                 .map(|c| {
                     let (rl, cl, z) = (index(row), index(c), z0_entry(c));
                     coefficient(quote!(factors.t[(#rl, #cl)]), closed_t(row, c), z)
                 })
                 .collect();
-            terms.extend(
-                red.rows
-                    .iter()
-                    .filter(|&&q| inverse_pattern[row][q])
-                    .map(|&q| {
-                        let (rl, ql, name) = (index(row), index(q), n_name(q));
-                        let (negative, term) = coefficient(
-                            quote!(factors.a_inv[(#rl, #ql)]),
-                            closed_a_inv(row, q),
-                            quote!(#name),
-                        );
-                        (!negative, term)
-                    }),
-            );
-            signed_sum(&terms)
+            let forced: Vec<(bool, TokenStream)> = red
+                .rows
+                .iter()
+                .filter(|&&q| inverse_pattern[row][q])
+                .map(|&q| {
+                    let (rl, ql, name) = (index(row), index(q), n_name(q));
+                    let (negative, term) = coefficient(
+                        quote!(factors.a_inv[(#rl, #ql)]),
+                        closed_a_inv(row, q),
+                        quote!(#name),
+                    );
+                    (!negative, term)
+                })
+                .collect();
+            // the forcing is known last: its terms join the sum of the others at the end
+            let parts: Vec<(bool, TokenStream)> = [sum_tree(&terms), sum_tree(&forced)]
+                .into_iter()
+                .flatten()
+                .collect();
+            signed_sum(&parts)
         });
         let forcing = emit(g, &red.nonlinear_jacobian, &scheme);
         let dn_stmts = forcing.stmts;
