@@ -10,8 +10,8 @@
 //! Chains of one operation through inlined nodes (`a * b * c`, `a - b + c`) are emitted as
 //! balanced trees that combine the earliest available operands first (tree-height reduction
 //! on an estimate of each value's latency), so a long chain does not wait on its slowest
-//! operand at every step: `h * ((t * y) * r)` with `r = 1/s` late becomes
-//! `((h * y) * t) * r`. This reassociates floating-point operations, which changes results
+//! operand at every step: `h * (t * (y * r))` with `r = 1/s` known last becomes
+//! `(y * (h * t)) * r`. This reassociates floating-point operations, which changes results
 //! in the last bits only.
 
 use proc_macro2::{Literal, TokenStream};
@@ -169,7 +169,7 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
         reciprocal: &reciprocal,
         latency: Vec::new(),
     };
-    emitter.latency = (0..len).map(|_| 0).collect();
+    emitter.latency = vec![0; len];
     for i in 0..len {
         emitter.latency[i] = emitter.estimate(Id(i as u32));
     }
@@ -434,22 +434,7 @@ impl Emitter<'_> {
             return self.balanced(id, kind, in_loop);
         }
         match self.g.node(id).clone() {
-            Node::Add(a, b) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#a + #b)
-            }
-            Node::Sub(a, b) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#a - #b)
-            }
-            Node::Mul(a, b) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#a * #b)
-            }
-            Node::Div(a, b) if !in_loop && self.reciprocal[b.0 as usize] => {
-                let (a, b) = (r(a), reciprocal_name(b));
-                quote!(#a * #b)
-            }
+            // sums, products and divisions by a bound reciprocal are chains (above)
             Node::Div(a, b) => {
                 let (a, b) = (r(a), r(b));
                 quote!(#a / #b)
