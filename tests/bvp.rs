@@ -4,6 +4,7 @@
 
 mod common;
 
+use common::largest_gap;
 use common::models::Scene;
 use retract::bvp::{
     BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver, continuation,
@@ -271,12 +272,7 @@ fn continuation_in_the_barrier_weight() {
     .unwrap();
     assert_sane(&solution);
     let direct = solve_scene(&ONE_DISC, 0.01, &START, &GOAL, 4.0, 200).unwrap();
-    let diff = solution
-        .states
-        .iter()
-        .zip(&direct.states)
-        .map(|(a, b)| (a - b).amax())
-        .fold(0.0, f64::max);
+    let diff = largest_gap(&solution.states, &direct.states);
     assert!(
         diff < 1e-8,
         "continuation and direct solve differ by {diff:e}"
@@ -432,12 +428,7 @@ fn linear_solvers_agree() {
             .expect("banded");
         for other in [&reduced, &banded] {
             assert_eq!(other.iterations, condensed.iterations);
-            let gap = condensed
-                .states
-                .iter()
-                .zip(&other.states)
-                .map(|(a, b)| (a - b).amax())
-                .fold(0.0, f64::max);
+            let gap = largest_gap(&condensed.states, &other.states);
             assert!(gap < 1e-9, "T = {t_end}: solutions differ by {gap:e}");
             assert!((other.cost - condensed.cost).abs() < 1e-9 * condensed.cost.abs());
         }

@@ -344,11 +344,8 @@ impl Emitter<'_> {
         if let Some(kind) = self.head(id, false) {
             let mut ops = Vec::new();
             self.operands(id, kind, false, false, &mut ops);
-            return balanced_latency(
-                ops.iter()
-                    .map(|&(op, _)| self.operand_latency(op))
-                    .collect(),
-            );
+            let latencies = ops.iter().map(|&(op, _)| ((), self.operand_latency(op)));
+            return earliest_first(latencies.collect(), |(), ()| ()).map_or(0, |(_, l)| l);
         }
         match *self.g.node(id) {
             Node::Const(_) | Node::Var(_) | Node::Named(_) => 0,
@@ -368,43 +365,36 @@ impl Emitter<'_> {
     fn balanced(&self, id: Id, kind: Chain, in_loop: bool) -> TokenStream {
         let mut ops = Vec::new();
         self.operands(id, kind, in_loop, false, &mut ops);
-        // (tokens, latency, negated), combined in order of latency, then position
-        let mut terms: Vec<(TokenStream, u32, bool)> = ops
+        // ((negated, tokens), latency)
+        let mut terms: Vec<((bool, TokenStream), u32)> = ops
             .iter()
             .map(|&(op, negate)| {
                 let tokens = match op {
                     Operand::Node(c) => self.reference(c, in_loop),
                     Operand::Reciprocal(b) => reciprocal_name(b),
                 };
-                (tokens, self.operand_latency(op), negate)
+                ((negate, tokens), self.operand_latency(op))
             })
             .collect();
         if kind == Chain::Product {
             // the sign of a product is carried to its end
-            let negate = terms.iter().filter(|t| t.2).count() % 2 == 1;
-            for t in &mut terms {
-                t.2 = false;
-            }
-            if let Some(first) = terms.first_mut() {
-                first.2 = negate;
+            let negate = terms.iter().filter(|t| t.0.0).count() % 2 == 1;
+            for (i, t) in terms.iter_mut().enumerate() {
+                t.0.0 = i == 0 && negate;
             }
         }
-        while terms.len() > 1 {
-            let first = take_earliest(&mut terms);
-            let second = take_earliest(&mut terms);
-            let ((a, la, na), (b, lb, nb)) = (first, second);
-            let latency = la.max(lb) + ADD;
-            let combined = match (kind, na, nb) {
-                (Chain::Product, ..) => (quote!((#a * #b)), latency, na ^ nb),
-                (Chain::Sum, false, false) => (quote!((#a + #b)), latency, false),
-                (Chain::Sum, false, true) => (quote!((#a - #b)), latency, false),
-                (Chain::Sum, true, false) => (quote!((#b - #a)), latency, false),
-                (Chain::Sum, true, true) => (quote!((#a + #b)), latency, true),
-            };
-            terms.push(combined);
+        let combined = earliest_first(terms, |a, b| match kind {
+            Chain::Product => {
+                let ((na, a), (nb, b)) = (a, b);
+                (na ^ nb, quote!((#a * #b)))
+            }
+            Chain::Sum => signed_add(a, b),
+        });
+        match combined {
+            None => quote!(0.0),
+            Some(((false, tokens), _)) => tokens,
+            Some(((true, tokens), _)) => quote!(-#tokens),
         }
-        let (tokens, _, negate) = terms.pop().unwrap_or((quote!(0.0), 0, false));
-        if negate { quote!(-#tokens) } else { tokens }
     }
 
     /// How a parent refers to `id`: a leaf, a temporary, or (inlined) its parenthesised value.
@@ -469,24 +459,36 @@ impl Emitter<'_> {
     }
 }
 
-/// The latency of a balanced chain over operands of the given latencies.
-fn balanced_latency(mut latencies: Vec<u32>) -> u32 {
-    latencies.sort_unstable();
-    while latencies.len() > 1 {
-        let (a, b) = (latencies.remove(0), latencies.remove(0));
-        let combined = a.max(b) + ADD;
-        let at = latencies.partition_point(|&l| l <= combined);
-        latencies.insert(at, combined);
+/// Combines `terms` (each with the latency at which it is known) into one, repeatedly merging
+/// the two known first (the earlier position on ties) into a term known `ADD` later: the
+/// balanced tree of least latency. `None` for no terms.
+fn earliest_first<T>(
+    mut terms: Vec<(T, u32)>,
+    mut merge: impl FnMut(T, T) -> T,
+) -> Option<(T, u32)> {
+    let take = |terms: &mut Vec<(T, u32)>| {
+        let at = (0..terms.len()).min_by_key(|&i| (terms[i].1, i))?;
+        Some(terms.remove(at))
+    };
+    while terms.len() > 1 {
+        let (a, la) = take(&mut terms)?;
+        let (b, lb) = take(&mut terms)?;
+        terms.push((merge(a, b), la.max(lb) + ADD));
     }
-    latencies.pop().unwrap_or(0)
+    terms.pop()
 }
 
-/// Removes the term of least latency (the first such).
-fn take_earliest(terms: &mut Vec<(TokenStream, u32, bool)>) -> (TokenStream, u32, bool) {
-    let at = (0..terms.len())
-        .min_by_key(|&i| (terms[i].1, i))
-        .unwrap_or(0);
-    terms.remove(at)
+/// `a + b` for terms `(negated, tokens)`, as `(negated, tokens)` with no negation inside.
+pub(crate) fn signed_add(
+    (na, a): (bool, TokenStream),
+    (nb, b): (bool, TokenStream),
+) -> (bool, TokenStream) {
+    match (na, nb) {
+        (false, false) => (false, quote!((#a + #b))),
+        (false, true) => (false, quote!((#a - #b))),
+        (true, false) => (false, quote!((#b - #a))),
+        (true, true) => (true, quote!((#a + #b))),
+    }
 }
 
 #[cfg(test)]

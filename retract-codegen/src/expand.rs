@@ -108,13 +108,10 @@ fn sum_tree(terms: &[(bool, TokenStream)]) -> Option<(bool, TokenStream)> {
         return terms.first().cloned();
     }
     let (left, right) = terms.split_at(terms.len() / 2);
-    let ((na, a), (nb, b)) = (sum_tree(left)?, sum_tree(right)?);
-    Some(match (na, nb) {
-        (false, false) => (false, quote!((#a + #b))),
-        (false, true) => (false, quote!((#a - #b))),
-        (true, false) => (false, quote!((#b - #a))),
-        (true, true) => (true, quote!((#a + #b))),
-    })
+    Some(crate::codegen::signed_add(
+        sum_tree(left)?,
+        sum_tree(right)?,
+    ))
 }
 
 /// `check_domain`: each guard at the three points of a step, one loop per slice guard.

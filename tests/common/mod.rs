@@ -70,3 +70,11 @@ pub fn assert_orders(orders: &[f64], range: std::ops::Range<f64>, what: &str) {
 }
 
 pub mod models;
+
+/// $\max_k |a_k - b_k|_\infty$ over two runs' states, paired in order.
+pub fn largest_gap<const S: usize>(a: &[SVector<f64, S>], b: &[SVector<f64, S>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0, f64::max)
+}
