@@ -56,7 +56,7 @@ pub use reduced::{ClosedForm, ReducedFactors, ReducedScheme, ReducedStepper};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};
-pub use system::{Gradient, Hessian, Lagrangian, LiftedSystem};
+pub use system::{Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem};
 
 /// The linear-algebra crate of the public API, re-exported so users and generated code
 /// name the same version.

@@ -63,6 +63,21 @@ impl<const N: usize, const K: usize> Hessian<N, K> {
     }
 }
 
+/// A scalar function $g(x, u)$ of the jet $x = (q, \dots, q^{(k-1)})$ and the top derivative
+/// $u = q^{(k)}$ on $\mathbb{R}^N$ with $K = k$, with its gradient and Hessian: a stage
+/// constraint of the optimal-control solver ([`crate::bvp`]), written as plain Rust under
+/// `#[jet_function(order = k)]`.
+pub trait JetFunction<const N: usize, const K: usize> {
+    /// $g(x, u)$.
+    fn value(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> f64;
+
+    /// $(\partial g/\partial x_0, \dots, \partial g/\partial x_{k-1}, \partial g/\partial u)$.
+    fn gradient(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Gradient<N, K>;
+
+    /// The Hessian of $g$ in $(x, u)$, by blocks.
+    fn hessian(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Hessian<N, K>;
+}
+
 /// A $k$-th order Lagrangian $L(x, u)$ on $\mathbb{R}^N$ with $K = k$.
 pub trait Lagrangian<const N: usize, const K: usize> {
     /// $L(x, u)$.

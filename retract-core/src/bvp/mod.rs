@@ -24,8 +24,18 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+mod certificate;
+mod guess;
+mod optimize;
+mod riccati;
+
+pub use optimize::{
+    Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions,
+};
+
 use crate::banded::BandMatrix;
 use crate::{Error, LiftedSystem, ReducedFactors, ReducedScheme};
+use guess::Hermite;
 
 /// Options of the boundary-value solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,48 +311,19 @@ where
     /// The Hermite-spline guess, through the Legendre map.
     fn spline_guess(&self) -> Result<Vec<f64>, Error> {
         let (n, k) = (Sys::DIMENSION, Sys::ORDER);
-        let t_end = self.t_end;
-        // q_i(t) = sum_m c[m] t^m, degree 2k - 1; c[m] = a_m / m! for m < k
-        let falling = |m: usize, j: usize| -> f64 { ((m - j + 1)..=m).map(|v| v as f64).product() };
-        let mut coefficients = vec![vec![0.0; 2 * k]; n];
-        for (i, c) in coefficients.iter_mut().enumerate() {
-            for (m, cm) in c.iter_mut().enumerate().take(k) {
-                *cm = self.start[m * n + i] / falling(m, m);
-            }
-            let mut a = DMatrix::<f64>::zeros(k, k);
-            let mut rhs = DVector::<f64>::zeros(k);
-            for j in 0..k {
-                let known: f64 = (j..k)
-                    .map(|m| c[m] * falling(m, j) * t_end.powi((m - j) as i32))
-                    .sum();
-                rhs[j] = self.goal[j * n + i] - known;
-                for m in k..2 * k {
-                    a[(j, m - k)] = falling(m, j) * t_end.powi((m - j) as i32);
-                }
-            }
-            let upper = a.lu().solve(&rhs).ok_or(Error::InvalidArgument {
-                name: "t_end",
-                requirement: "the spline guess needs a non-degenerate horizon",
-            })?;
-            c[k..2 * k].copy_from_slice(upper.as_slice());
-        }
-        let derivative = |i: usize, j: usize, t: f64| -> f64 {
-            (j..2 * k)
-                .map(|m| coefficients[i][m] * falling(m, j) * t.powi((m - j) as i32))
-                .sum()
-        };
+        let spline = Hermite::new(self.start, self.goal, self.t_end, n, k)?;
         let layout = self.layout();
         let h = self.h();
         let mut v = vec![0.0; layout.size()];
         for step in 0..=self.steps {
             let t = step as f64 * h;
-            let jet = SVector::<f64, S>::from_fn(|r, _| derivative(r % n, r / n, t));
+            let jet = SVector::<f64, S>::from_fn(|r, _| spline.jet_entry(r, t));
             let z = self.system.legendre(&jet);
             v[layout.z(step)..layout.z(step) + S].copy_from_slice(z.as_slice());
             if step < self.steps {
                 let t_mid = t + self.options.theta * h;
                 for i in 0..n {
-                    v[layout.u(step) + i] = derivative(i, k, t_mid);
+                    v[layout.u(step) + i] = spline.derivative(i, k, t_mid);
                 }
             }
         }

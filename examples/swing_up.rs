@@ -1,0 +1,65 @@
+//! Swing-up suite (`../shared/BENCHMARKS.md`): rest-to-rest minimum-torque swing-ups on the
+//! lifted-midpoint transcription with N = 100 T steps from the smoothstep guess, solved by the
+//! optimizer (`OptimalControlProblem`). One line per problem:
+//! `<problem> T=<T> N=<N> J=<J> iterations=<n> time_ms=<t> min_reduced_hessian_eig=<e>`.
+//!
+//! Run: `cargo run --release --example swing_up` (add `-- quick` for T = 1 only, as the tests
+//! do).
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use retract::bvp::{OptimalControlProblem, PlanGuess};
+use retract::higher_order_lagrangian;
+
+/// Double pendulum (point masses at the rod ends, angles from the downward vertical, the
+/// second relative to the first): L = 1/2 |tau|^2, tau = M(q) q'' + C(q, q') q' + G(q).
+#[higher_order_lagrangian(order = 2)]
+fn double_pendulum(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let m22 = m2 * l2 * l2;
+    let b = m2 * l1 * l2 * s2;
+    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
+    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
+    let tau1 = m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
+    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
+    0.5 * (tau1 * tau1 + tau2 * tau2)
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let quick = std::env::args().any(|a| a == "quick");
+    let horizons: &[f64] = if quick { &[1.0] } else { &[2.0, 3.0, 4.0] };
+    let pendulum = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    for &t_end in horizons {
+        let steps = (100.0 * t_end) as usize;
+        let problem =
+            OptimalControlProblem::new(&pendulum, &[0.0; 4], &[PI, 0.0, 0.0, 0.0], t_end, steps);
+        let start = Instant::now();
+        let plan = problem.solve(PlanGuess::Spline)?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        println!(
+            "pendulum T={t_end} N={steps} J={:.6} iterations={} time_ms={ms:.1} min_reduced_hessian_eig={:.3e}",
+            plan.cost, plan.iterations, plan.certificate.min_reduced_hessian_eig
+        );
+    }
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}

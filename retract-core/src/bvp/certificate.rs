@@ -1,0 +1,142 @@
+//! What a plan is certified by: the KKT residuals with the momenta recovered from the
+//! multipliers, and the smallest eigenvalue of the reduced Hessian.
+
+use nalgebra::{DMatrix, SVector, SymmetricEigen};
+
+use super::riccati::{Dynamics, Riccati, StageModel};
+
+/// The multipliers $\mu_i$ of the scheme's $x$-equations
+/// $x_{i+1} - x_i - h A x_{\theta,i} - h B u_i = 0$, the momenta and the stationarity residual.
+///
+/// With $\lambda_{i+1}$ the cost-to-go gradient of the subproblem after step $i$ and $g_i$ the
+/// gradient of $h L$ at step $i$: $\mu_i = -W^T(\lambda_{i+1} + \theta g_{x,i})$. The gradient
+/// of the Lagrangian of the transcription is, in $u_i$, $r_{u,i} = g_{u,i} - h B^T \mu_i$ and,
+/// in $x_i$ ($0 < i < N$), $r_{x,i} = (1-\theta) d_i + \theta d_{i-1} - (\mu_i - \mu_{i-1})$
+/// with $d_i = g_{x,i} - h A^T \mu_i$; the momenta are $p_i = \mu_i - (1-\theta) d_i$ and
+/// $p_N = \mu_{N-1} + \theta d_{N-1}$ (so that $\mu_i = \theta p_i + (1-\theta) p_{i+1}$ and
+/// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). Returns the momenta and
+/// $\max(|r_u|_\infty, |r_x|_\infty) / h$.
+pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
+    dynamics: &Dynamics<N, X>,
+    stages: &[StageModel<N, X>],
+    costate: &[SVector<f64, X>],
+) -> (Vec<SVector<f64, X>>, f64) {
+    let (h, theta) = (dynamics.h, dynamics.theta);
+    let wt = dynamics.w.transpose();
+    // (A^T mu)_j = mu_{j-1}; B^T mu = the last block
+    let shift_t = |mu: &SVector<f64, X>| {
+        SVector::<f64, X>::from_fn(|r, _| if r >= N { mu[r - N] } else { 0.0 })
+    };
+    let mut momenta = Vec::with_capacity(stages.len() + 1);
+    let mut worst: f64 = 0.0;
+    let mut previous: Option<(SVector<f64, X>, SVector<f64, X>)> = None;
+    for (stage, lambda) in stages.iter().zip(costate) {
+        let mu = -(wt * (lambda + stage.gx * theta));
+        let d = stage.gx - shift_t(&mu) * h;
+        for a in 0..N {
+            worst = worst.max((stage.gu[a] - h * mu[X - N + a]).abs());
+        }
+        if let Some((mu_prev, d_prev)) = previous {
+            let r = d * (1.0 - theta) + d_prev * theta - (mu - mu_prev);
+            worst = worst.max(r.amax());
+        }
+        momenta.push(mu - d * (1.0 - theta));
+        previous = Some((mu, d));
+    }
+    if let Some((mu, d)) = previous {
+        momenta.push(mu + d * theta);
+    }
+    (momenta, worst / h)
+}
+
+/// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\, Z$ ($Z$ orthonormal) of a
+/// positive definite factorisation, by Lanczos on its inverse: the subproblem's solution
+/// operator $v \mapsto \delta$ (min $\tfrac12 \delta^T \nabla^2 J \delta - v^T \delta$ subject
+/// to the homogeneous constraints) is $Z (Z^T \nabla^2 J Z)^{-1} Z^T$, whose largest
+/// eigenvalue is the reciprocal of the one sought. NaN if Lanczos does not settle.
+pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
+    riccati: &Riccati<N, X>,
+    dynamics: &Dynamics<N, X>,
+    steps: usize,
+) -> f64 {
+    let inner = (steps - 1) * X;
+    let dim = inner + steps * N;
+    let apply = |v: &[f64]| -> Vec<f64> {
+        let linear = |i: usize| {
+            let lx = if i >= 1 && i < steps {
+                SVector::<f64, X>::from_fn(|r, _| -v[(i - 1) * X + r])
+            } else {
+                SVector::zeros()
+            };
+            let lu = SVector::<f64, N>::from_fn(|a, _| -v[inner + i * N + a]);
+            (lx, lu, SVector::zeros())
+        };
+        let zero = SVector::<f64, X>::zeros();
+        let d = riccati.solve_linear(dynamics, &linear, &zero, &zero);
+        let mut out = Vec::with_capacity(dim);
+        for dx in &d.dx[1..steps] {
+            out.extend_from_slice(dx.as_slice());
+        }
+        for du in &d.du {
+            out.extend_from_slice(du.as_slice());
+        }
+        out
+    };
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    // a start vector in the null space: the operator applied to a fixed pseudo-random vector
+    let seed: Vec<f64> = (0..dim)
+        .map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5)
+        .collect();
+    let mut q = apply(&seed);
+    let norm = dot(&q, &q).sqrt();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return f64::NAN;
+    }
+    q.iter_mut().for_each(|x| *x /= norm);
+    let mut q_prev = vec![0.0; dim];
+    let (mut alphas, mut betas) = (Vec::new(), Vec::new());
+    let mut largest = f64::NAN;
+    let mut beta = 0.0;
+    for m in 0..dim.min(150) {
+        let mut w = apply(&q);
+        for (wi, pi) in w.iter_mut().zip(&q_prev) {
+            *wi -= beta * pi;
+        }
+        let alpha = dot(&w, &q);
+        for (wi, qi) in w.iter_mut().zip(&q) {
+            *wi -= alpha * qi;
+        }
+        beta = dot(&w, &w).sqrt();
+        alphas.push(alpha);
+        betas.push(beta);
+        if m % 5 == 4 || beta <= 1e-14 * alpha.abs() {
+            let size = alphas.len();
+            let t = DMatrix::<f64>::from_fn(size, size, |r, c| {
+                if r == c {
+                    alphas[r]
+                } else if r + 1 == c || c + 1 == r {
+                    betas[r.min(c)]
+                } else {
+                    0.0
+                }
+            });
+            let eig = SymmetricEigen::new(t);
+            let Some((index, &top)) = eig
+                .eigenvalues
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(b.1))
+            else {
+                return f64::NAN;
+            };
+            let bound = beta * eig.eigenvectors[(size - 1, index)].abs();
+            largest = top;
+            if bound <= 1e-9 * top.abs() || beta <= 1e-14 * alpha.abs() {
+                return 1.0 / largest;
+            }
+        }
+        q_prev = std::mem::replace(&mut q, w);
+        q.iter_mut().for_each(|x| *x /= beta);
+    }
+    1.0 / largest
+}
