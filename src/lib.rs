@@ -4,7 +4,7 @@
 #![warn(missing_docs)]
 
 pub use retract_core::*;
-pub use retract_macros::higher_order_lagrangian;
+pub use retract_macros::{higher_order_lagrangian, jet_function};
 
 #[doc(hidden)]
 pub mod __private {

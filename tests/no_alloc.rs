@@ -73,3 +73,30 @@ fn stepping_allocates_nothing() {
     let v: Vec<f64> = Vec::with_capacity(4);
     assert!(allocations() > after && v.capacity() >= 4);
 }
+
+/// A stage constraint with a run-time list: linear in q''.
+#[retract::jet_function(order = 2)]
+fn clearance_rate(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], discs: &[[f64; 3]]) -> f64 {
+    let mut s = ddq[0] * dq[1] - ddq[1] * dq[0];
+    for d in discs {
+        s += (-((q[0] - d[0]).powi(2) + (q[1] - d[1]).powi(2)).sqrt()).exp() * d[2];
+    }
+    s
+}
+
+#[test]
+fn jet_functions_allocate_nothing() {
+    use retract::JetFunction;
+    let discs = [[0.0, 0.0, 1.0], [3.0, 2.0, 0.5]];
+    let g = ClearanceRate::new(&discs);
+    let x = [SVector::from([1.0, 2.0]), SVector::from([0.5, -0.5])];
+    let u = SVector::from([0.3, 0.1]);
+    let before = allocations();
+    let mut acc = 0.0;
+    for _ in 0..100 {
+        acc += g.value(&x, &u) + g.gradient(&x, &u).u[0] + g.hessian(&x, &u).xu[1][(0, 0)];
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "allocations in a jet function");
+    assert!(acc.is_finite() && acc != 0.0);
+}

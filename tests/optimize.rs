@@ -10,7 +10,7 @@ use retract::bvp::{
     BoundaryValueProblem, Failure, OptimalControlProblem, Plan, PlanGuess, PlanOptions,
 };
 use retract::nalgebra::{DMatrix, SVector};
-use retract::{Lagrangian, LiftedSystem, higher_order_lagrangian};
+use retract::{JetFunction, Lagrangian, LiftedSystem, higher_order_lagrangian, jet_function};
 
 /// The double pendulum of the swing-up suite (`../shared/BENCHMARKS.md`).
 #[higher_order_lagrangian(order = 2)]
@@ -109,4 +109,315 @@ fn plan_satisfies_the_lifted_scheme() {
         assert!((root.states[i] - z(i)).amax() < 1e-7, "state {i}");
     }
     assert!((root.cost - plan.cost).abs() < 1e-9 * plan.cost.abs());
+}
+
+/// The pendulum swing-up from rest at q = 0 to rest at (pi, 0) in `t_end`.
+fn pendulum_problem(
+    system: &DoublePendulum,
+    t_end: f64,
+    steps: usize,
+) -> OptimalControlProblem<'_, DoublePendulum, 2, 2, 4> {
+    const GOAL: [f64; 4] = [PI, 0.0, 0.0, 0.0];
+    OptimalControlProblem::new(system, &[0.0; 4], &GOAL, t_end, steps)
+}
+
+/// The smallest eigenvalue of Z^T (sum_i T_i^T h D^2 L T_i) Z with Z an orthonormal null-space
+/// basis of the scheme's x-equations, formed densely (SVD) in the variables
+/// (x_1, ..., x_{N-1}, u_0, ..., u_{N-1}).
+fn dense_min_reduced_eigenvalue<Sys: Lagrangian<2, 2>>(system: &Sys, plan: &Plan<2, 4>) -> f64 {
+    let (h, theta) = (plan.h, plan.theta);
+    let steps = plan.u.len();
+    let inner = (steps - 1) * 4;
+    let dim = inner + steps * 2;
+    // column of x_i entry r (None for the fixed x_0, x_N) and of u_i entry a
+    let xcol = |i: usize, r: usize| (i >= 1 && i < steps).then(|| (i - 1) * 4 + r);
+    let ucol = |i: usize, a: usize| inner + i * 2 + a;
+    let mut hessian = DMatrix::<f64>::zeros(dim, dim);
+    let mut constraints = DMatrix::<f64>::zeros(steps * 4, dim);
+    for i in 0..steps {
+        let xt = plan.x[i] * (1.0 - theta) + plan.x[i + 1] * theta;
+        let blocks = [
+            xt.fixed_rows::<2>(0).into_owned(),
+            xt.fixed_rows::<2>(2).into_owned(),
+        ];
+        let hs = system.hessian(&blocks, &plan.u[i]);
+        // y = (x_theta, u) (6 entries) as a combination of the columns
+        let mut t = DMatrix::<f64>::zeros(6, dim);
+        for r in 0..4 {
+            if let Some(c) = xcol(i, r) {
+                t[(r, c)] += 1.0 - theta;
+            }
+            if let Some(c) = xcol(i + 1, r) {
+                t[(r, c)] += theta;
+            }
+        }
+        for a in 0..2 {
+            t[(4 + a, ucol(i, a))] = 1.0;
+        }
+        let hy = DMatrix::<f64>::from_fn(6, 6, |r, c| match (r < 4, c < 4) {
+            (true, true) => hs.xx[r / 2][c / 2][(r % 2, c % 2)],
+            (true, false) => hs.xu[r / 2][(r % 2, c - 4)],
+            (false, true) => hs.xu[c / 2][(c % 2, r - 4)],
+            (false, false) => hs.uu[(r - 4, c - 4)],
+        });
+        hessian += t.transpose() * hy * &t * h;
+        // x_{i+1} - x_i - h A x_theta - h B u = 0, A the block shift
+        for r in 0..4 {
+            let row = i * 4 + r;
+            if let Some(c) = xcol(i + 1, r) {
+                constraints[(row, c)] += 1.0;
+            }
+            if let Some(c) = xcol(i, r) {
+                constraints[(row, c)] -= 1.0;
+            }
+            if r < 2 {
+                if let Some(c) = xcol(i, r + 2) {
+                    constraints[(row, c)] -= h * (1.0 - theta);
+                }
+                if let Some(c) = xcol(i + 1, r + 2) {
+                    constraints[(row, c)] -= h * theta;
+                }
+            } else {
+                constraints[(row, ucol(i, r - 2))] -= h;
+            }
+        }
+    }
+    let svd = constraints.transpose().svd(true, false);
+    let u = svd.u.unwrap();
+    // the constraints have full row rank: the null space is spanned by the left singular
+    // vectors of C^T beyond the first 4N (completed by a QR of the whole space)
+    let full = DMatrix::<f64>::from_fn(dim, dim, |r, c| {
+        if c < u.ncols() {
+            u[(r, c)]
+        } else if r == c {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    let q = full.qr().q();
+    let z = q.columns(steps * 4, dim - steps * 4).into_owned();
+    let reduced = z.transpose() * hessian * &z;
+    reduced.symmetric_eigenvalues().min()
+}
+
+#[test]
+fn certificate_eigenvalue_matches_a_dense_computation() {
+    let system = DoublePendulum { g: 9.81 };
+    let plan = pendulum_problem(&system, 1.0, 24)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let dense = dense_min_reduced_eigenvalue(&system, &plan);
+    let lanczos = plan.certificate.min_reduced_hessian_eig;
+    assert!(dense > 0.0);
+    assert!(
+        (lanczos - dense).abs() < 1e-6 * dense.abs(),
+        "Lanczos {lanczos:e}, dense {dense:e}"
+    );
+}
+
+/// The root finder on the optimality conditions returns a stationary point of the T = 2
+/// swing-up with negative curvature; the optimizer descends from the same guess to a point of
+/// lower cost with a positive definite reduced Hessian, and refuses the root finder's point as
+/// a minimum.
+#[test]
+fn the_optimizer_descends_where_the_root_finder_stops_at_a_saddle() {
+    let system = DoublePendulum { g: 9.81 };
+    let goal = [PI, 0.0, 0.0, 0.0];
+    let root = BoundaryValueProblem::new(&system, &[0.0; 4], &goal, 2.0, 200)
+        .solve(retract::bvp::Guess::Spline)
+        .unwrap();
+    let plan = pendulum_problem(&system, 2.0, 200)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    assert!(
+        plan.cost < 0.5 * root.cost,
+        "optimizer {} root finder {}",
+        plan.cost,
+        root.cost
+    );
+    assert_eq!(plan.certificate.negative_directions, 0);
+    assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+    // started at the root finder's point, the optimizer sees a KKT point with negative curvature
+    let x: Vec<_> = root
+        .states
+        .iter()
+        .map(|z| z.fixed_rows::<4>(0).into_owned())
+        .collect();
+    let u: Vec<_> = root
+        .unknowns
+        .iter()
+        .map(|w| w.fixed_rows::<2>(8).into_owned())
+        .collect();
+    let error = pendulum_problem(&system, 2.0, 200)
+        .with_options(PlanOptions::default().with_max_iterations(1))
+        .solve(PlanGuess::Path { x: &x, u: &u })
+        .unwrap_err();
+    let Failure::NotAMinimum {
+        negative_directions,
+    } = error.failure
+    else {
+        panic!("expected NotAMinimum, got {error}");
+    };
+    assert!(negative_directions > 0);
+    let last = error.last.expect("the saddle is attached");
+    assert!(last.certificate.stationarity < 1e-9 && last.certificate.feasibility < 1e-9);
+    assert!((last.cost - root.cost).abs() < 1e-9 * root.cost);
+}
+
+/// Every swing-up horizon of the suite at reduced size converges to a certified minimum whose
+/// cost decreases with the horizon (more time, less torque).
+#[test]
+fn swing_ups_converge_to_certified_minima() {
+    let system = DoublePendulum { g: 9.81 };
+    let mut previous = f64::INFINITY;
+    for t_end in [2.0, 3.0, 4.0] {
+        let plan = pendulum_problem(&system, t_end, (25.0 * t_end) as usize)
+            .solve(PlanGuess::Spline)
+            .unwrap();
+        assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+        assert!(plan.certificate.stationarity <= 1e-9 && plan.certificate.feasibility <= 1e-9);
+        assert!(
+            plan.cost < previous,
+            "T = {t_end}: {} after {previous}",
+            plan.cost
+        );
+        previous = plan.cost;
+    }
+}
+
+/// At any N the plan keeps out of the disc along every chord (checked here at 200 points per
+/// chord), and N <= 300 converges from the scene's feasible guess.
+#[test]
+fn no_plan_passes_through_the_disc_at_any_n() {
+    for steps in [2, 3, 4, 5, 6, 8, 10, 20, 50, 100, 200, 300] {
+        match solve_disc(steps, PlanOptions::default()) {
+            Ok(plan) => {
+                for (a, b) in plan.x.iter().zip(&plan.x[1..]) {
+                    for j in 0..=200 {
+                        let s = j as f64 / 200.0;
+                        let q = a.fixed_rows::<2>(0) * (1.0 - s) + b.fixed_rows::<2>(0) * s;
+                        assert!(
+                            q.norm() > 1.0,
+                            "N = {steps}: chord point {q} inside the disc"
+                        );
+                    }
+                }
+                assert!(plan.cost > 0.0, "N = {steps}: J = {}", plan.cost);
+            }
+            Err(e) => assert!(steps < 20, "N = {steps}: {e}"),
+        }
+    }
+}
+
+/// A failed solve carries the last iterate with its residuals and iteration count.
+#[test]
+fn failures_carry_the_last_iterate() {
+    let system = DoublePendulum { g: 9.81 };
+    let error = pendulum_problem(&system, 3.0, 60)
+        .with_options(PlanOptions::default().with_max_iterations(3))
+        .solve(PlanGuess::Spline)
+        .unwrap_err();
+    assert_eq!(error.failure, Failure::IterationLimit);
+    let last = error.last.as_ref().expect("an iterate");
+    assert_eq!(last.iterations, 3);
+    assert_eq!(
+        (last.x.len(), last.u.len(), last.momenta.len()),
+        (61, 60, 61)
+    );
+    assert!(last.certificate.stationarity > 1e-9 && last.certificate.stationarity.is_finite());
+    assert!(error.to_string().contains("after 3 iterations"), "{error}");
+    let timed = pendulum_problem(&system, 3.0, 60)
+        .with_options(PlanOptions::default().with_max_time(std::time::Duration::ZERO))
+        .solve(PlanGuess::Spline)
+        .unwrap_err();
+    assert_eq!(timed.failure, Failure::TimeLimit);
+    assert!(timed.last.is_some());
+    // a guess through the disc is refused before any iteration
+    let straight =
+        OptimalControlProblem::new(&OneDisc { tau: 1e-2 }, &DISC_START, &DISC_GOAL, 4.0, 40)
+            .solve(PlanGuess::Spline)
+            .unwrap_err();
+    assert!(
+        matches!(straight.failure, Failure::GuessOutsideDomain { .. }),
+        "{straight}"
+    );
+}
+
+/// The cart-pole of the swing-up suite: the cost 1/2 F^2 on the cart force.
+#[higher_order_lagrangian(order = 2)]
+fn cart_pole(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    let force = 1.3 * ddq[0] + 0.15 * q[1].cos() * ddq[1] - 0.15 * q[1].sin() * dq[1] * dq[1];
+    0.5 * force * force
+}
+
+/// The pole's generalized force tau_p = mp l cos(th) x'' + mp l^2 th'' + mp g l sin(th).
+#[jet_function(order = 2)]
+fn pole_torque(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    0.15 * q[1].cos() * ddq[0] + 0.075 * ddq[1] + 0.15 * 9.81 * q[1].sin()
+}
+
+/// The same cart-pole with the constraint as a quadratic penalty rho/2 tau_p^2 in the cost.
+#[higher_order_lagrangian(order = 2)]
+fn penalised_cart_pole(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], rho: f64) -> f64 {
+    let force = 1.3 * ddq[0] + 0.15 * q[1].cos() * ddq[1] - 0.15 * q[1].sin() * dq[1] * dq[1];
+    let torque = 0.15 * q[1].cos() * ddq[0] + 0.075 * ddq[1] + 0.15 * 9.81 * q[1].sin();
+    0.5 * force * force + 0.5 * rho * torque * torque
+}
+
+const UPRIGHT: [f64; 4] = [0.0, PI, 0.0, 0.0];
+
+/// The swing-up with the pole torque constrained to zero keeps it zero at every evaluation
+/// point, is certified, and is the limit of the quadratic-penalty problems: the force cost of
+/// the penalised optimum approaches it as the weight grows (error O(1/rho)).
+#[test]
+fn the_cart_pole_swing_up_keeps_the_pole_unactuated() {
+    let (t_end, steps) = (2.0, 50);
+    let plan = OptimalControlProblem::new(&CartPole::new(), &[0.0; 4], &UPRIGHT, t_end, steps)
+        .with_equality(&PoleTorque::new())
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+    for (i, u) in plan.u.iter().enumerate() {
+        let xt = (plan.x[i] + plan.x[i + 1]) * 0.5;
+        let blocks = [
+            xt.fixed_rows::<2>(0).into_owned(),
+            xt.fixed_rows::<2>(2).into_owned(),
+        ];
+        let torque = PoleTorque::new().value(&blocks, u);
+        assert!(torque.abs() < 1e-9, "step {i}: pole torque {torque:e}");
+    }
+    let mut previous_gap = f64::INFINITY;
+    let mut guess = None;
+    for rho in [1e3, 1e4, 1e5, 1e6] {
+        let system = PenalisedCartPole { rho };
+        let problem = OptimalControlProblem::new(&system, &[0.0; 4], &UPRIGHT, t_end, steps);
+        let penalised = match &guess {
+            Some(previous) => problem.solve(PlanGuess::Plan(previous)),
+            None => problem.solve(PlanGuess::Spline),
+        }
+        .unwrap();
+        let force_cost: f64 = (0..steps)
+            .map(|i| {
+                let xt = (penalised.x[i] + penalised.x[i + 1]) * 0.5;
+                let blocks = [
+                    xt.fixed_rows::<2>(0).into_owned(),
+                    xt.fixed_rows::<2>(2).into_owned(),
+                ];
+                plan.h * CartPole::new().lagrangian(&blocks, &penalised.u[i])
+            })
+            .sum();
+        let gap = (force_cost - plan.cost).abs();
+        println!(
+            "rho {rho:e}: force cost {force_cost} vs constrained {} (gap {gap:e})",
+            plan.cost
+        );
+        assert!(
+            gap < 0.5 * previous_gap,
+            "rho = {rho:e}: gap {gap:e} after {previous_gap:e}"
+        );
+        previous_gap = gap;
+        guess = Some(penalised);
+    }
+    assert!(previous_gap < 1e-3 * plan.cost);
 }

@@ -1,11 +1,12 @@
-//! A controller crate without std: a generated integrator, stepped without allocation.
+//! A controller crate without std: a generated integrator, stepped without allocation, and a
+//! generated stage constraint evaluated without allocation.
 //! CI builds it alone (`cargo build -p retract-no-std-check`), so `retract` has no `std`.
 #![no_std]
 #![forbid(unsafe_code)]
 
-use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
-use retract::{Error, LiftedSystem, StepOptions, step};
+use retract::{Error, JetFunction, LiftedSystem, StepOptions, step};
+use retract::{higher_order_lagrangian, jet_function};
 
 /// The SE(2) body with a barrier per disc of a run-time list (cx, cy, r).
 #[higher_order_lagrangian(order = 2)]
@@ -30,4 +31,23 @@ pub fn control_period(system: &Body<'_>, z: &mut SVector<f64, 12>, h: f64) -> Re
 /// The state for a jet (q, q', q'', q''').
 pub fn start(system: &Body<'_>, jet: &[f64; 12]) -> SVector<f64, 12> {
     system.legendre(&SVector::from_column_slice(jet))
+}
+
+/// A stage constraint linear in q'' (no Lagrangian could be): heading rate times a speed,
+/// with transcendental terms and a run-time list.
+#[jet_function(order = 2)]
+pub fn heading(q: [f64; 3], dq: [f64; 3], ddq: [f64; 3], discs: &[[f64; 3]]) -> f64 {
+    let mut s = ddq[2] * (dq[0].powi(2) + dq[1].powi(2)).sqrt() + q[2].sin().atan2(1.0);
+    for d in discs {
+        s += (-(q[0] - d[0]).powi(2)).exp();
+    }
+    s
+}
+
+/// g(x, u) and dg/du_2 + d2g/du_2^2 at (x, u): all three generated methods, without std.
+pub fn constraint(g: &Heading<'_>, x: &[SVector<f64, 3>; 2], u: &SVector<f64, 3>) -> (f64, f64) {
+    (
+        g.value(x, u),
+        g.gradient(x, u).u[2] + g.hessian(x, u).uu[(2, 2)],
+    )
 }

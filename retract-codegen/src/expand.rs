@@ -10,7 +10,7 @@ use crate::graph::Id;
 use crate::graph::{Graph, Var};
 use crate::lower::{Guard, GuardKind, Lower};
 use crate::mechanics::{self, Degenerate, Mechanics};
-use crate::signature::{self, Kind, Signature};
+use crate::signature::{self, Attribute, Kind, Signature};
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
@@ -37,7 +37,7 @@ pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
 /// The expansion, or the errors of the input combined into one `syn::Error`.
 pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
     let function: ItemFn = syn::parse2(item)?;
-    let sig = signature::parse(attr, &function)?;
+    let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;
     let mut graph = Graph::default();
     let (root, guards) = {
         let mut lower = Lower::new(&mut graph, &sig);
@@ -263,6 +263,222 @@ impl Leaves for Names<'_> {
     }
 }
 
+/// q^(order)[i] inside a method taking `(x, u)`: `x[order][i]` below the top order k,
+/// `u[i]` at it.
+fn xu_leaf(k: usize, order: u8, i: u16) -> TokenStream {
+    let i = index(i as usize);
+    if (order as usize) < k {
+        let o = index(order as usize);
+        quote!(x[#o][#i])
+    } else {
+        quote!(u[#i])
+    }
+}
+
+/// The math methods for no_std (with std the inherent f64 methods take precedence).
+pub(crate) fn float_import() -> TokenStream {
+    quote!(
+        #[allow(unused_imports)]
+        use ::retract::__private::Float as _;
+    )
+}
+
+/// The lints allowed on generated impls.
+pub(crate) fn allow_generated() -> TokenStream {
+    quote!(#[allow(
+        unused_imports,
+        unused_variables,
+        unused_mut,
+        unused_parens,
+        clippy::all,
+        clippy::pedantic,
+        clippy::nursery
+    )])
+}
+
+/// The annotated function as it is re-emitted: the generated code does not call it; it
+/// stays for users to call.
+pub(crate) fn callable(function: &ItemFn) -> ItemFn {
+    let mut function = function.clone();
+    function.block.stmts.insert(
+        0,
+        syn::parse_quote!(
+            #[allow(unused_imports)]
+            use ::retract::__private::Float as _;
+        ),
+    );
+    function
+        .attrs
+        .push(syn::parse_quote!(#[allow(dead_code, clippy::too_many_arguments)]));
+    function
+}
+
+/// The pieces of the generated parameter struct.
+pub(crate) struct ParamTokens {
+    /// `<'a>` when a parameter is a slice, else nothing.
+    pub generics: TokenStream,
+    /// The type with its generics.
+    pub ty_full: TokenStream,
+    /// The public fields, documented.
+    pub fields: Vec<TokenStream>,
+    /// The arguments of `new`.
+    pub ctor_args: Vec<TokenStream>,
+    /// The field names, in order.
+    pub field_names: Vec<syn::Ident>,
+}
+
+/// The parameter struct of `sig`; `symbol` names the function in the docs (`L`, `g`).
+pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
+    let ty = &sig.type_name;
+    let has_slice = sig.params.iter().any(|p| matches!(p.kind, Kind::Slice(_)));
+    let (generics, ty_full) = if has_slice {
+        (quote!(<'a>), quote!(#ty<'a>))
+    } else {
+        (quote!(), quote!(#ty))
+    };
+    let fields = sig
+        .params
+        .iter()
+        .map(|p| {
+            let name = &p.name;
+            let (t, doc) = match p.kind {
+                Kind::Scalar => (quote!(f64), format!("Parameter `{name}`.")),
+                Kind::Array(len) => {
+                    let l = index(len);
+                    (quote!([f64; #l]), format!("Parameter `{name}`."))
+                }
+                Kind::Slice(len) => {
+                    let l = index(len);
+                    (
+                        quote!(&'a [[f64; #l]]),
+                        format!("Parameter list `{name}` (any length; {symbol} sums over it)."),
+                    )
+                }
+            };
+            quote!(#[doc = #doc] pub #name: #t)
+        })
+        .collect();
+    let ctor_args = sig
+        .params
+        .iter()
+        .map(|p| {
+            let name = &p.name;
+            match p.kind {
+                Kind::Scalar => quote!(#name: f64),
+                Kind::Array(len) => {
+                    let l = index(len);
+                    quote!(#name: [f64; #l])
+                }
+                Kind::Slice(len) => {
+                    let l = index(len);
+                    quote!(#name: &'a [[f64; #l]])
+                }
+            }
+        })
+        .collect();
+    let field_names = sig.params.iter().map(|p| p.name.clone()).collect();
+    ParamTokens {
+        generics,
+        ty_full,
+        fields,
+        ctor_args,
+        field_names,
+    }
+}
+
+/// The bodies of the value, gradient and Hessian methods of a scalar function of the jet,
+/// in `(x, u)`: shared by `Lagrangian` and `JetFunction`.
+pub(crate) struct ScalarBodies {
+    /// The value (`lagrangian` / `value`).
+    pub value: TokenStream,
+    /// The gradient, as a `Gradient`.
+    pub gradient: TokenStream,
+    /// The Hessian, as a `Hessian`; structural zeros are not computed.
+    pub hessian: TokenStream,
+}
+
+/// Straight-line bodies for `value`, its `gradient` (entry `j * n + i` is d/dq^(j)_i) and its
+/// symmetric `hessian` over the same index, as built by `mechanics::derivatives`.
+pub(crate) fn scalar_bodies(
+    g: &Graph,
+    sig: &Signature,
+    value: Id,
+    gradient: &[Id],
+    hessian: &[Vec<Id>],
+) -> ScalarBodies {
+    let (n, k) = (sig.dim, sig.order);
+    let core = quote!(::retract::__private::retract_core);
+    let float = float_import();
+    let in_xu = |order: u8, i: u16| xu_leaf(k, order, i);
+    let xu = Names { sig, jet: &in_xu };
+
+    let value_code = emit(g, &[value], &xu);
+    let (l_stmts, l_expr) = (value_code.stmts, &value_code.exprs[0]);
+
+    let gradient_code = emit(g, gradient, &xu);
+    let g_stmts = gradient_code.stmts;
+    let g_sets = gradient.iter().enumerate().filter_map(|(a, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &gradient_code.exprs[a];
+        let (j, i) = (a / n, index(a % n));
+        Some(if j < k {
+            let j = index(j);
+            quote!(__out.x[#j][#i] = #e;)
+        } else {
+            quote!(__out.u[#i] = #e;)
+        })
+    });
+
+    let flat_h: Vec<_> = hessian.iter().flatten().copied().collect();
+    let hessian_code = emit(g, &flat_h, &xu);
+    let h_stmts = hessian_code.stmts;
+    let dim = n * (k + 1);
+    let h_sets = flat_h.iter().enumerate().filter_map(|(r, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let e = &hessian_code.exprs[r];
+        let (a, b) = (r / dim, r % dim);
+        let (ja, ia, jb, ib) = (a / n, index(a % n), b / n, index(b % n));
+        Some(match (ja < k, jb < k) {
+            (true, true) => {
+                let (ja, jb) = (index(ja), index(jb));
+                quote!(__out.xx[#ja][#jb][(#ia, #ib)] = #e;)
+            }
+            (true, false) => {
+                let ja = index(ja);
+                quote!(__out.xu[#ja][(#ia, #ib)] = #e;)
+            }
+            (false, true) => return None, // the transpose, stored in xu
+            (false, false) => quote!(__out.uu[(#ia, #ib)] = #e;),
+        })
+    });
+
+    ScalarBodies {
+        value: quote! {
+            #float
+            #l_stmts
+            #l_expr
+        },
+        gradient: quote! {
+            #float
+            #g_stmts
+            let mut __out = #core::Gradient::zeros();
+            #(#g_sets)*
+            __out
+        },
+        hessian: quote! {
+            #float
+            #h_stmts
+            let mut __out = #core::Hessian::zeros();
+            #(#h_sets)*
+            __out
+        },
+    }
+}
+
 fn generate(
     function: &ItemFn,
     sig: &Signature,
@@ -281,47 +497,13 @@ fn generate(
     let ty = &sig.type_name;
     let vis = &function.vis;
     let fn_name = &function.sig.ident;
-    let has_slice = sig.params.iter().any(|p| matches!(p.kind, Kind::Slice(_)));
-    let (generics, ty_full) = if has_slice {
-        (quote!(<'a>), quote!(#ty<'a>))
-    } else {
-        (quote!(), quote!(#ty))
-    };
-
-    // the parameter struct
-    let fields = sig.params.iter().map(|p| {
-        let name = &p.name;
-        let (t, doc) = match p.kind {
-            Kind::Scalar => (quote!(f64), format!("Parameter `{name}`.")),
-            Kind::Array(len) => {
-                let l = index(len);
-                (quote!([f64; #l]), format!("Parameter `{name}`."))
-            }
-            Kind::Slice(len) => {
-                let l = index(len);
-                (
-                    quote!(&'a [[f64; #l]]),
-                    format!("Parameter list `{name}` (any length; L sums over it)."),
-                )
-            }
-        };
-        quote!(#[doc = #doc] pub #name: #t)
-    });
-    let ctor_args = sig.params.iter().map(|p| {
-        let name = &p.name;
-        match p.kind {
-            Kind::Scalar => quote!(#name: f64),
-            Kind::Array(len) => {
-                let l = index(len);
-                quote!(#name: [f64; #l])
-            }
-            Kind::Slice(len) => {
-                let l = index(len);
-                quote!(#name: &'a [[f64; #l]])
-            }
-        }
-    });
-    let field_names = sig.params.iter().map(|p| &p.name);
+    let ParamTokens {
+        generics,
+        ty_full,
+        fields,
+        ctor_args,
+        field_names,
+    } = param_tokens(sig, "L");
     let body_text = tidy(&function.block.to_token_stream().to_string());
     let struct_doc = format!(
         "The order-{k} Lagrangian [`{fn_name}`] on R^{n} with its parameters, as a system for \
@@ -331,15 +513,7 @@ fn generate(
     );
 
     // q^(order)[index] in each method
-    let in_xu = |order: u8, i: u16| {
-        let i = index(i as usize);
-        if (order as usize) < k {
-            let o = index(order as usize);
-            quote!(x[#o][#i])
-        } else {
-            quote!(u[#i])
-        }
-    };
+    let in_xu = |order: u8, i: u16| xu_leaf(k, order, i);
     let in_jet = |order: u8, i: u16| {
         let i = index(i as usize);
         if (order as usize) < k {
@@ -355,49 +529,11 @@ fn generate(
     let jet = Names { sig, jet: &in_jet };
     let scheme = Names { sig, jet: &none };
 
-    let lagrangian = emit(g, &[mech.lagrangian], &xu);
-    let (l_stmts, l_expr) = (lagrangian.stmts, &lagrangian.exprs[0]);
-
-    let gradient = emit(g, &mech.gradient, &xu);
-    let g_stmts = gradient.stmts;
-    let g_sets = mech.gradient.iter().enumerate().filter_map(|(a, &id)| {
-        if g.is_const(id, 0.0) {
-            return None;
-        }
-        let e = &gradient.exprs[a];
-        let (j, i) = (a / n, index(a % n));
-        Some(if j < k {
-            let j = index(j);
-            quote!(__out.x[#j][#i] = #e;)
-        } else {
-            quote!(__out.u[#i] = #e;)
-        })
-    });
-
-    let flat_h: Vec<_> = mech.hessian.iter().flatten().copied().collect();
-    let hessian = emit(g, &flat_h, &xu);
-    let h_stmts = hessian.stmts;
-    let dim = n * (k + 1);
-    let h_sets = flat_h.iter().enumerate().filter_map(|(r, &id)| {
-        if g.is_const(id, 0.0) {
-            return None;
-        }
-        let e = &hessian.exprs[r];
-        let (a, b) = (r / dim, r % dim);
-        let (ja, ia, jb, ib) = (a / n, index(a % n), b / n, index(b % n));
-        Some(match (ja < k, jb < k) {
-            (true, true) => {
-                let (ja, jb) = (index(ja), index(jb));
-                quote!(__out.xx[#ja][#jb][(#ia, #ib)] = #e;)
-            }
-            (true, false) => {
-                let ja = index(ja);
-                quote!(__out.xu[#ja][(#ia, #ib)] = #e;)
-            }
-            (false, true) => return None, // the transpose, stored in xu
-            (false, false) => quote!(__out.uu[(#ia, #ib)] = #e;),
-        })
-    });
+    let ScalarBodies {
+        value: l_body,
+        gradient: g_body,
+        hessian: h_body,
+    } = scalar_bodies(g, sig, mech.lagrangian, &mech.gradient, &mech.hessian);
 
     let momenta = emit(g, &mech.momenta, &jet);
     let p_stmts = momenta.stmts;
@@ -532,20 +668,8 @@ fn generate(
         }
     });
 
-    // math methods for no_std (with std the inherent f64 methods take precedence)
-    let float = quote!(
-        #[allow(unused_imports)]
-        use ::retract::__private::Float as _;
-    );
-    let allow = quote!(#[allow(
-        unused_imports,
-        unused_variables,
-        unused_mut,
-        unused_parens,
-        clippy::all,
-        clippy::pedantic,
-        clippy::nursery
-    )]);
+    let float = float_import();
+    let allow = allow_generated();
     let reduced_unknowns = index(reduced.map_or(0, |r| r.core.len()));
     let reduced_impl = reduced.map(|red| {
         let r = red.core.len();
@@ -908,18 +1032,7 @@ fn generate(
 
     let jet_blocks = quote!([#vec_n; #k_lit]);
 
-    // The generated code does not call the function; it stays for users to call.
-    let mut function = function.clone();
-    function.block.stmts.insert(
-        0,
-        syn::parse_quote!(
-            #[allow(unused_imports)]
-            use ::retract::__private::Float as _;
-        ),
-    );
-    function
-        .attrs
-        .push(syn::parse_quote!(#[allow(dead_code, clippy::too_many_arguments)]));
+    let function = callable(function);
 
     quote! {
         #function
@@ -956,27 +1069,17 @@ fn generate(
         impl #generics #core::Lagrangian<#n_lit, #k_lit> for #ty_full {
             /// L(x, u), straight-line code of the annotated function.
             fn lagrangian(&self, x: &#jet_blocks, u: &#vec_n) -> f64 {
-                #float
-                #l_stmts
-                #l_expr
+                #l_body
             }
 
             /// (dL/dx_0, ..., dL/dx_{k-1}, dL/du), differentiated at compile time.
             fn gradient(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Gradient<#n_lit, #k_lit> {
-                #float
-                #g_stmts
-                let mut __out = #core::Gradient::zeros();
-                #(#g_sets)*
-                __out
+                #g_body
             }
 
             /// The Hessian of L in (x, u); structural zeros are not computed.
             fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
-                #float
-                #h_stmts
-                let mut __out = #core::Hessian::zeros();
-                #(#h_sets)*
-                __out
+                #h_body
             }
 
             /// Ostrogradsky momenta p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j.

@@ -1,11 +1,13 @@
-//! The expansion behind `#[higher_order_lagrangian]`, as ordinary functions over
-//! `proc_macro2` tokens so that it can be unit-tested, fuzzed and benchmarked.
+//! The expansions behind `#[higher_order_lagrangian]` and `#[jet_function]`, as ordinary
+//! functions over `proc_macro2` tokens so that they can be unit-tested, fuzzed and
+//! benchmarked.
 //!
 //! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically and
 //! emits straight-line code for the `retract_core` traits. The stages, one module each:
 //! `signature` (order, dimension, parameters) -> `lower` (body to a hash-consed expression
 //! graph) -> `mechanics` (gradient, Hessian, momenta, scheme) -> `codegen` (one `let` per
-//! shared node).
+//! shared node). `#[jet_function]` (module `jet_function`) reuses them for a scalar function
+//! of the jet, emitting only its value, gradient and Hessian.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -13,6 +15,7 @@ mod codegen;
 mod diff;
 mod expand;
 mod graph;
+mod jet_function;
 mod lower;
 mod mechanics;
 mod signature;
@@ -20,3 +23,4 @@ mod signature;
 pub mod samples;
 
 pub use expand::{expand, try_expand};
+pub use jet_function::{expand_jet_function, try_expand_jet_function};

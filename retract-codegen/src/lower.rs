@@ -115,8 +115,10 @@ impl<'a> Lower<'a> {
         }
     }
 
+    /// Records an error; messages name a Lagrangian, reworded for `#[jet_function]`.
     fn error(&mut self, span: Span, msg: impl Into<String>) -> Id {
-        self.errors.push(syn::Error::new(span, msg.into()));
+        let msg = self.sig.attribute.reword(msg.into());
+        self.errors.push(syn::Error::new(span, msg));
         self.g.constant(0.0)
     }
 

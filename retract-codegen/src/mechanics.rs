@@ -54,13 +54,20 @@ fn jet(order: usize, index: usize) -> Var {
     }
 }
 
-/// Builds the mechanics of L = `lagrangian` of order k on R^n.
-pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechanics, Degenerate> {
+/// The gradient of `f` in the jet q, ..., q^(k) on R^n (entry `j * n + i` is df/dq^(j)_i) and
+/// its Hessian over the same index, full and symmetric (shared ids), with the differentiator
+/// that computed them (its memo serves later derivatives).
+pub fn derivatives(
+    g: &mut Graph,
+    f: Id,
+    n: usize,
+    k: usize,
+) -> (Differentiator, Vec<Id>, Vec<Vec<Id>>) {
     let mut d = Differentiator::default();
     let vars: Vec<Var> = (0..=k)
         .flat_map(|j| (0..n).map(move |i| jet(j, i)))
         .collect();
-    let gradient: Vec<Id> = vars.iter().map(|&v| d.diff(g, lagrangian, v)).collect();
+    let gradient: Vec<Id> = vars.iter().map(|&v| d.diff(g, f, v)).collect();
     let m = vars.len();
     let mut hessian = vec![vec![g.constant(0.0); m]; m];
     for a in 0..m {
@@ -70,6 +77,12 @@ pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechan
             hessian[b][a] = h;
         }
     }
+    (d, gradient, hessian)
+}
+
+/// Builds the mechanics of L = `lagrangian` of order k on R^n.
+pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechanics, Degenerate> {
+    let (mut d, gradient, hessian) = derivatives(g, lagrangian, n, k);
 
     // Degeneracy in the top derivative.
     let top = k * n;

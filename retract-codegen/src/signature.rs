@@ -28,6 +28,33 @@ impl Kind {
     }
 }
 
+/// The attribute being expanded, for its options and its messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Attribute {
+    /// `#[higher_order_lagrangian]`: a Lagrangian and its integrator.
+    Lagrangian,
+    /// `#[jet_function]`: a scalar function of the jet with its gradient and Hessian.
+    JetFunction,
+}
+
+impl Attribute {
+    /// The attribute's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Attribute::Lagrangian => "higher_order_lagrangian",
+            Attribute::JetFunction => "jet_function",
+        }
+    }
+
+    /// A message written for a Lagrangian, reworded for the function this attribute takes.
+    pub fn reword(self, msg: String) -> String {
+        match self {
+            Attribute::Lagrangian => msg,
+            Attribute::JetFunction => msg.replace("Lagrangian", "jet function"),
+        }
+    }
+}
+
 /// A parameter: an argument after the jet.
 #[derive(Clone, Debug)]
 pub struct Param {
@@ -52,6 +79,8 @@ pub struct Signature {
     pub type_name: Ident,
     /// Whether the domain check (singularity guard) is emitted.
     pub guard: bool,
+    /// The attribute that is expanded.
+    pub attribute: Attribute,
 }
 
 /// Options of the attribute.
@@ -61,7 +90,7 @@ struct Options {
     guard: bool,
 }
 
-fn parse_options(attr: TokenStream) -> syn::Result<Options> {
+fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options> {
     let mut options = Options {
         order: None,
         name: None,
@@ -82,7 +111,7 @@ fn parse_options(attr: TokenStream) -> syn::Result<Options> {
         } else if meta.path.is_ident("name") {
             options.name = Some(meta.value()?.parse()?);
             Ok(())
-        } else if meta.path.is_ident("guard") {
+        } else if meta.path.is_ident("guard") && attribute == Attribute::Lagrangian {
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
@@ -140,19 +169,22 @@ fn camel(name: &Ident) -> Ident {
     Ident::new(&s, name.span())
 }
 
-/// Checks the attribute and the signature of `item`.
-pub fn parse(attr: TokenStream, item: &ItemFn) -> syn::Result<Signature> {
-    let options = parse_options(attr)?;
+/// Checks the attribute and the signature of `item` under `attribute`.
+pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
+    let options = parse_options(attr, attribute)?;
     let sig = &item.sig;
     let mut errors: Vec<syn::Error> = Vec::new();
     let fail = |errors: &mut Vec<syn::Error>, span: Span, msg: String| {
-        errors.push(syn::Error::new(span, msg))
+        errors.push(syn::Error::new(span, attribute.reword(msg)))
     };
 
     let Some((order, order_span)) = options.order else {
         return Err(syn::Error::new(
             Span::call_site(),
-            "missing the order: write #[higher_order_lagrangian(order = k)] with k in 1..=4",
+            format!(
+                "missing the order: write #[{}(order = k)] with k in 1..=4",
+                attribute.name()
+            ),
         ));
     };
     if let Some(c) = &sig.constness {
@@ -315,5 +347,6 @@ pub fn parse(attr: TokenStream, item: &ItemFn) -> syn::Result<Signature> {
         params,
         type_name: options.name.unwrap_or_else(|| camel(&sig.ident)),
         guard: options.guard,
+        attribute,
     })
 }

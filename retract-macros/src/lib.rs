@@ -1,5 +1,5 @@
-//! The `#[higher_order_lagrangian]` attribute of `retract`; the expansion lives in
-//! `retract-codegen`.
+//! The `#[higher_order_lagrangian]` and `#[jet_function]` attributes of `retract`; the
+//! expansions live in `retract-codegen`.
 #![forbid(unsafe_code)]
 
 use proc_macro::TokenStream;
@@ -21,4 +21,24 @@ use proc_macro::TokenStream;
 #[proc_macro_attribute]
 pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand(attr.into(), item.into()).into()
+}
+
+/// Turns a scalar function of the jet into a `retract::JetFunction` (value, gradient and
+/// Hessian), e.g. a stage constraint of the optimal-control solver.
+///
+/// ```text
+/// #[jet_function(order = 2)]
+/// fn pole_torque(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], mp: f64, l: f64, g: f64) -> f64 {
+///     mp * l * q[1].cos() * ddq[0] + mp * l * l * ddq[1] + mp * g * l * q[1].sin()
+/// }
+/// ```
+///
+/// The signature, the body and the options (`order = k`, required; `name = TypeName`) follow
+/// `#[higher_order_lagrangian]`, but g may be linear in, or independent of, q^(k): only
+/// `value`, `gradient` and `hessian` in (x, u) are generated, on a type named after the
+/// function (`PoleTorque`) with the parameters as public fields and `new`. The function
+/// stays callable.
+#[proc_macro_attribute]
+pub fn jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
+    retract_codegen::expand_jet_function(attr.into(), item.into()).into()
 }

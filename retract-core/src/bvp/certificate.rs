@@ -3,23 +3,23 @@
 
 use nalgebra::{DMatrix, SVector, SymmetricEigen};
 
-use super::riccati::{Dynamics, Riccati, StageModel};
+use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
 
 /// The multipliers $\mu_i$ of the scheme's $x$-equations
 /// $x_{i+1} - x_i - h A x_{\theta,i} - h B u_i = 0$, the momenta and the stationarity residual.
 ///
 /// With $\lambda_{i+1}$ the cost-to-go gradient of the subproblem after step $i$ and $g_i$ the
-/// gradient of $h L$ at step $i$: $\mu_i = -W^T(\lambda_{i+1} + \theta g_{x,i})$. The gradient
+/// gradient of $h L + y_i^T g$ at step $i$ ($y_i$ the multipliers of the stage constraints): $\mu_i = -W^T(\lambda_{i+1} + \theta g_{x,i})$. The gradient
 /// of the Lagrangian of the transcription is, in $u_i$, $r_{u,i} = g_{u,i} - h B^T \mu_i$ and,
 /// in $x_i$ ($0 < i < N$), $r_{x,i} = (1-\theta) d_i + \theta d_{i-1} - (\mu_i - \mu_{i-1})$
 /// with $d_i = g_{x,i} - h A^T \mu_i$; the momenta are $p_i = \mu_i - (1-\theta) d_i$ and
 /// $p_N = \mu_{N-1} + \theta d_{N-1}$ (so that $\mu_i = \theta p_i + (1-\theta) p_{i+1}$ and
-/// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). Returns the momenta and
-/// $\max(|r_u|_\infty, |r_x|_\infty) / h$.
+/// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). Returns the momenta and the relative
+/// stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla L|_\infty))$.
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stages: &[StageModel<N, X>],
-    costate: &[SVector<f64, X>],
+    direction: &Direction<N, X>,
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
     let wt = dynamics.w.transpose();
@@ -29,12 +29,21 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     };
     let mut momenta = Vec::with_capacity(stages.len() + 1);
     let mut worst: f64 = 0.0;
+    let mut scale: f64 = 1.0;
     let mut previous: Option<(SVector<f64, X>, SVector<f64, X>)> = None;
-    for (stage, lambda) in stages.iter().zip(costate) {
-        let mu = -(wt * (lambda + stage.gx * theta));
-        let d = stage.gx - shift_t(&mu) * h;
+    for ((stage, lambda), y) in stages
+        .iter()
+        .zip(&direction.costate)
+        .zip(&direction.multipliers)
+    {
+        scale = scale.max(stage.gx.amax() / h).max(stage.gu.amax() / h);
+        // the gradient of the stage's Lagrangian h L + y^T g
+        let gx = stage.gx + stage.cx.transpose() * y;
+        let gu = stage.gu + stage.cu.transpose() * y;
+        let mu = -(wt * (lambda + gx * theta));
+        let d = gx - shift_t(&mu) * h;
         for a in 0..N {
-            worst = worst.max((stage.gu[a] - h * mu[X - N + a]).abs());
+            worst = worst.max((gu[a] - h * mu[X - N + a]).abs());
         }
         if let Some((mu_prev, d_prev)) = previous {
             let r = d * (1.0 - theta) + d_prev * theta - (mu - mu_prev);
@@ -46,7 +55,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     if let Some((mu, d)) = previous {
         momenta.push(mu + d * theta);
     }
-    (momenta, worst / h)
+    (momenta, worst / (h * scale))
 }
 
 /// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\, Z$ ($Z$ orthonormal) of a
@@ -69,7 +78,12 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
                 SVector::zeros()
             };
             let lu = SVector::<f64, N>::from_fn(|a, _| -v[inner + i * N + a]);
-            (lx, lu, SVector::zeros())
+            StageLinear {
+                lx,
+                lu,
+                defect: SVector::zeros(),
+                constraint: SVector::zeros(),
+            }
         };
         let zero = SVector::<f64, X>::zeros();
         let d = riccati.solve_linear(dynamics, &linear, &zero, &zero);

@@ -28,6 +28,7 @@ mod certificate;
 mod guess;
 mod optimize;
 mod riccati;
+mod sqp;
 
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions,

@@ -26,12 +26,12 @@
 
 use std::time::{Duration, Instant};
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 
-use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::guess::Hermite;
-use super::riccati::{Dynamics, Riccati, StageModel};
-use crate::{DomainViolation, Error, Lagrangian, LiftedSystem};
+use super::riccati::Dynamics;
+use super::sqp::Sqp;
+use crate::{DomainViolation, Error, JetFunction, Lagrangian, LiftedSystem};
 
 /// Options of [`OptimalControlProblem::solve`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,8 +39,8 @@ use crate::{DomainViolation, Error, Lagrangian, LiftedSystem};
 pub struct PlanOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
     pub theta: f64,
-    /// Converged when the stationarity residual (per unit time) and the constraint violation
-    /// are both below this.
+    /// Converged when the relative stationarity ([`Certificate::stationarity`]) and the
+    /// constraint violation are both below this.
     pub tolerance: f64,
     /// Iteration budget.
     pub max_iterations: usize,
@@ -118,8 +118,9 @@ pub enum PlanGuess<'a, const N: usize, const X: usize> {
 /// What a returned plan is certified to satisfy.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Certificate {
-    /// Max-norm of the gradient of the Lagrangian of the transcription divided by $h$
-    /// (stationarity per unit time), with the multipliers of the last subproblem.
+    /// Max-norm of the gradient of the Lagrangian of the transcription, with the multipliers
+    /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
+    /// unit time relative to the size of the gradient of $L$.
     pub stationarity: f64,
     /// Max-norm of the constraint violation (dynamics defects, boundary data).
     pub feasibility: f64,
@@ -186,8 +187,9 @@ pub enum Failure {
 }
 
 /// A failed solve: the reason and, where there was one, the last iterate with its residuals
-/// (its `certificate` describes it; it is not a minimum).
-#[derive(Clone, Debug, PartialEq)]
+/// (its `certificate` describes it; it is not a minimum). Its `Debug` output summarises the
+/// iterate instead of listing it.
+#[derive(Clone, PartialEq)]
 pub struct PlanError<const N: usize, const X: usize> {
     /// Why.
     pub failure: Failure,
@@ -253,6 +255,20 @@ impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
     }
 }
 
+impl<const N: usize, const X: usize> core::fmt::Debug for PlanError<N, X> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let mut d = f.debug_struct("PlanError");
+        d.field("failure", &self.failure);
+        if let Some(last) = &self.last {
+            d.field("steps", &last.u.len())
+                .field("iterations", &last.iterations)
+                .field("cost", &last.cost)
+                .field("certificate", &last.certificate);
+        }
+        d.finish()
+    }
+}
+
 impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 
 /// An optimal-control problem: minimise $\sum_i h\,L(x_{\theta,i}, u_i)$ over the lifted
@@ -260,27 +276,28 @@ impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 ///
 /// `N` is the dimension $n$, `K` the order $k$ and `X` $= nk$ the length of a jet; `S` and
 /// `M` are those of the system's [`LiftedSystem`] (used for its singularity guard).
-pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const X: usize> {
-    system: &'a Sys,
-    start: SVector<f64, X>,
-    goal: SVector<f64, X>,
+pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize> {
+    pub(super) system: &'a Sys,
+    pub(super) equalities: Vec<&'a dyn JetFunction<N, K>>,
+    pub(super) start: SVector<f64, X>,
+    pub(super) goal: SVector<f64, X>,
     t_end: f64,
-    steps: usize,
-    options: PlanOptions,
+    pub(super) steps: usize,
+    pub(super) options: PlanOptions,
 }
 
-impl<'a, Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'a, Sys, N, X> {
+impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
+    OptimalControlProblem<'a, Sys, N, K, X>
+{
     /// The problem from `start` $= (q, \dots, q^{(k-1)})(0)$ to `goal` at $T$ = `t_end` in
     /// `steps` steps (jets in blocks of $n$).
-    pub fn new(
-        system: &'a Sys,
-        start: &[f64; X],
-        goal: &[f64; X],
-        t_end: f64,
-        steps: usize,
-    ) -> Self {
+    pub fn new(system: &'a Sys, start: &[f64; X], goal: &[f64; X], t_end: f64, steps: usize) -> Self
+    where
+        Sys: Lagrangian<N, K>,
+    {
         Self {
             system,
+            equalities: Vec::new(),
             start: SVector::from_column_slice(start),
             goal: SVector::from_column_slice(goal),
             t_end,
@@ -295,6 +312,14 @@ impl<'a, Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'a, 
         self
     }
 
+    /// Adds the equality constraint $g(x_{\theta,i}, u_i) = 0$ at every step (e.g. a passive
+    /// joint's torque, written under `#[jet_function]`). At most $n$ constraints, jointly of
+    /// full rank in the top derivative $u$ (so that each step can satisfy them).
+    pub fn with_equality(mut self, constraint: &'a dyn JetFunction<N, K>) -> Self {
+        self.equalities.push(constraint);
+        self
+    }
+
     fn h(&self) -> f64 {
         self.t_end / self.steps as f64
     }
@@ -304,6 +329,12 @@ impl<'a, Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'a, 
         let o = &self.options;
         if n * k != X || N != n {
             return invalid("system", "the jet length X must be n k");
+        }
+        if self.equalities.len() > n {
+            return invalid(
+                "equalities",
+                "at most n equality constraints per step (each must fix a direction of u)",
+            );
         }
         if !self
             .start
@@ -344,17 +375,19 @@ pub(crate) fn blocks<const N: usize, const K: usize, const X: usize>(
 
 /// The iterate of the optimizer.
 #[derive(Clone)]
-struct Iterate<const N: usize, const X: usize> {
-    x: Vec<SVector<f64, X>>,
-    u: Vec<SVector<f64, N>>,
+pub(super) struct Iterate<const N: usize, const X: usize> {
+    pub x: Vec<SVector<f64, X>>,
+    pub u: Vec<SVector<f64, N>>,
 }
 
-impl<Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'_, Sys, N, X> {
+impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
+    OptimalControlProblem<'_, Sys, N, K, X>
+{
     /// Solves the problem from `guess`.
     ///
     /// # Errors
     /// A [`PlanError`] with the [`Failure`] and, after the first iteration, the last iterate.
-    pub fn solve<const K: usize, const S: usize, const M: usize>(
+    pub fn solve<const S: usize, const M: usize>(
         &self,
         guess: PlanGuess<'_, N, X>,
     ) -> Result<Plan<N, X>, PlanError<N, X>>
@@ -372,7 +405,7 @@ impl<Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'_, Sys,
                 requirement: "the optimizer needs the general unknowns w = (z_1, u)",
             }));
         }
-        let iterate = self.initial::<K>(guess).map_err(invalid)?;
+        let iterate = self.initial(guess).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {
             return Err(PlanError {
                 failure: Failure::GuessOutsideDomain { step, violation },
@@ -387,7 +420,7 @@ impl<Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'_, Sys,
         .run(iterate)
     }
 
-    fn initial<const K: usize>(&self, guess: PlanGuess<'_, N, X>) -> Result<Iterate<N, X>, Error> {
+    fn initial(&self, guess: PlanGuess<'_, N, X>) -> Result<Iterate<N, X>, Error> {
         let (h, theta, steps) = (self.h(), self.options.theta, self.steps);
         let wrong = |requirement| Error::InvalidArgument {
             name: "guess",
@@ -445,7 +478,7 @@ impl<Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'_, Sys,
 
     /// The singularity guard on every step: at its ends, its evaluation point and
     /// `chord_samples` interior points of its chord.
-    fn guard<const S: usize, const M: usize>(
+    pub(super) fn guard<const S: usize, const M: usize>(
         &self,
         iterate: &Iterate<N, X>,
     ) -> Result<(), (usize, DomainViolation)>
@@ -474,333 +507,7 @@ impl<Sys: ?Sized, const N: usize, const X: usize> OptimalControlProblem<'_, Sys,
     }
 }
 
-/// One run of the SQP iteration.
-struct Sqp<
-    'p,
-    'a,
-    Sys: ?Sized,
-    const N: usize,
-    const K: usize,
-    const X: usize,
-    const S: usize,
-    const M: usize,
-> {
-    problem: &'p OptimalControlProblem<'a, Sys, N, X>,
-    dynamics: Dynamics<N, X>,
-    started: Instant,
-}
-
-/// The models of all stages at one iterate.
-struct Models<const N: usize, const X: usize> {
-    stages: Vec<StageModel<N, X>>,
-    cost: f64,
-    r0: SVector<f64, X>,
-    r_end: SVector<f64, X>,
-}
-
-impl<const N: usize, const X: usize> Models<N, X> {
-    /// $\|c\|_1$ over defects and boundary data.
-    fn violation_l1(&self) -> f64 {
-        self.stages.iter().map(|s| s.defect.lp_norm(1)).sum::<f64>()
-            + self.r0.lp_norm(1)
-            + self.r_end.lp_norm(1)
-    }
-    /// $\|c\|_\infty$.
-    fn violation_max(&self) -> f64 {
-        self.stages
-            .iter()
-            .map(|s| s.defect.amax())
-            .fold(self.r0.amax().max(self.r_end.amax()), f64::max)
-    }
-}
-
-impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
-    Sqp<'_, '_, Sys, N, K, X, S, M>
-where
-    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
-{
-    fn x_theta(&self, iterate: &Iterate<N, X>, i: usize) -> SVector<f64, X> {
-        let theta = self.dynamics.theta;
-        iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
-    }
-
-    /// $J$ alone (line search); `None` if not finite.
-    fn cost(&self, iterate: &Iterate<N, X>) -> Option<f64> {
-        let h = self.dynamics.h;
-        let system = self.problem.system;
-        let cost: f64 = (0..iterate.u.len())
-            .map(|i| h * system.lagrangian(&blocks(&self.x_theta(iterate, i)), &iterate.u[i]))
-            .sum();
-        cost.is_finite().then_some(cost)
-    }
-
-    /// Cost, gradients, Hessians and defects at `iterate`; `None` if anything is not finite.
-    fn models(&self, iterate: &Iterate<N, X>) -> Option<Models<N, X>> {
-        let (h, system) = (self.dynamics.h, self.problem.system);
-        let mut stages = Vec::with_capacity(iterate.u.len());
-        let mut cost = 0.0;
-        for (i, u) in iterate.u.iter().enumerate() {
-            let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
-            let g = system.gradient(&xb, u);
-            let hs = system.hessian(&xb, u);
-            cost += h * system.lagrangian(&xb, u);
-            let stage = StageModel {
-                hxx: SMatrix::from_fn(|r, c| h * hs.xx[r / N][c / N][(r % N, c % N)]),
-                hux: SMatrix::from_fn(|b, c| h * hs.xu[c / N][(c % N, b)]),
-                huu: hs.uu * h,
-                gx: SVector::from_fn(|r, _| h * g.x[r / N][r % N]),
-                gu: g.u * h,
-                defect: self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1],
-            };
-            let finite = stage
-                .hxx
-                .iter()
-                .chain(stage.hux.iter())
-                .chain(stage.huu.iter())
-                .chain(stage.gx.iter())
-                .chain(stage.gu.iter())
-                .all(|v| v.is_finite());
-            if !finite {
-                return None;
-            }
-            stages.push(stage);
-        }
-        let r0 = self.problem.start - iterate.x[0];
-        let r_end = self.problem.goal - iterate.x[iterate.x.len() - 1];
-        cost.is_finite().then_some(Models {
-            stages,
-            cost,
-            r0,
-            r_end,
-        })
-    }
-
-    /// The Riccati factorisation with the smallest inertia correction $\rho$ (scaled by $h$)
-    /// that makes the reduced Hessian positive definite, starting from a third of `last`.
-    fn factor_corrected(&self, models: &Models<N, X>, last: f64) -> Option<(Riccati<N, X>, f64)> {
-        let h = self.dynamics.h;
-        let riccati = Riccati::factor(&self.dynamics, &models.stages, 0.0);
-        if riccati.positive_definite() {
-            return Some((riccati, 0.0));
-        }
-        let mut rho = if last > 0.0 {
-            (last / 3.0).max(1e-20)
-        } else {
-            1e-4
-        };
-        while rho < 1e40 {
-            let riccati = Riccati::factor(&self.dynamics, &models.stages, h * rho);
-            if riccati.positive_definite() {
-                return Some((riccati, rho));
-            }
-            rho *= if last > 0.0 { 8.0 } else { 100.0 };
-        }
-        None
-    }
-
-    fn plan(
-        &self,
-        iterate: &Iterate<N, X>,
-        cost: f64,
-        iterations: usize,
-        momenta: Vec<SVector<f64, X>>,
-        certificate: Certificate,
-    ) -> Plan<N, X> {
-        Plan {
-            h: self.dynamics.h,
-            theta: self.dynamics.theta,
-            x: iterate.x.clone(),
-            u: iterate.u.clone(),
-            momenta,
-            cost,
-            iterations,
-            certificate,
-        }
-    }
-
-    fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
-        let options = &self.problem.options;
-        let h = self.dynamics.h;
-        let mut rho_last = 0.0;
-        let mut penalty = 0.0;
-        let mut iterations = 0;
-        loop {
-            let done = iterations;
-            let fail = |failure, iterate: &Iterate<N, X>, cost, certificate, momenta| PlanError {
-                failure,
-                last: Some(Box::new(self.plan(
-                    iterate,
-                    cost,
-                    done,
-                    momenta,
-                    certificate,
-                ))),
-            };
-            let Some(models) = self.models(&iterate) else {
-                return Err(PlanError {
-                    failure: Failure::NonFinite,
-                    last: None,
-                });
-            };
-            let Some((riccati, rho)) = self.factor_corrected(&models, rho_last) else {
-                return Err(fail(
-                    Failure::Regularization,
-                    &iterate,
-                    models.cost,
-                    unknown_certificate(),
-                    Vec::new(),
-                ));
-            };
-            rho_last = rho;
-            let direction = riccati.solve(
-                &self.dynamics,
-                &models.stages,
-                h * rho,
-                &models.r0,
-                &models.r_end,
-            );
-            let (momenta, stationarity) =
-                kkt_residuals(&self.dynamics, &models.stages, &direction.costate);
-            let mut certificate = Certificate {
-                stationarity,
-                feasibility: models.violation_max(),
-                negative_directions: riccati.negative,
-                min_reduced_hessian_eig: f64::NAN,
-            };
-            if stationarity <= options.tolerance && certificate.feasibility <= options.tolerance {
-                if rho > 0.0 {
-                    let exact = Riccati::factor(&self.dynamics, &models.stages, 0.0);
-                    certificate.negative_directions = exact.negative.max(1);
-                    return Err(fail(
-                        Failure::NotAMinimum {
-                            negative_directions: certificate.negative_directions,
-                        },
-                        &iterate,
-                        models.cost,
-                        certificate,
-                        momenta,
-                    ));
-                }
-                certificate.min_reduced_hessian_eig =
-                    min_reduced_eigenvalue(&riccati, &self.dynamics, self.problem.steps);
-                return Ok(self.plan(&iterate, models.cost, iterations, momenta, certificate));
-            }
-            if iterations == options.max_iterations {
-                return Err(fail(
-                    Failure::IterationLimit,
-                    &iterate,
-                    models.cost,
-                    certificate,
-                    momenta,
-                ));
-            }
-            if options
-                .max_time
-                .is_some_and(|budget| self.started.elapsed() >= budget)
-            {
-                return Err(fail(
-                    Failure::TimeLimit,
-                    &iterate,
-                    models.cost,
-                    certificate,
-                    momenta,
-                ));
-            }
-            iterations += 1;
-            match self.line_search(&iterate, &models, &direction, &mut penalty) {
-                Some(next) => iterate = next,
-                None => {
-                    return Err(fail(
-                        Failure::LineSearch,
-                        &iterate,
-                        models.cost,
-                        certificate,
-                        momenta,
-                    ));
-                }
-            }
-        }
-    }
-
-    /// Backtracking on $J + \pi \|c\|_1$ along the direction; `None` if no step is accepted.
-    fn line_search(
-        &self,
-        iterate: &Iterate<N, X>,
-        models: &Models<N, X>,
-        direction: &super::riccati::Direction<N, X>,
-        penalty: &mut f64,
-    ) -> Option<Iterate<N, X>> {
-        let options = &self.problem.options;
-        let theta = self.dynamics.theta;
-        // directional derivative of J and the curvature of the model along the direction
-        let (mut slope, mut curvature) = (0.0, 0.0);
-        for (i, stage) in models.stages.iter().enumerate() {
-            let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-            let du = &direction.du[i];
-            slope += stage.gx.dot(&dxt) + stage.gu.dot(du);
-            curvature += dxt.dot(&(stage.hxx * dxt))
-                + 2.0 * du.dot(&(stage.hux * dxt))
-                + du.dot(&(stage.huu * du));
-        }
-        let violation = models.violation_l1();
-        if violation > 0.0 {
-            let needed = (slope + 0.5 * curvature.max(0.0)) / (0.9 * violation);
-            if needed > *penalty {
-                *penalty = needed * 1.1;
-            }
-        }
-        let descent = slope - *penalty * violation;
-        let merit0 = models.cost + *penalty * violation;
-        if !descent.is_finite() {
-            return None;
-        }
-        // a non-negative slope: the direction is at rounding level; take it as it is
-        let descent = descent.min(0.0);
-        let mut alpha = 1.0;
-        for _ in 0..=options.max_backtracks {
-            let trial = Iterate {
-                x: iterate
-                    .x
-                    .iter()
-                    .zip(&direction.dx)
-                    .map(|(x, d)| x + d * alpha)
-                    .collect(),
-                u: iterate
-                    .u
-                    .iter()
-                    .zip(&direction.du)
-                    .map(|(u, d)| u + d * alpha)
-                    .collect(),
-            };
-            let merit = self
-                .problem
-                .guard::<S, M>(&trial)
-                .ok()
-                .and_then(|()| self.cost(&trial))
-                .map(|cost| cost + *penalty * self.violation_l1(&trial));
-            if merit.is_some_and(|m| {
-                m <= merit0 + options.armijo * alpha * descent + 1e-14 * merit0.abs()
-            }) {
-                return Some(trial);
-            }
-            alpha *= 0.5;
-        }
-        None
-    }
-
-    fn violation_l1(&self, iterate: &Iterate<N, X>) -> f64 {
-        let defects: f64 = (0..iterate.u.len())
-            .map(|i| {
-                (self.dynamics.next(&iterate.x[i], &iterate.u[i]) - iterate.x[i + 1]).lp_norm(1)
-            })
-            .sum();
-        defects
-            + (self.problem.start - iterate.x[0]).lp_norm(1)
-            + (self.problem.goal - iterate.x[iterate.x.len() - 1]).lp_norm(1)
-    }
-}
-
-fn unknown_certificate() -> Certificate {
+pub(super) fn unknown_certificate() -> Certificate {
     Certificate {
         stationarity: f64::NAN,
         feasibility: f64::NAN,

@@ -75,7 +75,9 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
 }
 
 /// One stage's quadratic model: the Hessian blocks and gradient of $h\,L$ in
-/// $y = (x_\theta, u)$, and the defect $c_i$.
+/// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
+/// defect $c_i$, and the stage's equality constraints $g(y) = 0$: `constraints` rows of
+/// `cx` $= \partial g/\partial x_\theta$, `cu` $= \partial g/\partial u$ and `value` $= g$.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub hxx: SMatrix<f64, X, X>,
@@ -85,13 +87,70 @@ pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub gx: SVector<f64, X>,
     pub gu: SVector<f64, N>,
     pub defect: SVector<f64, X>,
+    pub constraints: usize,
+    pub cx: SMatrix<f64, N, X>,
+    pub cu: SMatrix<f64, N, N>,
+    pub value: SVector<f64, N>,
+}
+
+/// The stage constraints in the Riccati variables: with $\delta y = (E \delta x + \theta \bar B
+/// \delta u + \theta c, \delta u)$ the linearisation is $C_x \delta x + C_u \delta u + c_0 = 0$,
+/// $C_x = G_x E$, $C_u = G_x \theta \bar B + G_u$, $c_0 = g + \theta G_x c$. Returned: the
+/// projector $\Pi = I - C_u^+ C_u$ onto the null space of $C_u$ and the pseudo-inverse
+/// $C_u^+$ (Gram-Schmidt on the rows); `None` if $C_u$ is rank-deficient.
+fn constraint_projection<const N: usize, const X: usize>(
+    dynamics: &Dynamics<N, X>,
+    stage: &StageModel<N, X>,
+) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMatrix<f64, N, X>)> {
+    let m = stage.constraints;
+    let cu = stage.cx * dynamics.b * dynamics.theta + stage.cu;
+    let cx = stage.cx * dynamics.e;
+    // rows of C_u = R Q with orthonormal rows q_j: R lower triangular (m x m)
+    let mut q = SMatrix::<f64, N, N>::zeros();
+    let mut r = SMatrix::<f64, N, N>::zeros();
+    for j in 0..m {
+        let mut row = cu.row(j).transpose();
+        let norm0 = row.norm();
+        for l in 0..j {
+            let ql = q.row(l).transpose();
+            let coefficient = ql.dot(&row);
+            r[(j, l)] = coefficient;
+            row -= ql * coefficient;
+        }
+        let norm = row.norm();
+        if !(norm > 1e-10 * norm0.max(f64::MIN_POSITIVE) && norm.is_finite()) {
+            return None;
+        }
+        r[(j, j)] = norm;
+        q.set_row(j, &(row / norm).transpose());
+    }
+    // C_u^+ = Q^T R^{-1}: column j solves R^T-free forward substitution on unit vectors
+    let mut r_inv = SMatrix::<f64, N, N>::zeros();
+    for c in 0..m {
+        for j in c..m {
+            let mut v = if j == c { 1.0 } else { 0.0 };
+            for l in c..j {
+                v -= r[(j, l)] * r_inv[(l, c)];
+            }
+            r_inv[(j, c)] = v / r[(j, j)];
+        }
+    }
+    let pinv = q.transpose() * r_inv;
+    let projector = SMatrix::<f64, N, N>::identity() - q.transpose() * q;
+    Some((projector, pinv, cx))
 }
 
 /// What the backward pass keeps of a stage.
 #[derive(Clone, Copy, Debug)]
 struct StageFactor<const N: usize, const X: usize> {
+    /// $(\Pi Q_{uu} \Pi + I - \Pi)^{-1}$ ($Q_{uu}^{-1}$ without constraints).
     quu_inv: SMatrix<f64, N, N>,
+    quu: SMatrix<f64, N, N>,
     qux: SMatrix<f64, N, X>,
+    /// The constraint projector $\Pi$ and $C_u^+$ (zero without constraints).
+    projector: SMatrix<f64, N, N>,
+    pinv: SMatrix<f64, N, N>,
+    constrained: bool,
     /// $\delta u = K \delta x + k + K_\nu \nu$ ($k$ depends on the linear terms).
     gain: SMatrix<f64, N, X>,
     gain_nu: SMatrix<f64, N, X>,
@@ -103,11 +162,11 @@ struct StageFactor<const N: usize, const X: usize> {
 /// The factorised KKT system of one iteration.
 pub(crate) struct Riccati<const N: usize, const X: usize> {
     stages: Vec<StageFactor<N, X>>,
-    /// $D_N$ and its inverse.
+    /// $D_N^{-1}$.
     d_end_inv: SMatrix<f64, X, X>,
     /// Negative eigenvalues of the reduced Hessian.
     pub negative: usize,
-    /// A pivot was singular (or non-finite).
+    /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
     pub singular: bool,
 }
 
@@ -119,6 +178,17 @@ pub(crate) struct Direction<const N: usize, const X: usize> {
     pub du: Vec<SVector<f64, N>>,
     /// $\lambda_{i+1} = \nabla V_{i+1}(\delta x_{i+1})$ for $i < N$: the cost-to-go gradients.
     pub costate: Vec<SVector<f64, X>>,
+    /// The multipliers $y_i$ of the stage constraints (first `constraints` entries).
+    pub multipliers: Vec<SVector<f64, N>>,
+}
+
+/// The linear data of one stage of a subproblem: the gradient $(l_x, l_u)$ in
+/// $(\delta x_i, \delta u_i)$, the defect $c_i$ and the constraint offset $c_0$.
+pub(crate) struct StageLinear<const N: usize, const X: usize> {
+    pub lx: SVector<f64, X>,
+    pub lu: SVector<f64, N>,
+    pub defect: SVector<f64, X>,
+    pub constraint: SVector<f64, N>,
 }
 
 /// Inverts a symmetric matrix and counts its negative eigenvalues; `None` if (nearly)
@@ -143,51 +213,103 @@ fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64
     Some((SMatrix::from_column_slice(inv.as_slice()), negative))
 }
 
+/// One stage of the backward pass from $P_{i+1}$ and $S_{i+1}$:
+/// $Q_{xx} = E^T H_{xx} E + \bar A^T P \bar A$, $Q_{ux} = (\theta \bar B^T H_{xx} + H_{ux}) E +
+/// \bar B^T P \bar A$, $Q_{uu}$ likewise, and the gains. Without constraints
+/// $K = -Q_{uu}^{-1} Q_{ux}$ and $K_\nu = -Q_{uu}^{-1} \bar B^T S$; with them
+/// $\delta u = M \delta x + m_0 + \Pi v$ ($M = -C_u^+ C_x$) and $v$ minimises over the null
+/// space: $K = M - \Pi \tilde Q^{-1} \Pi (Q_{ux} + Q_{uu} M)$, $K_\nu = -\Pi \tilde Q^{-1}
+/// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + I - \Pi$. Returns the factor, $Q_{xx}$
+/// and the negative eigenvalues of $\tilde Q$ on the null space (`None`: singular).
+fn stage_factor<const N: usize, const X: usize>(
+    dynamics: &Dynamics<N, X>,
+    stage: &StageModel<N, X>,
+    rho: f64,
+    p: &SMatrix<f64, X, X>,
+    sens: &SMatrix<f64, X, X>,
+) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
+    let (a, b, e) = (&dynamics.a, &dynamics.b, &dynamics.e);
+    let fu = b * dynamics.theta;
+    let hxx = stage.hxx + SMatrix::<f64, X, X>::identity() * rho;
+    let huu = stage.huu + SMatrix::<f64, N, N>::identity() * rho;
+    let hxx_e = hxx * e;
+    let pa = p * a;
+    let pb = p * b;
+    let qxx = e.transpose() * hxx_e + a.transpose() * pa;
+    let qux = fu.transpose() * hxx_e + stage.hux * e + b.transpose() * pa;
+    let cross = stage.hux * fu;
+    let quu = fu.transpose() * (hxx * fu) + cross + cross.transpose() + huu + b.transpose() * pb;
+    let quu = (quu + quu.transpose()) * 0.5;
+    let bts = b.transpose() * sens;
+    let mut factor = StageFactor {
+        quu_inv: SMatrix::zeros(),
+        quu,
+        qux,
+        projector: SMatrix::identity(),
+        pinv: SMatrix::zeros(),
+        constrained: stage.constraints > 0,
+        gain: SMatrix::zeros(),
+        gain_nu: SMatrix::zeros(),
+        p_next: *p,
+        sens_next: *sens,
+    };
+    if !factor.constrained {
+        let Some((quu_inv, neg)) = invert_counting(quu) else {
+            return (factor, qxx, None);
+        };
+        factor.quu_inv = quu_inv;
+        factor.gain = -(quu_inv * qux);
+        factor.gain_nu = -(quu_inv * bts);
+        return (factor, qxx, Some(neg));
+    }
+    let Some((projector, pinv, cx)) = constraint_projection(dynamics, stage) else {
+        return (factor, qxx, None);
+    };
+    let complement = SMatrix::<f64, N, N>::identity() - projector;
+    let reduced = projector * quu * projector + complement;
+    let Some((quu_inv, neg)) = invert_counting((reduced + reduced.transpose()) * 0.5) else {
+        return (factor, qxx, None);
+    };
+    let m = -(pinv * cx);
+    let solve = projector * quu_inv * projector;
+    factor.gain = m - solve * (qux + quu * m);
+    factor.gain_nu = -(solve * bts);
+    factor.quu_inv = quu_inv;
+    factor.projector = projector;
+    factor.pinv = pinv;
+    (factor, qxx, Some(neg))
+}
+
 impl<const N: usize, const X: usize> Riccati<N, X> {
     /// The backward pass over `stages` with $\rho$ added to the diagonal of every $H_i$
     /// (inertia correction), then the terminal system.
     pub fn factor(dynamics: &Dynamics<N, X>, stages: &[StageModel<N, X>], rho: f64) -> Self {
-        let (a, b, e, theta) = (&dynamics.a, &dynamics.b, &dynamics.e, dynamics.theta);
-        let fu = b * theta;
+        let (a, b) = (&dynamics.a, &dynamics.b);
         let mut p = SMatrix::<f64, X, X>::zeros();
         let mut sens = SMatrix::<f64, X, X>::identity();
         let mut factors = Vec::with_capacity(stages.len());
         let mut negative = 0;
         let mut singular = false;
         for stage in stages.iter().rev() {
-            let hxx = stage.hxx + SMatrix::<f64, X, X>::identity() * rho;
-            let huu = stage.huu + SMatrix::<f64, N, N>::identity() * rho;
-            let hxx_e = hxx * e;
-            let hxx_fu = hxx * fu;
-            let pa = p * a;
-            let pb = p * b;
-            let qxx = e.transpose() * hxx_e + a.transpose() * pa;
-            let qux = fu.transpose() * hxx_e + stage.hux * e + b.transpose() * pa;
-            let cross = stage.hux * fu;
-            let quu =
-                fu.transpose() * hxx_fu + cross + cross.transpose() + huu + b.transpose() * pb;
-            let quu = (quu + quu.transpose()) * 0.5;
-            let (quu_inv, neg) = match invert_counting(quu) {
-                Some(pair) => pair,
-                None => {
-                    singular = true;
-                    (SMatrix::zeros(), 0)
-                }
+            let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p, &sens);
+            singular |= neg.is_none();
+            negative += neg.unwrap_or(0);
+            // V_i(dx) = Q(dx, K dx + k + K_nu nu): the general form (K need not minimise Q
+            // over all du when the stage is constrained)
+            let (k, kn, qux, quu) = (&factor.gain, &factor.gain_nu, &factor.qux, &factor.quu);
+            let quu_k = quu * k;
+            let p_new = if factor.constrained {
+                qxx + k.transpose() * qux + qux.transpose() * k + k.transpose() * quu_k
+            } else {
+                qxx + qux.transpose() * k
             };
-            negative += neg;
-            let gain = -(quu_inv * qux);
-            let gain_nu = -(quu_inv * (b.transpose() * sens));
-            factors.push(StageFactor {
-                quu_inv,
-                qux,
-                gain,
-                gain_nu,
-                p_next: p,
-                sens_next: sens,
-            });
-            let p_new = qxx + qux.transpose() * gain;
             p = (p_new + p_new.transpose()) * 0.5;
-            sens = a.transpose() * sens + qux.transpose() * gain_nu;
+            sens = if factor.constrained {
+                (a + b * k).transpose() * sens + (qux + quu_k).transpose() * kn
+            } else {
+                a.transpose() * sens + qux.transpose() * kn
+            };
+            factors.push(factor);
         }
         factors.reverse();
         // D_N = d delta x_N / d nu: forward sweep of the closed-loop sensitivity
@@ -196,9 +318,18 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             d = (a + b * f.gain) * d + b * f.gain_nu;
         }
         let d_sym = (d + d.transpose()) * 0.5;
-        let (d_end_inv, neg_d) = invert_counting(d_sym).unwrap_or_else(|| {
+        // the symmetric part for the inertia, the matrix itself for the solve
+        let neg_d = invert_counting(d_sym).map_or_else(
+            || {
+                singular = true;
+                0
+            },
+            |(_, neg)| neg,
+        );
+        // by LU with partial pivoting (nalgebra's closed-form 4x4 inverse loses digits here)
+        let d_end_inv = crate::linalg::solve(&d, &SMatrix::identity()).unwrap_or_else(|| {
             singular = true;
-            (SMatrix::zeros(), 0)
+            SMatrix::zeros()
         });
         Self {
             stages: factors,
@@ -229,40 +360,52 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let offset = stage.defect * dynamics.theta;
             let gx = stage.gx + (stage.hxx + SMatrix::<f64, X, X>::identity() * rho) * offset;
             let gu = stage.gu + stage.hux * offset;
-            let lx = dynamics.e.transpose() * gx;
-            let lu = fu.transpose() * gx + gu;
-            (lx, lu, stage.defect)
+            StageLinear {
+                lx: dynamics.e.transpose() * gx,
+                lu: fu.transpose() * gx + gu,
+                defect: stage.defect,
+                constraint: stage.value + stage.cx * offset,
+            }
         };
         self.solve_linear(dynamics, &linear, r0, r_end)
     }
 
-    /// The subproblem's solution for the stage linear terms $(l_x, l_u)$ in
-    /// $(\delta x_i, \delta u_i)$ and the defects $c_i$ given by `linear(i)`.
+    /// The subproblem's solution for the stage linear terms, defects and constraint offsets
+    /// given by `linear(i)`.
     pub fn solve_linear(
         &self,
         dynamics: &Dynamics<N, X>,
-        linear: &dyn Fn(usize) -> (SVector<f64, X>, SVector<f64, N>, SVector<f64, X>),
+        linear: &dyn Fn(usize) -> StageLinear<N, X>,
         r0: &SVector<f64, X>,
         r_end: &SVector<f64, X>,
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.a, &dynamics.b);
         let steps = self.stages.len();
-        // backward: the feed-forward terms and s_{i+1} for these linear terms
+        // backward: the feed-forward terms, q_u and s_{i+1} for these linear terms
         let mut feedforward = vec![SVector::<f64, N>::zeros(); steps];
+        let mut qus = vec![SVector::<f64, N>::zeros(); steps];
         let mut s_next = vec![SVector::<f64, X>::zeros(); steps];
         let mut defects = vec![SVector::<f64, X>::zeros(); steps];
         let mut s = SVector::<f64, X>::zeros();
         for i in (0..steps).rev() {
             let f = &self.stages[i];
-            let (lx, lu, defect) = linear(i);
-            let pcs = f.p_next * defect + s;
-            let qx = lx + a.transpose() * pcs;
-            let qu = lu + b.transpose() * pcs;
-            let k = -(f.quu_inv * qu);
+            let l = linear(i);
+            let pcs = f.p_next * l.defect + s;
+            let qx = l.lx + a.transpose() * pcs;
+            let qu = l.lu + b.transpose() * pcs;
             s_next[i] = s;
-            feedforward[i] = k;
-            defects[i] = defect;
-            s = qx + f.qux.transpose() * k;
+            defects[i] = l.defect;
+            qus[i] = qu;
+            if f.constrained {
+                let m0 = -(f.pinv * l.constraint);
+                let k = m0 - f.projector * (f.quu_inv * (f.projector * (qu + f.quu * m0)));
+                s = qx + f.gain.transpose() * (qu + f.quu * k) + f.qux.transpose() * k;
+                feedforward[i] = k;
+            } else {
+                let k = -(f.quu_inv * qu);
+                s = qx + f.qux.transpose() * k;
+                feedforward[i] = k;
+            }
         }
         // forward without nu, then nu from the terminal condition
         let mut x = *r0;
@@ -270,19 +413,150 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let du = f.gain * x + feedforward[i];
             x = a * x + b * du + defects[i];
         }
-        let nu = self.d_end_inv * (r_end - x);
-        let mut dx = Vec::with_capacity(steps + 1);
-        let mut du = Vec::with_capacity(steps);
-        let mut costate = Vec::with_capacity(steps);
-        let mut x = *r0;
-        dx.push(x);
-        for (i, f) in self.stages.iter().enumerate() {
-            let u = f.gain * x + feedforward[i] + f.gain_nu * nu;
-            x = a * x + b * u + defects[i];
-            costate.push(f.p_next * x + s_next[i] + f.sens_next * nu);
-            du.push(u);
-            dx.push(x);
+        let mut nu = self.d_end_inv * (r_end - x);
+        let mut d = Direction {
+            dx: Vec::with_capacity(steps + 1),
+            du: Vec::with_capacity(steps),
+            costate: Vec::with_capacity(steps),
+            multipliers: Vec::with_capacity(steps),
+        };
+        // one refinement of nu when the terminal condition is missed by more than rounding
+        for refinement in 0..2 {
+            d.dx.clear();
+            d.du.clear();
+            d.costate.clear();
+            d.multipliers.clear();
+            let mut x = *r0;
+            d.dx.push(x);
+            for (i, f) in self.stages.iter().enumerate() {
+                let u = f.gain * x + feedforward[i] + f.gain_nu * nu;
+                if f.constrained {
+                    let dq = f.qux * x + f.quu * u + qus[i] + b.transpose() * (f.sens_next * nu);
+                    d.multipliers.push(-(f.pinv.transpose() * dq));
+                } else {
+                    d.multipliers.push(SVector::zeros());
+                }
+                x = a * x + b * u + defects[i];
+                d.costate.push(f.p_next * x + s_next[i] + f.sens_next * nu);
+                d.du.push(u);
+                d.dx.push(x);
+            }
+            let miss = r_end - x;
+            if refinement == 1 || miss.amax() <= 1e-14 * (1.0 + r_end.amax() + x.amax()) {
+                break;
+            }
+            nu += self.d_end_inv * miss;
         }
-        Direction { dx, du, costate }
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic pseudo-random number in [-1, 1).
+    fn noise(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// The Riccati solve equals a dense solve of the same equality-constrained quadratic
+    /// program, including an indefinite stage Hessian whose reduced Hessian stays definite.
+    #[test]
+    fn riccati_equals_the_dense_kkt_solve() {
+        const N: usize = 2;
+        const X: usize = 4;
+        let steps = 7;
+        let dynamics = Dynamics::<N, X>::new(0.3, 0.5);
+        let mut seed = 7;
+        let stages: Vec<StageModel<N, X>> = (0..steps)
+            .map(|_| {
+                let m = SMatrix::<f64, 6, 6>::from_fn(|_, _| noise(&mut seed));
+                let h = m * m.transpose() + SMatrix::<f64, 6, 6>::identity() * 0.5;
+                StageModel {
+                    hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
+                    hux: h.fixed_view::<2, 4>(4, 0).into_owned(),
+                    huu: h.fixed_view::<2, 2>(4, 4).into_owned(),
+                    gx: SVector::from_fn(|_, _| noise(&mut seed)),
+                    gu: SVector::from_fn(|_, _| noise(&mut seed)),
+                    defect: SVector::from_fn(|_, _| 0.1 * noise(&mut seed)),
+                    constraints: 0,
+                    cx: SMatrix::zeros(),
+                    cu: SMatrix::zeros(),
+                    value: SVector::zeros(),
+                }
+            })
+            .collect();
+        let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+        let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+        let riccati = Riccati::factor(&dynamics, &stages, 0.0);
+        assert!(riccati.positive_definite());
+        let d = riccati.solve(&dynamics, &stages, 0.0, &r0, &r_end);
+        // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
+        let nv = (steps + 1) * X + steps * N;
+        let nc = (steps + 2) * X;
+        let xc = |i: usize| i * X;
+        let uc = |i: usize| (steps + 1) * X + i * N;
+        let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
+        let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
+        let theta = dynamics.theta;
+        for (i, s) in stages.iter().enumerate() {
+            let mut t = DMatrix::<f64>::zeros(6, nv);
+            for r in 0..X {
+                t[(r, xc(i) + r)] = 1.0 - theta;
+                t[(r, xc(i + 1) + r)] = theta;
+            }
+            for a in 0..N {
+                t[(4 + a, uc(i) + a)] = 1.0;
+            }
+            let mut h = DMatrix::<f64>::zeros(6, 6);
+            h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
+            h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
+            h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
+            h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
+            let g = nalgebra::DVector::from_iterator(6, s.gx.iter().chain(s.gu.iter()).copied());
+            let block = t.transpose() * h * &t;
+            let mut view = kkt.view_mut((0, 0), (nv, nv));
+            view += block;
+            let mut top = rhs.rows_mut(0, nv);
+            top -= t.transpose() * g;
+            // x_{i+1} - A x_i - B u_i = c_i
+            let row = nv + (i + 1) * X;
+            for r in 0..X {
+                kkt[(row + r, xc(i + 1) + r)] = 1.0;
+                for c in 0..X {
+                    kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+                }
+                for a in 0..N {
+                    kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                }
+                rhs[row + r] = s.defect[r];
+            }
+        }
+        for r in 0..X {
+            kkt[(nv + r, xc(0) + r)] = 1.0;
+            rhs[nv + r] = r0[r];
+            kkt[(nv + (steps + 1) * X + r, xc(steps) + r)] = 1.0;
+            rhs[nv + (steps + 1) * X + r] = r_end[r];
+        }
+        for r in nv..nv + nc {
+            for c in 0..nv {
+                kkt[(c, r)] = kkt[(r, c)];
+            }
+        }
+        let sol = kkt.lu().solve(&rhs).unwrap();
+        for i in 0..=steps {
+            for r in 0..X {
+                assert!((d.dx[i][r] - sol[xc(i) + r]).abs() < 1e-9, "dx[{i}][{r}]");
+            }
+        }
+        for i in 0..steps {
+            for a in 0..N {
+                assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
+            }
+        }
     }
 }
