@@ -25,11 +25,13 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 mod certificate;
+mod extrapolate;
 mod guess;
 mod optimize;
 mod riccati;
 mod sqp;
 
+pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions,
 };

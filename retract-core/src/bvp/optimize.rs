@@ -154,6 +154,30 @@ pub struct Plan<const N: usize, const X: usize> {
     pub certificate: Certificate,
 }
 
+impl<const N: usize, const X: usize> Plan<N, X> {
+    /// The plan shifted one step forward in time, for a receding-horizon warm start
+    /// ([`PlanGuess::Plan`]): $x_i \leftarrow x_{i+1}$, $u_i \leftarrow u_{i+1}$, the last
+    /// top derivative repeated and the new last jet one step of the scheme's $x$-equations
+    /// from the old end with it. The momenta are shifted alike (the last one repeated); the
+    /// certificate is that of the unshifted plan.
+    pub fn shifted(&self) -> Self {
+        let mut out = self.clone();
+        let (Some(&last_x), Some(&last_u)) = (self.x.last(), self.u.last()) else {
+            return out;
+        };
+        let dynamics = Dynamics::<N, X>::new(self.h, self.theta);
+        out.x.remove(0);
+        out.x.push(dynamics.next(&last_x, &last_u));
+        out.u.remove(0);
+        out.u.push(last_u);
+        if let Some(&last_p) = self.momenta.last() {
+            out.momenta.remove(0);
+            out.momenta.push(last_p);
+        }
+        out
+    }
+}
+
 /// Why the optimizer stopped without a certified plan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
