@@ -9,7 +9,9 @@ use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
 /// $x_{i+1} - x_i - h A x_{\theta,i} - h B u_i = 0$, the momenta and the stationarity residual.
 ///
 /// With $\lambda_{i+1}$ the cost-to-go gradient of the subproblem after step $i$ and $g_i$ the
-/// gradient of $h L + y_i^T g$ at step $i$ ($y_i$ the multipliers of the stage constraints): $\mu_i = -W^T(\lambda_{i+1} + \theta g_{x,i})$. The gradient
+/// gradient of the stage's Lagrangian $h L - h z_i^T g^{\ge} + y_i^T g^{=}$ at step $i$
+/// (`gradients` holds that of $h L - h z_i^T g^{\ge}$; $y_i$ are the multipliers of the stage
+/// equalities): $\mu_i = -W^T(\lambda_{i+1} + \theta g_{x,i})$. The gradient
 /// of the Lagrangian of the transcription is, in $u_i$, $r_{u,i} = g_{u,i} - h B^T \mu_i$ and,
 /// in $x_i$ ($0 < i < N$), $r_{x,i} = (1-\theta) d_i + \theta d_{i-1} - (\mu_i - \mu_{i-1})$
 /// with $d_i = g_{x,i} - h A^T \mu_i$; the momenta are $p_i = \mu_i - (1-\theta) d_i$ and
@@ -19,6 +21,7 @@ use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stages: &[StageModel<N, X>],
+    gradients: &[(SVector<f64, X>, SVector<f64, N>)],
     direction: &Direction<N, X>,
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
@@ -31,15 +34,16 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     let mut worst: f64 = 0.0;
     let mut scale: f64 = 1.0;
     let mut previous: Option<(SVector<f64, X>, SVector<f64, X>)> = None;
-    for ((stage, lambda), y) in stages
+    for (((stage, (gx, gu)), lambda), y) in stages
         .iter()
+        .zip(gradients)
         .zip(&direction.costate)
         .zip(&direction.multipliers)
     {
-        scale = scale.max(stage.gx.amax() / h).max(stage.gu.amax() / h);
-        // the gradient of the stage's Lagrangian h L + y^T g
-        let gx = stage.gx + stage.cx.transpose() * y;
-        let gu = stage.gu + stage.cu.transpose() * y;
+        scale = scale.max(gx.amax() / h).max(gu.amax() / h);
+        // the gradient of the stage's Lagrangian h L - h z^T g_ineq + y^T g_eq
+        let gx = gx + stage.cx.transpose() * y;
+        let gu = gu + stage.cu.transpose() * y;
         let mu = -(wt * (lambda + gx * theta));
         let d = gx - shift_t(&mu) * h;
         for a in 0..N {

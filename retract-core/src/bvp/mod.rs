@@ -24,13 +24,16 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+mod barrier;
 mod certificate;
+mod constraints;
 mod extrapolate;
 mod guess;
 mod optimize;
 mod riccati;
 mod sqp;
 
+pub use constraints::Variable;
 pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions,

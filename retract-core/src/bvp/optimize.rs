@@ -28,6 +28,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::SVector;
 
+use super::constraints::{StageConstraint, Variable};
 use super::guess::Hermite;
 use super::riccati::Dynamics;
 use super::sqp::Sqp;
@@ -42,6 +43,10 @@ pub struct PlanOptions {
     /// Converged when the relative stationarity ([`Certificate::stationarity`]) and the
     /// constraint violation are both below this.
     pub tolerance: f64,
+    /// Accepted instead of `tolerance` when the line search has made only rounding-level
+    /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
+    /// acceptable level; the certificate reports the residuals reached.
+    pub acceptable: f64,
     /// Iteration budget.
     pub max_iterations: usize,
     /// Wall-time budget; `None` for none.
@@ -53,6 +58,8 @@ pub struct PlanOptions {
     pub armijo: f64,
     /// Step halvings per line search.
     pub max_backtracks: usize,
+    /// Initial barrier parameter $\mu$ of the inequalities (per unit time).
+    pub initial_barrier: f64,
 }
 
 impl Default for PlanOptions {
@@ -60,11 +67,13 @@ impl Default for PlanOptions {
         Self {
             theta: 0.5,
             tolerance: 1e-9,
+            acceptable: 1e-6,
             max_iterations: 200,
             max_time: None,
             chord_samples: 3,
             armijo: 1e-4,
             max_backtracks: 40,
+            initial_barrier: 0.1,
         }
     }
 }
@@ -122,8 +131,12 @@ pub struct Certificate {
     /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
     /// unit time relative to the size of the gradient of $L$.
     pub stationarity: f64,
-    /// Max-norm of the constraint violation (dynamics defects, boundary data).
+    /// Max-norm of the constraint violation (dynamics defects, boundary data, stage
+    /// equalities).
     pub feasibility: f64,
+    /// $\max_j z_j g_j$ over the inequalities $g_j \ge 0$ with their multipliers $z_j$ (0
+    /// without inequalities): how far the interior-point iterate is from complementarity.
+    pub complementarity: f64,
     /// Negative eigenvalues of the reduced Hessian (0 for a returned plan).
     pub negative_directions: usize,
     /// The smallest eigenvalue of $Z^T \nabla^2 J\, Z$, $Z$ an orthonormal basis of the null
@@ -303,9 +316,10 @@ impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize> {
     pub(super) system: &'a Sys,
     pub(super) equalities: Vec<&'a dyn JetFunction<N, K>>,
+    pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
     pub(super) start: SVector<f64, X>,
     pub(super) goal: SVector<f64, X>,
-    t_end: f64,
+    pub(super) t_end: f64,
     pub(super) steps: usize,
     pub(super) options: PlanOptions,
 }
@@ -322,6 +336,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Self {
             system,
             equalities: Vec::new(),
+            inequalities: Vec::new(),
             start: SVector::from_column_slice(start),
             goal: SVector::from_column_slice(goal),
             t_end,
@@ -344,6 +359,31 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         self
     }
 
+    /// Adds the inequality $g(x_{\theta,i}, u_i) \ge 0$ at the evaluation point of every step
+    /// (obstacle clearance, a keep-out cone, a torque limit $\tau_{\max} - \tau \ge 0$),
+    /// handled by the interior-point iteration with slacks ([`super::barrier`]): the first
+    /// guess need not satisfy it.
+    pub fn with_inequality(mut self, constraint: &'a dyn JetFunction<N, K>) -> Self {
+        self.inequalities
+            .push(StageConstraint::Function(constraint));
+        self
+    }
+
+    /// Bounds `lower` $\le v \le$ `upper` on one variable of every step (either may be
+    /// infinite: no bound on that side), as two inequalities ([`Self::with_inequality`]).
+    pub fn with_bounds(mut self, variable: Variable, lower: f64, upper: f64) -> Self {
+        for (value, sign) in [(lower, 1.0), (upper, -1.0)] {
+            if value.is_nan() || value.is_finite() {
+                self.inequalities.push(StageConstraint::Bound {
+                    variable,
+                    value,
+                    sign,
+                });
+            }
+        }
+        self
+    }
+
     fn h(&self) -> f64 {
         self.t_end / self.steps as f64
     }
@@ -353,6 +393,12 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let o = &self.options;
         if n * k != X || N != n {
             return invalid("system", "the jet length X must be n k");
+        }
+        if !self.inequalities.iter().all(|c| c.valid::<X>()) {
+            return invalid(
+                "bounds",
+                "a bound needs a finite value and a jet index < n k or a top index < n",
+            );
         }
         if self.equalities.len() > n {
             return invalid(
@@ -377,10 +423,18 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         if !(0.0..=1.0).contains(&o.theta) {
             return invalid("theta", "theta must lie in [0, 1]");
         }
-        if !(o.tolerance.is_finite() && o.tolerance > 0.0) || o.max_iterations == 0 {
+        if !(o.tolerance.is_finite() && o.tolerance > 0.0 && o.acceptable >= o.tolerance)
+            || o.max_iterations == 0
+        {
             return invalid(
                 "options",
                 "need a finite tolerance > 0 and max_iterations >= 1",
+            );
+        }
+        if !(o.initial_barrier.is_finite() && o.initial_barrier > 0.0) {
+            return invalid(
+                "options",
+                "the initial barrier parameter must be finite and > 0",
             );
         }
         if !(o.armijo > 0.0 && o.armijo < 0.5) || o.chord_samples > 64 {
@@ -535,6 +589,7 @@ pub(super) fn unknown_certificate() -> Certificate {
     Certificate {
         stationarity: f64::NAN,
         feasibility: f64::NAN,
+        complementarity: f64::NAN,
         negative_directions: 0,
         min_reduced_hessian_eig: f64::NAN,
     }

@@ -5,12 +5,14 @@ use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
 
+use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
+use super::constraints::{Linearized, flat_hessian};
 use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
 use super::riccati::{Direction, Dynamics, Riccati, StageModel};
-use crate::{Hessian, Lagrangian, LiftedSystem};
+use crate::{Lagrangian, LiftedSystem};
 
 /// One run of the SQP iteration.
 pub(super) struct Sqp<
@@ -31,18 +33,29 @@ pub(super) struct Sqp<
 /// The models of all stages at one iterate.
 struct Models<const N: usize, const X: usize> {
     stages: Vec<StageModel<N, X>>,
+    /// $J$.
     cost: f64,
+    /// $J - h \mu \sum \ln g$.
+    barrier_cost: f64,
     r0: SVector<f64, X>,
     r_end: SVector<f64, X>,
+    /// The inequalities at every step (step-major).
+    inequalities: Vec<Linearized<N, X>>,
+    /// The gradient of $h L$ alone at every step (the models hold the barrier's too).
+    cost_gradient: Vec<(SVector<f64, X>, SVector<f64, N>)>,
+    /// $\sum |g - s|$ and $\max |g - s|$ over the inequalities.
+    slack_violation: (f64, f64),
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
     /// $\|c\|_1$ over defects, stage constraints and boundary data.
     fn violation_l1(&self) -> f64 {
-        self.stages
-            .iter()
-            .map(|s| s.defect.lp_norm(1) + s.value.lp_norm(1))
-            .sum::<f64>()
+        self.slack_violation.0
+            + self
+                .stages
+                .iter()
+                .map(|s| s.defect.lp_norm(1) + s.value.lp_norm(1))
+                .sum::<f64>()
             + self.r0.lp_norm(1)
             + self.r_end.lp_norm(1)
     }
@@ -52,20 +65,8 @@ impl<const N: usize, const X: usize> Models<N, X> {
             .iter()
             .map(|s| s.defect.amax().max(s.value.amax()))
             .fold(self.r0.amax().max(self.r_end.amax()), f64::max)
+            .max(self.slack_violation.1)
     }
-}
-
-/// `h` times the Hessian blocks of a function of $(x, u)$ as $(H_{xx}, H_{ux}, H_{uu})$ over the
-/// flat jet.
-fn flat_hessian<const N: usize, const K: usize, const X: usize>(
-    hs: &Hessian<N, K>,
-    scale: f64,
-) -> (SMatrix<f64, X, X>, SMatrix<f64, N, X>, SMatrix<f64, N, N>) {
-    (
-        SMatrix::from_fn(|r, c| scale * hs.xx[r / N][c / N][(r % N, c % N)]),
-        SMatrix::from_fn(|b, c| scale * hs.xu[c / N][(c % N, b)]),
-        hs.uu * scale,
-    )
 }
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
@@ -78,29 +79,50 @@ where
         iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
     }
 
-    /// $J$ and $\|c\|_1$ (line search); `None` if not finite.
-    fn merit_parts(&self, iterate: &Iterate<N, X>) -> Option<(f64, f64)> {
+    /// The barrier cost $J - h \mu \sum \ln s$ and $\|c\|_1$ (with $\sum |g - s|$) at a
+    /// trial point whose slacks are $s + \alpha\,\delta s$; `None` if not finite.
+    fn merit_parts(
+        &self,
+        iterate: &Iterate<N, X>,
+        barrier: &Barrier,
+        ds: &[f64],
+        alpha: f64,
+    ) -> Option<(f64, f64)> {
         let (h, system) = (self.dynamics.h, self.problem.system);
         let (mut cost, mut violation) = (0.0, 0.0);
+        let mut values = Vec::with_capacity(ds.len());
         for (i, u) in iterate.u.iter().enumerate() {
-            let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
+            let xt = self.x_theta(iterate, i);
+            let xb = blocks::<N, K, X>(&xt);
             cost += h * system.lagrangian(&xb, u);
             violation += (self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1]).lp_norm(1);
             for g in &self.problem.equalities {
                 violation += g.value(&xb, u).abs();
             }
+            values.extend(self.problem.inequalities.iter().map(|c| c.value(&xt, u)));
         }
-        violation += (self.problem.start - iterate.x[0]).lp_norm(1)
+        let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
+        violation += slack
+            + (self.problem.start - iterate.x[0]).lp_norm(1)
             + (self.problem.goal - iterate.x[iterate.x.len() - 1]).lp_norm(1);
+        let cost = cost + log;
         (cost.is_finite() && violation.is_finite()).then_some((cost, violation))
     }
 
     /// The model of stage `i`: the Hessian of $h L + y^T g$, the gradient of $h L$, the
     /// defect and the constraints with their Jacobians.
-    fn stage(&self, iterate: &Iterate<N, X>, i: usize, y: &SVector<f64, N>) -> StageModel<N, X> {
+    fn stage(
+        &self,
+        iterate: &Iterate<N, X>,
+        i: usize,
+        y: &SVector<f64, N>,
+        barrier: &Barrier,
+        inequalities: &[Linearized<N, X>],
+    ) -> StageModel<N, X> {
         let (h, system) = (self.dynamics.h, self.problem.system);
         let u = &iterate.u[i];
-        let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
+        let xt = self.x_theta(iterate, i);
+        let xb = blocks::<N, K, X>(&xt);
         let g = system.gradient(&xb, u);
         let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&system.hessian(&xb, u), h);
         let mut stage = StageModel {
@@ -131,19 +153,39 @@ where
                 huu += cuu;
             }
         }
+        for (j, c) in self.problem.inequalities.iter().enumerate() {
+            let z = barrier.z[i * barrier.count + j];
+            if let Some((cxx, cux, cuu)) = c.weighted_hessian(&xt, u, -h * z) {
+                hxx += cxx;
+                hux += cux;
+                huu += cuu;
+            }
+        }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
+        barrier.add_to_stage(&mut stage, i, inequalities, h);
         stage
     }
 
     /// The models of every stage with the constraint multipliers `y`; `None` if anything is
     /// not finite.
-    fn models(&self, iterate: &Iterate<N, X>, y: &[SVector<f64, N>]) -> Option<Models<N, X>> {
+    fn models(
+        &self,
+        iterate: &Iterate<N, X>,
+        y: &[SVector<f64, N>],
+        barrier: &Barrier,
+    ) -> Option<Models<N, X>> {
         let (h, system) = (self.dynamics.h, self.problem.system);
         let mut stages = Vec::with_capacity(iterate.u.len());
+        let inequalities = self.inequalities(iterate);
+        let mut cost_gradient = Vec::with_capacity(iterate.u.len());
         let mut cost = 0.0;
         for (i, u) in iterate.u.iter().enumerate() {
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
-            let stage = self.stage(iterate, i, &y[i]);
+            let count = barrier.count;
+            let own = &inequalities[i * count..(i + 1) * count];
+            let g = system.gradient(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
+            cost_gradient.push((SVector::from_fn(|r, _| h * g.x[r / N][r % N]), g.u * h));
+            let stage = self.stage(iterate, i, &y[i], barrier, own);
             let finite = stage
                 .hxx
                 .iter()
@@ -162,12 +204,34 @@ where
         }
         let r0 = self.problem.start - iterate.x[0];
         let r_end = self.problem.goal - iterate.x[iterate.x.len() - 1];
-        cost.is_finite().then_some(Models {
+        let (log, slack_l1) = barrier.current_terms(&inequalities, h);
+        let slack_violation = (slack_l1, barrier.residual(&inequalities));
+        let barrier_cost = cost + log;
+        barrier_cost.is_finite().then_some(Models {
             stages,
             cost,
+            barrier_cost,
             r0,
             r_end,
+            inequalities,
+            cost_gradient,
+            slack_violation,
         })
+    }
+
+    /// Every inequality linearised at every step (step-major).
+    pub fn inequalities(&self, iterate: &Iterate<N, X>) -> Vec<Linearized<N, X>> {
+        let mut out = Vec::with_capacity(iterate.u.len() * self.problem.inequalities.len());
+        for (i, u) in iterate.u.iter().enumerate() {
+            let xt = self.x_theta(iterate, i);
+            out.extend(
+                self.problem
+                    .inequalities
+                    .iter()
+                    .map(|c| c.linearize(&xt, u)),
+            );
+        }
+        out
     }
 
     /// The Riccati factorisation with an inertia correction $\rho$ (scaled by $h$) that makes
@@ -215,13 +279,31 @@ where
     }
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
-    /// definite reduced Hessian, or a budget or the line search fails.
+    /// definite reduced Hessian (and, with inequalities, the barrier parameter at its floor
+    /// $\varepsilon / 10$), or a budget or the line search fails.
     pub fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
         let options = &self.problem.options;
-        let h = self.dynamics.h;
-        let mut rho_last = 0.0;
-        let mut penalty = 0.0;
-        let mut iterations = 0;
+        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        let count = self.problem.inequalities.len();
+        let values: Vec<f64> = self
+            .inequalities(&iterate)
+            .iter()
+            .map(|c| c.value)
+            .collect();
+        if !values.iter().all(|v| v.is_finite()) {
+            return Err(PlanError {
+                failure: Failure::NonFinite,
+                last: None,
+            });
+        }
+        let mu = if count > 0 {
+            options.initial_barrier
+        } else {
+            0.0
+        };
+        let mut barrier = Barrier::new(mu, count, &values);
+        let floor = options.tolerance / 10.0;
+        let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
         loop {
             let done = iterations;
@@ -235,7 +317,7 @@ where
                     certificate,
                 ))),
             };
-            let Some(models) = self.models(&iterate, &y) else {
+            let Some(models) = self.models(&iterate, &y, &barrier) else {
                 return Err(PlanError {
                     failure: Failure::NonFinite,
                     last: None,
@@ -243,13 +325,8 @@ where
             };
             let Some((riccati, rho)) = self.factor_corrected(&models, rho_last) else {
                 let unknown = super::optimize::unknown_certificate();
-                return Err(fail(
-                    Failure::Regularization,
-                    &iterate,
-                    models.cost,
-                    unknown,
-                    vec![],
-                ));
+                let failure = Failure::Regularization;
+                return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
             };
             rho_last = rho;
             let direction = riccati.solve(
@@ -259,30 +336,40 @@ where
                 &models.r0,
                 &models.r_end,
             );
-            let (momenta, stationarity) = kkt_residuals(&self.dynamics, &models.stages, &direction);
-            let mut certificate = Certificate {
+            let mut gradients = models.cost_gradient.clone();
+            barrier.lagrangian_gradients(&mut gradients, &models.inequalities, h);
+            let (momenta, stationarity) =
+                kkt_residuals(&self.dynamics, &models.stages, &gradients, &direction);
+            let (complementarity, complementarity_error) = barrier.complementarity();
+            let certificate = Certificate {
                 stationarity,
                 feasibility: models.violation_max(),
+                complementarity,
                 negative_directions: riccati.negative,
                 min_reduced_hessian_eig: f64::NAN,
             };
-            if stationarity <= options.tolerance && certificate.feasibility <= options.tolerance {
-                // the certificate is the factorisation without correction
-                let exact = if rho > 0.0 {
-                    Riccati::factor(&self.dynamics, &models.stages, 0.0)
-                } else {
-                    riccati
-                };
-                certificate.negative_directions = exact.negative;
-                if !exact.positive_definite() {
-                    let failure = Failure::NotAMinimum {
-                        negative_directions: exact.negative,
-                    };
-                    return Err(fail(failure, &iterate, models.cost, certificate, momenta));
-                }
-                certificate.min_reduced_hessian_eig =
-                    min_reduced_eigenvalue(&exact, &self.dynamics, self.problem.steps);
-                return Ok(self.plan(&iterate, models.cost, iterations, momenta, certificate));
+            let error = stationarity.max(certificate.feasibility);
+            if barrier.mu > floor && error.max(complementarity_error) <= 10.0 * barrier.mu {
+                barrier.decrease(floor);
+                continue;
+            }
+            // converged, or at the acceptable level with no progress left but rounding
+            let acceptable = stalled >= 3 && error.max(complementarity) <= options.acceptable;
+            if (error <= options.tolerance || acceptable) && barrier.mu <= floor {
+                return self
+                    .certify((&iterate, &y, &barrier), &models, riccati, rho, certificate)
+                    .map(|certificate| {
+                        self.plan(
+                            &iterate,
+                            models.cost,
+                            iterations,
+                            momenta.clone(),
+                            certificate,
+                        )
+                    })
+                    .map_err(|(failure, certificate)| {
+                        fail(failure, &iterate, models.cost, certificate, momenta)
+                    });
             }
             let out_of_time = options
                 .max_time
@@ -296,58 +383,131 @@ where
                 return Err(fail(failure, &iterate, models.cost, certificate, momenta));
             }
             iterations += 1;
-            let Some((next, alpha)) = self.line_search(&iterate, &models, &direction, &mut penalty)
+            let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
+            let Some((next, alpha, at_rounding)) =
+                self.line_search(&iterate, &models, &direction, &barrier, &ds, &mut penalty)
             else {
                 let failure = Failure::LineSearch;
                 return Err(fail(failure, &iterate, models.cost, certificate, momenta));
             };
             iterate = next;
-            // the constraint multipliers move with the primal step
+            barrier.update(&ds, alpha);
+            stalled = if at_rounding { stalled + 1 } else { 0 };
+            // the equality multipliers move with the primal step
             for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
                 *yi += (target - *yi) * alpha;
             }
         }
     }
 
-    /// Backtracking on $J + \pi \|c\|_1$ along the direction: the accepted point and step
-    /// length, `None` if no step is accepted.
+    /// The second-order check at a KKT point: the Hessian of the Lagrangian must be positive
+    /// definite on the null space of the constraints, with the active inequalities
+    /// ($s_k < z_k$: strict complementarity separates them by orders of magnitude) as
+    /// equalities and the barrier terms left out (the second-order sufficient condition; the
+    /// barrier Hessian itself is too ill-conditioned near the end to count its inertia). Then
+    /// its smallest eigenvalue completes the certificate.
+    fn certify(
+        &self,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        models: &Models<N, X>,
+        riccati: Riccati<N, X>,
+        rho: f64,
+        mut certificate: Certificate,
+    ) -> Result<Certificate, (Failure, Certificate)> {
+        let (iterate, y, barrier) = state;
+        let exact = if barrier.count > 0 {
+            let stages = self.active_set_models(iterate, y, barrier, &models.inequalities);
+            Riccati::factor(
+                &self.dynamics,
+                stages.as_deref().unwrap_or(&models.stages),
+                0.0,
+            )
+        } else if rho > 0.0 {
+            Riccati::factor(&self.dynamics, &models.stages, 0.0)
+        } else {
+            riccati
+        };
+        certificate.negative_directions = exact.negative;
+        if !exact.positive_definite() {
+            let failure = Failure::NotAMinimum {
+                negative_directions: exact.negative,
+            };
+            return Err((failure, certificate));
+        }
+        certificate.min_reduced_hessian_eig =
+            min_reduced_eigenvalue(&exact, &self.dynamics, self.problem.steps);
+        Ok(certificate)
+    }
+
+    /// The stage models of the Lagrangian (no barrier terms) with the active inequalities
+    /// appended to the equalities; `None` if a step has more than $n$ of them.
+    fn active_set_models(
+        &self,
+        iterate: &Iterate<N, X>,
+        y: &[SVector<f64, N>],
+        barrier: &Barrier,
+        lin: &[Linearized<N, X>],
+    ) -> Option<Vec<StageModel<N, X>>> {
+        let count = barrier.count;
+        let mut stages = Vec::with_capacity(iterate.u.len());
+        for (i, yi) in y.iter().enumerate() {
+            let mut stage = self.stage(iterate, i, yi, barrier, &[]);
+            for (k, c) in lin.iter().enumerate().skip(i * count).take(count) {
+                if barrier.s[k] < barrier.z[k] {
+                    let m = stage.constraints;
+                    if m >= N {
+                        return None;
+                    }
+                    stage.cx.set_row(m, &c.gx.transpose());
+                    stage.cu.set_row(m, &c.gu.transpose());
+                    stage.value[m] = 0.0;
+                    stage.constraints += 1;
+                }
+            }
+            stages.push(stage);
+        }
+        Some(stages)
+    }
+
+    /// Backtracking on $J - h \mu \sum \ln g + \pi \|c\|_1$ along the direction: the
+    /// accepted point, the step length and the inequalities' values there; `None` if no step
+    /// is accepted.
     fn line_search(
         &self,
         iterate: &Iterate<N, X>,
         models: &Models<N, X>,
         direction: &Direction<N, X>,
+        barrier: &Barrier,
+        ds: &[f64],
         penalty: &mut f64,
-    ) -> Option<(Iterate<N, X>, f64)> {
+    ) -> Option<(Iterate<N, X>, f64, bool)> {
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
         // directional derivative of J and the curvature of the model along the direction
-        let (mut slope, mut curvature) = (0.0, 0.0);
-        for (i, stage) in models.stages.iter().enumerate() {
+        let mut slope = 0.0;
+        for (i, (gx, gu)) in models.cost_gradient.iter().enumerate() {
             let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-            let du = &direction.du[i];
-            slope += stage.gx.dot(&dxt) + stage.gu.dot(du);
-            curvature += dxt.dot(&(stage.hxx * dxt))
-                + 2.0 * du.dot(&(stage.hux * dxt))
-                + du.dot(&(stage.huu * du));
+            slope += gx.dot(&dxt) + gu.dot(&direction.du[i]);
         }
+        slope += barrier.slope(ds, self.dynamics.h);
         let violation = models.violation_l1();
         if violation > 0.0 {
-            let needed = (slope + 0.5 * curvature.max(0.0)) / (0.9 * violation);
+            let needed = slope / (0.9 * violation);
             if needed > *penalty {
                 *penalty = needed * 1.1;
             }
         }
         let descent = slope - *penalty * violation;
-        let merit0 = models.cost + *penalty * violation;
+        let merit0 = models.barrier_cost + *penalty * violation;
         if !descent.is_finite() {
             return None;
         }
         // rounding of the merit function: of J and of the defects (about eps |x| each)
         let size: f64 = iterate.x.iter().map(|x| x.lp_norm(1)).sum();
-        let noise = 1e-14 * (models.cost.abs() + 2.0 * *penalty * size);
+        let noise = 1e-14 * (models.barrier_cost.abs() + 2.0 * *penalty * size);
         // a non-negative slope: the direction is at rounding level; take it as it is
         let descent = descent.min(0.0);
-        let mut alpha = 1.0;
+        let mut alpha = barrier.max_step(ds);
         for _ in 0..=options.max_backtracks {
             let trial = Iterate {
                 x: iterate
@@ -363,14 +523,15 @@ where
                     .map(|(u, d)| u + d * alpha)
                     .collect(),
             };
-            let merit = self
+            let parts = self
                 .problem
                 .guard::<S, M>(&trial)
                 .ok()
-                .and_then(|()| self.merit_parts(&trial))
-                .map(|(cost, violation)| cost + *penalty * violation);
-            if merit.is_some_and(|m| m <= merit0 + options.armijo * alpha * descent + noise) {
-                return Some((trial, alpha));
+                .and_then(|()| self.merit_parts(&trial, barrier, ds, alpha));
+            if parts.is_some_and(|(cost, violation)| {
+                cost + *penalty * violation <= merit0 + options.armijo * alpha * descent + noise
+            }) {
+                return Some((trial, alpha, -descent <= noise));
             }
             alpha *= 0.5;
         }

@@ -1,0 +1,174 @@
+//! Hard inequality constraints of the optimizer (interior point): bounds on the top
+//! derivative against a closed-form optimal control, a torque limit that is active at the
+//! optimum, and the errors for a guess outside an inequality.
+
+use std::f64::consts::PI;
+
+use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, Variable};
+use retract::{JetFunction, higher_order_lagrangian, jet_function};
+
+/// The double pendulum of the swing-up suite.
+#[higher_order_lagrangian(order = 2)]
+fn double_pendulum(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let tau1 = (3.0 + 2.0 * c2) * ddq[0] + (1.0 + c2) * ddq[1]
+        - s2 * (2.0 * dq[0] * dq[1] + dq[1] * dq[1])
+        + 2.0 * g * q[0].sin()
+        + g * (q[0] + q[1]).sin();
+    let tau2 = (1.0 + c2) * ddq[0] + ddq[1] + s2 * dq[0] * dq[0] + g * (q[0] + q[1]).sin();
+    0.5 * (tau1 * tau1 + tau2 * tau2)
+}
+
+/// limit - tau1 >= 0 (sign = 1) or limit + tau1 >= 0 (sign = -1): the shoulder torque limit.
+#[jet_function(order = 2)]
+fn shoulder_limit(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64, limit: f64, sign: f64) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let tau1 = (3.0 + 2.0 * c2) * ddq[0] + (1.0 + c2) * ddq[1]
+        - s2 * (2.0 * dq[0] * dq[1] + dq[1] * dq[1])
+        + 2.0 * g * q[0].sin()
+        + g * (q[0] + q[1]).sin();
+    limit - sign * tau1
+}
+
+/// tau1 at the evaluation point of every step of a plan.
+fn shoulder_torques(plan: &retract::bvp::Plan<2, 4>) -> Vec<f64> {
+    let torque = ShoulderLimit {
+        g: 9.81,
+        limit: 0.0,
+        sign: -1.0,
+    };
+    (0..plan.u.len())
+        .map(|i| {
+            let xt = (plan.x[i] + plan.x[i + 1]) * 0.5;
+            let b = [
+                xt.fixed_rows::<2>(0).into_owned(),
+                xt.fixed_rows::<2>(2).into_owned(),
+            ];
+            torque.value(&b, &plan.u[i])
+        })
+        .collect()
+}
+
+/// A shoulder torque limit of 10 (the unconstrained T = 2 swing-up peaks near 12): the plan
+/// keeps |tau1| <= 10 at every step, the limit is active, the cost is above the unconstrained
+/// one, and the point is certified (complementarity below the tolerance).
+#[test]
+fn a_torque_limit_holds_and_is_active() {
+    let system = DoublePendulum { g: 9.81 };
+    let goal = [PI, 0.0, 0.0, 0.0];
+    let (t_end, steps) = (2.0, 50);
+    let free = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, steps)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let free_peak = shoulder_torques(&free)
+        .iter()
+        .fold(0.0_f64, |m, t| m.max(t.abs()));
+    assert!(free_peak > 11.0, "unconstrained peak {free_peak}");
+    let upper = ShoulderLimit {
+        g: 9.81,
+        limit: 10.0,
+        sign: 1.0,
+    };
+    let lower = ShoulderLimit {
+        g: 9.81,
+        limit: 10.0,
+        sign: -1.0,
+    };
+    let plan = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, steps)
+        .with_inequality(&upper)
+        .with_inequality(&lower)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let peak = shoulder_torques(&plan)
+        .iter()
+        .fold(0.0_f64, |m, t| m.max(t.abs()));
+    assert!(peak <= 10.0 + 1e-9, "peak torque {peak}");
+    assert!(
+        peak > 10.0 - 1e-6,
+        "the limit should be active: peak {peak}"
+    );
+    assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+    assert!(plan.certificate.complementarity <= 1e-9);
+    // the limit costs something: without it, descent from this plan lowers the cost
+    let released = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, steps)
+        .solve(PlanGuess::Plan(&plan))
+        .unwrap();
+    assert!(
+        released.cost < plan.cost - 1e-6,
+        "{} vs {}",
+        released.cost,
+        plan.cost
+    );
+}
+
+/// x'' = u from rest at 0 to rest at 1 in T = 1 with |u| <= U, cost int 1/2 u^2.
+#[higher_order_lagrangian(order = 2)]
+fn double_integrator(_q: f64, _dq: f64, ddq: f64) -> f64 {
+    0.5 * ddq * ddq
+}
+
+/// With |u| <= U (4 < U < 6) the optimal control saturates near both ends:
+/// u = U on [0, 1/2 - a], U (1 - 2t) / (2a) in between, -U after, with a^2 = 3/4 - 3/U, and
+/// J = U^2 (1 - 4a/3) / 2 (a closed form independent of the solver). The bounded plan
+/// converges to it as N grows, and the bound holds at every step.
+#[test]
+fn bounded_control_converges_to_the_closed_form() {
+    let bound: f64 = 5.0;
+    let a = (0.75 - 3.0 / bound).sqrt();
+    let exact = 0.5 * bound * bound * (1.0 - 4.0 * a / 3.0);
+    let mut errors = Vec::new();
+    for steps in [25, 50, 100, 200] {
+        let plan = OptimalControlProblem::new(
+            &DoubleIntegrator::new(),
+            &[0.0, 0.0],
+            &[1.0, 0.0],
+            1.0,
+            steps,
+        )
+        .with_bounds(Variable::Top(0), -bound, bound)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+        assert!(plan.u.iter().all(|u| u[0].abs() <= bound + 1e-9));
+        assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+        errors.push((plan.cost - exact).abs());
+    }
+    assert!(errors[3] < 1e-3 * exact, "errors {errors:?}");
+    assert!(
+        errors.windows(2).all(|w| w[1] < 0.7 * w[0]),
+        "errors {errors:?}"
+    );
+}
+
+/// A bound that the first guess violates everywhere is reached anyway (the slacks start
+/// feasible), and infinite bounds add no constraint.
+#[test]
+fn bounds_need_no_feasible_guess_and_accept_infinite_sides() {
+    let plan =
+        OptimalControlProblem::new(&DoubleIntegrator::new(), &[0.0, 0.0], &[1.0, 0.0], 1.0, 40)
+            .with_bounds(Variable::Jet(1), f64::NEG_INFINITY, 1.6)
+            .solve(PlanGuess::Spline)
+            .unwrap();
+    // the spline's peak speed is 1.5; the free optimum's is 1.5 too, so impose 1.2 instead
+    assert!(plan.x.iter().all(|x| x[1] <= 1.6 + 1e-9));
+    let tight =
+        OptimalControlProblem::new(&DoubleIntegrator::new(), &[0.0, 0.0], &[1.0, 0.0], 1.0, 40)
+            .with_bounds(Variable::Jet(1), f64::NEG_INFINITY, 1.2)
+            .solve(PlanGuess::Spline)
+            .unwrap();
+    let peak = (0..40)
+        .map(|i| 0.5 * (tight.x[i][1] + tight.x[i + 1][1]))
+        .fold(0.0, f64::max);
+    assert!(
+        peak <= 1.2 + 1e-9 && peak > 1.2 - 1e-6,
+        "peak evaluation-point speed {peak}"
+    );
+    assert!(tight.cost > plan.cost);
+    let invalid =
+        OptimalControlProblem::new(&DoubleIntegrator::new(), &[0.0, 0.0], &[1.0, 0.0], 1.0, 40)
+            .with_bounds(Variable::Top(3), -1.0, 1.0)
+            .solve(PlanGuess::Spline)
+            .unwrap_err();
+    assert!(matches!(invalid.failure, Failure::Invalid(_)), "{invalid}");
+}
