@@ -421,3 +421,34 @@ fn the_cart_pole_swing_up_keeps_the_pole_unactuated() {
     }
     assert!(previous_gap < 1e-3 * plan.cost);
 }
+
+/// Receding horizon: after one step the shifted plan is a good start, so two real-time
+/// iterations reach the new problem's minimum cost to 1e-6 (residuals below 1e-4), and a cap of one
+/// iteration is reported as not converged rather than as a plan.
+#[test]
+fn real_time_iterations_track_a_receding_horizon() {
+    let system = OneDisc { tau: 1e-2 };
+    let steps = 200;
+    let plan = solve_disc(steps, PlanOptions::default()).unwrap();
+    let shifted = plan.shifted();
+    let start: [f64; 4] = plan.x[1].into();
+    let problem = OptimalControlProblem::new(&system, &start, &DISC_GOAL, 4.0, steps);
+    let full = problem.solve(PlanGuess::Plan(&shifted)).unwrap();
+    let quick = problem
+        .solve_real_time(PlanGuess::Plan(&shifted), 2)
+        .unwrap();
+    let c = &quick.plan.certificate;
+    assert!(c.stationarity < 1e-4 && c.feasibility < 1e-9, "{c:?}");
+    assert!((quick.plan.cost - full.cost).abs() < 1e-6 * full.cost);
+    let one = problem.solve_real_time(PlanGuess::Spline, 1);
+    // the straight spline crosses the disc: an error, not a plan
+    assert!(one.is_err());
+    let capped = problem
+        .solve_real_time(
+            PlanGuess::Plan(&solve_disc(steps, PlanOptions::default()).unwrap()),
+            1,
+        )
+        .unwrap();
+    assert!(!capped.converged);
+    assert_eq!(capped.plan.iterations, 1);
+}

@@ -191,6 +191,15 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     }
 }
 
+/// The result of [`OptimalControlProblem::solve_real_time`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RealTime<const N: usize, const X: usize> {
+    /// The last iterate (a certified minimum only if `converged`).
+    pub plan: Plan<N, X>,
+    /// Whether the KKT and second-order conditions hold at `plan`.
+    pub converged: bool,
+}
+
 /// Why the optimizer stopped without a certified plan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -496,6 +505,50 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             started: Instant::now(),
         }
         .run(iterate)
+    }
+
+    /// Real-time iteration for receding horizons (as acados' RTI): at most `iterations` SQP
+    /// iterations from `guess` (typically [`Plan::shifted`] of the last plan), whatever the
+    /// residuals then. The result says whether the plan is a certified minimum
+    /// ([`RealTime::converged`]); if not, its certificate holds the residuals reached.
+    ///
+    /// # Errors
+    /// As [`Self::solve`], except that running out of iterations is not an error.
+    pub fn solve_real_time<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        iterations: usize,
+    ) -> Result<RealTime<N, X>, PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
+        let capped = OptimalControlProblem {
+            system: self.system,
+            equalities: self.equalities.clone(),
+            inequalities: self.inequalities.clone(),
+            start: self.start,
+            goal: self.goal,
+            t_end: self.t_end,
+            steps: self.steps,
+            options: PlanOptions {
+                max_iterations: iterations.max(1),
+                ..self.options
+            },
+        };
+        match capped.solve(guess) {
+            Ok(plan) => Ok(RealTime {
+                plan,
+                converged: true,
+            }),
+            Err(PlanError {
+                failure: Failure::IterationLimit,
+                last: Some(plan),
+            }) => Ok(RealTime {
+                plan: *plan,
+                converged: false,
+            }),
+            Err(e) => Err(e),
+        }
     }
 
     fn initial(&self, guess: PlanGuess<'_, N, X>) -> Result<Iterate<N, X>, Error> {

@@ -1,0 +1,920 @@
+//! The root finder: Newton's method on the discrete necessary conditions.
+//!
+//! Given the jet $x = (q, \dots, q^{(k-1)})$ at both ends, $x(0) = a$ and $x(T) = b$, and
+//! $N$ steps of $h = T/N$, the unknowns are the whole discrete trajectory
+//! $v = (z_0, u_0, z_1, u_1, \dots, u_{N-1}, z_N)$ and the equations
+//!
+//! $$x(z_0) = a, \qquad F(z_i, (z_{i+1}, u_i)) = 0 \ (i < N), \qquad x(z_N) = b,$$
+//!
+//! with $F$ the theta-scheme residual of [`LiftedSystem`]. Newton's method with backtracking
+//! on $|R|^2$ solves them. Its linear system is solved in $O(N)$ by condensing
+//! ([`LinearSolver::Condensed`], the default): each step's unknowns are eliminated through
+//! its linearised step map $\delta w_i = \Phi_i \delta z_i + c_i$, which leaves an
+//! $nk \times nk$ system for the free initial momenta. [`BoundaryValueProblem::solve_reduced`]
+//! forms $\Phi_i$ from the cached factors of a [`ReducedScheme`] (a rank-$R$ update of a
+//! constant matrix) instead of a dense LU per step. The banded LU of the whole Jacobian
+//! ($k_l = k_u = nk + M - 1$ in this ordering, [`crate::banded`]) is the fallback.
+//!
+//! The first guess is the Hermite polynomial of degree $2k - 1$ between the boundary jets
+//! (the $V = 0$ spline), mapped through the system's Legendre map, or a previous solution
+//! (warm start, [`BvpSolution::shifted`] for receding horizons, [`continuation`] in a
+//! parameter). A solution whose clearance to an obstacle is negative is an error
+//! ([`Error::ThroughObstacle`]): inside an obstacle the cost is unbounded below, so such a
+//! stationary point is not a plan.
+
+//!
+//! It solves the KKT system of the transcription without looking at the cost, so it can stop
+//! at a saddle or a maximum; [`super::OptimalControlProblem`] is the optimizer.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use super::guess::Hermite;
+use crate::banded::BandMatrix;
+use crate::{Error, LiftedSystem, ReducedFactors, ReducedScheme};
+
+/// Options of the boundary-value solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct BvpOptions {
+    /// The scheme parameter $\theta$ (1/2: midpoint).
+    pub theta: f64,
+    /// Converged when $|R|_\infty \le$ this.
+    pub residual_tolerance: f64,
+    /// Newton iteration cap.
+    pub max_iterations: usize,
+    /// Armijo constant of the backtracking line search.
+    pub armijo: f64,
+    /// Step halvings per iteration.
+    pub max_backtracks: usize,
+    /// How the Newton direction is computed.
+    pub linear_solver: LinearSolver,
+}
+
+/// How the boundary-value Newton direction is computed. Both give the same direction up to
+/// rounding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum LinearSolver {
+    /// Eliminate each step's unknowns through its linearised step map and solve the
+    /// remaining $nk \times nk$ system for the free initial momenta (cost $O(N)$ small dense
+    /// products); the banded LU below when that fails (a singular step map or end system, or
+    /// no descent along the direction).
+    Condensed,
+    /// The banded LU with partial pivoting of the whole Jacobian ([`crate::banded`]).
+    Banded,
+}
+
+impl Default for BvpOptions {
+    fn default() -> Self {
+        Self {
+            theta: 0.5,
+            residual_tolerance: 1e-10,
+            max_iterations: 50,
+            armijo: 1e-4,
+            max_backtracks: 40,
+            linear_solver: LinearSolver::Condensed,
+        }
+    }
+}
+
+impl BvpOptions {
+    /// Sets the residual tolerance.
+    pub fn with_residual_tolerance(mut self, tolerance: f64) -> Self {
+        self.residual_tolerance = tolerance;
+        self
+    }
+
+    /// Sets the iteration cap.
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+
+    /// Sets $\theta$.
+    pub fn with_theta(mut self, theta: f64) -> Self {
+        self.theta = theta;
+        self
+    }
+
+    /// Sets how the Newton direction is computed.
+    pub fn with_linear_solver(mut self, linear_solver: LinearSolver) -> Self {
+        self.linear_solver = linear_solver;
+        self
+    }
+}
+
+/// Where Newton starts.
+#[derive(Clone, Copy, Debug)]
+pub enum Guess<'a, const S: usize, const M: usize> {
+    /// The Hermite spline of degree $2k-1$ between the boundary jets.
+    Spline,
+    /// A previous solution with the same number of steps (warm start).
+    Solution(&'a BvpSolution<S, M>),
+    /// States $z_0, \dots, z_N$ of a path chosen by the caller (e.g. around an obstacle);
+    /// the top derivatives come from [`LiftedSystem::predictor`] at each state.
+    States(&'a [SVector<f64, S>]),
+}
+
+/// A solved boundary-value problem.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BvpSolution<const S: usize, const M: usize> {
+    /// Step size $h = T/N$.
+    pub h: f64,
+    /// The scheme parameter used.
+    pub theta: f64,
+    /// $z_0, \dots, z_N$.
+    pub states: Vec<SVector<f64, S>>,
+    /// The Newton unknowns $w_i = (z_{i+1}, u_i)$ of each step.
+    pub unknowns: Vec<SVector<f64, M>>,
+    /// $J = \sum_i h\,L(x_{\theta,i}, u_i)$.
+    pub cost: f64,
+    /// Minimum clearance to each obstacle over $z_0..z_N$ (empty without a clearance function).
+    pub clearance: Vec<f64>,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// $|R|_\infty$ at the solution.
+    pub residual_norm: f64,
+}
+
+impl<const S: usize, const M: usize> BvpSolution<S, M> {
+    /// The solution shifted one step forward in time, for a receding-horizon warm start:
+    /// $z_i \leftarrow z_{i+1}$, the new last step one integrator step from the old end
+    /// (repeating the last step's unknowns if that step fails).
+    pub fn shifted<Sys>(&self, system: &Sys) -> Self
+    where
+        Sys: LiftedSystem<S, M> + ?Sized,
+    {
+        let mut out = self.clone();
+        let (Some(&last_z), Some(&last_w)) = (self.states.last(), self.unknowns.last()) else {
+            return out;
+        };
+        let options = crate::StepOptions::default().with_theta(self.theta);
+        let next_w = system
+            .predictor(&last_z, self.h, self.theta)
+            .and_then(|guess| crate::step::solve_step(system, &last_z, guess, self.h, &options))
+            .map(|(w, _)| w)
+            .unwrap_or(last_w);
+        out.states.remove(0);
+        out.states.push(system.state(&next_w));
+        out.unknowns.remove(0);
+        out.unknowns.push(next_w);
+        out
+    }
+}
+
+/// Per-obstacle clearance of a state: writes one signed distance per obstacle into `out`
+/// (negative inside).
+pub type ClearanceFn<'a, const S: usize> = &'a dyn Fn(&SVector<f64, S>, &mut [f64]);
+
+/// A boundary-value problem: a system, the boundary jets, the horizon and the step count.
+pub struct BoundaryValueProblem<'a, Sys: ?Sized, const S: usize, const M: usize> {
+    system: &'a Sys,
+    start: &'a [f64],
+    goal: &'a [f64],
+    t_end: f64,
+    steps: usize,
+    options: BvpOptions,
+    clearance: Option<(usize, ClearanceFn<'a, S>)>,
+}
+
+/// Index layout of the unknowns and equations.
+#[derive(Clone, Copy)]
+struct Layout {
+    s: usize,
+    m: usize,
+    nk: usize,
+    steps: usize,
+}
+
+impl Layout {
+    fn size(&self) -> usize {
+        self.steps * self.m + self.s
+    }
+    fn z(&self, i: usize) -> usize {
+        i * self.m
+    }
+    fn u(&self, i: usize) -> usize {
+        i * self.m + self.s
+    }
+    /// Column of entry `c` of w_i = (z_{i+1}, u_i).
+    fn w(&self, i: usize, c: usize) -> usize {
+        if c < self.s {
+            self.z(i + 1) + c
+        } else {
+            self.u(i) + c - self.s
+        }
+    }
+    fn row(&self, i: usize) -> usize {
+        self.nk + i * self.m
+    }
+    fn bandwidth(&self) -> usize {
+        self.nk + self.m - 1
+    }
+}
+
+fn all_finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+impl<'a, Sys, const S: usize, const M: usize> BoundaryValueProblem<'a, Sys, S, M>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    /// The problem $x(0) = $ `start`, $x(T) = $ `goal` (each $nk$ numbers: $q, q', \dots,
+    /// q^{(k-1)}$, blocks of $n$) over $T = $ `t_end` with `steps` steps.
+    pub fn new(
+        system: &'a Sys,
+        start: &'a [f64],
+        goal: &'a [f64],
+        t_end: f64,
+        steps: usize,
+    ) -> Self {
+        Self {
+            system,
+            start,
+            goal,
+            t_end,
+            steps,
+            options: BvpOptions::default(),
+            clearance: None,
+        }
+    }
+
+    /// Sets the options.
+    pub fn with_options(mut self, options: BvpOptions) -> Self {
+        self.options = options;
+        self
+    }
+
+    /// Checks the clearance to `obstacles` obstacles on every state of the solution.
+    pub fn with_clearance(mut self, obstacles: usize, clearance: ClearanceFn<'a, S>) -> Self {
+        self.clearance = Some((obstacles, clearance));
+        self
+    }
+
+    fn layout(&self) -> Layout {
+        Layout {
+            s: S,
+            m: M,
+            nk: S / 2,
+            steps: self.steps,
+        }
+    }
+
+    fn h(&self) -> f64 {
+        self.t_end / self.steps as f64
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        let nk = S / 2;
+        let invalid = |name, requirement| Err(Error::InvalidArgument { name, requirement });
+        if M != S + Sys::DIMENSION {
+            return invalid(
+                "system",
+                "the boundary-value solver needs the general unknowns w = (z_1, u)",
+            );
+        }
+        if self.start.len() != nk || self.goal.len() != nk {
+            return invalid(
+                "start/goal",
+                "boundary data must hold q, ..., q^(k-1): n k numbers",
+            );
+        }
+        if !all_finite(self.start) || !all_finite(self.goal) {
+            return invalid("start/goal", "boundary data must be finite");
+        }
+        if self.steps == 0 {
+            return invalid("steps", "at least one step is needed");
+        }
+        if !(self.t_end.is_finite() && self.t_end > 0.0) {
+            return invalid("t_end", "the horizon must be finite and positive");
+        }
+        if !(0.0..=1.0).contains(&self.options.theta) {
+            return invalid("theta", "theta must lie in [0, 1]");
+        }
+        let tolerance = self.options.residual_tolerance;
+        if self.options.max_iterations == 0 || tolerance.is_nan() || tolerance < 0.0 {
+            return invalid("options", "need max_iterations >= 1 and a tolerance >= 0");
+        }
+        Ok(())
+    }
+
+    /// The Hermite-spline guess, through the Legendre map.
+    fn spline_guess(&self) -> Result<Vec<f64>, Error> {
+        let (n, k) = (Sys::DIMENSION, Sys::ORDER);
+        let spline = Hermite::new(self.start, self.goal, self.t_end, n, k)?;
+        let layout = self.layout();
+        let h = self.h();
+        let mut v = vec![0.0; layout.size()];
+        for step in 0..=self.steps {
+            let t = step as f64 * h;
+            let jet = SVector::<f64, S>::from_fn(|r, _| spline.jet_entry(r, t));
+            let z = self.system.legendre(&jet);
+            v[layout.z(step)..layout.z(step) + S].copy_from_slice(z.as_slice());
+            if step < self.steps {
+                let t_mid = t + self.options.theta * h;
+                for i in 0..n {
+                    v[layout.u(step) + i] = spline.derivative(i, k, t_mid);
+                }
+            }
+        }
+        Ok(v)
+    }
+
+    fn guess_from_solution(&self, guess: &BvpSolution<S, M>) -> Result<Vec<f64>, Error> {
+        if guess.states.len() != self.steps + 1 || guess.unknowns.len() != self.steps {
+            return Err(Error::InvalidArgument {
+                name: "guess",
+                requirement: "a warm start needs a solution with the same number of steps",
+            });
+        }
+        let layout = self.layout();
+        let mut v = vec![0.0; layout.size()];
+        for (i, z) in guess.states.iter().enumerate() {
+            v[layout.z(i)..layout.z(i) + S].copy_from_slice(z.as_slice());
+        }
+        for (i, w) in guess.unknowns.iter().enumerate() {
+            v[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&w.as_slice()[S..]);
+        }
+        Ok(v)
+    }
+
+    fn guess_from_states(&self, states: &[SVector<f64, S>]) -> Result<Vec<f64>, Error> {
+        if states.len() != self.steps + 1 {
+            return Err(Error::InvalidArgument {
+                name: "guess",
+                requirement: "a guess needs N + 1 states",
+            });
+        }
+        let layout = self.layout();
+        let mut v = vec![0.0; layout.size()];
+        for (i, z) in states.iter().enumerate() {
+            v[layout.z(i)..layout.z(i) + S].copy_from_slice(z.as_slice());
+            if i < self.steps {
+                let w = self.system.predictor(z, self.h(), self.options.theta)?;
+                v[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&w.as_slice()[S..]);
+            }
+        }
+        Ok(v)
+    }
+
+    fn state(&self, v: &[f64], i: usize) -> SVector<f64, S> {
+        let at = self.layout().z(i);
+        SVector::from_column_slice(&v[at..at + S])
+    }
+
+    fn unknowns(&self, v: &[f64], i: usize) -> SVector<f64, M> {
+        // w_i = (z_{i+1}, u_i): two contiguous pieces of v
+        let layout = self.layout();
+        let mut w = SVector::<f64, M>::zeros();
+        let (z_next, u) = w.as_mut_slice().split_at_mut(S);
+        z_next.copy_from_slice(&v[layout.z(i + 1)..layout.z(i + 1) + S]);
+        u.copy_from_slice(&v[layout.u(i)..layout.u(i) + M - S]);
+        w
+    }
+
+    fn residual(&self, v: &[f64], out: &mut [f64]) {
+        let layout = self.layout();
+        let (h, theta, nk) = (self.h(), self.options.theta, layout.nk);
+        for j in 0..nk {
+            out[j] = v[layout.z(0) + j] - self.start[j];
+            out[layout.row(self.steps) + j] = v[layout.z(self.steps) + j] - self.goal[j];
+        }
+        for i in 0..self.steps {
+            let f = self
+                .system
+                .residual(&self.state(v, i), &self.unknowns(v, i), h, theta);
+            out[layout.row(i)..layout.row(i) + M].copy_from_slice(f.as_slice());
+        }
+    }
+
+    fn jacobian(&self, v: &[f64], band: &mut BandMatrix) {
+        let layout = self.layout();
+        let (h, theta, nk) = (self.h(), self.options.theta, layout.nk);
+        band.clear();
+        for j in 0..nk {
+            band.set(j, layout.z(0) + j, 1.0);
+            band.set(layout.row(self.steps) + j, layout.z(self.steps) + j, 1.0);
+        }
+        for i in 0..self.steps {
+            let (z, w) = (self.state(v, i), self.unknowns(v, i));
+            let a = self.system.jacobian_initial(&z, &w, h, theta);
+            let b = self.system.jacobian(&z, &w, h, theta);
+            let row = layout.row(i);
+            for r in 0..M {
+                for c in 0..S {
+                    let value = a[(r, c)];
+                    if value != 0.0 {
+                        band.set(row + r, layout.z(i) + c, value);
+                    }
+                }
+                for c in 0..M {
+                    let value = b[(r, c)];
+                    if value != 0.0 {
+                        band.set(row + r, layout.w(i, c), value);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solves the problem from `guess`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for inconsistent data; Newton failures
+    /// ([`Error::NonFinite`], [`Error::SingularJacobian`], [`Error::LineSearchFailed`],
+    /// [`Error::NoConvergence`]); [`Error::ThroughObstacle`] for a solution with negative
+    /// clearance.
+    pub fn solve(&self, guess: Guess<'_, S, M>) -> Result<BvpSolution<S, M>, Error> {
+        let system = self.system;
+        let (h, theta) = (self.h(), self.options.theta);
+        self.solve_with(
+            guess,
+            &|z: &SVector<f64, S>, w: &SVector<f64, M>, f: &SVector<f64, M>| {
+                general_step_map(system, z, w, f, h, theta)
+            },
+        )
+    }
+
+    /// [`Self::solve`] with the linearised step maps of a [`ReducedScheme`]: the same Newton
+    /// iterates, with each step's linearisation from the cached factors of the reduced step
+    /// (a rank-$R$ update of a constant map) instead of a dense factorisation per step.
+    ///
+    /// # Errors
+    /// As [`Self::solve`]; a singular linear part is [`Error::SingularJacobian`].
+    pub fn solve_reduced<const R: usize>(
+        &self,
+        guess: Guess<'_, S, M>,
+    ) -> Result<BvpSolution<S, M>, Error>
+    where
+        Sys: ReducedScheme<S, M, R>,
+    {
+        let (h, theta) = (self.h(), self.options.theta);
+        let map = ReducedStepMap::new(self.system, h, theta)?;
+        self.solve_with(
+            guess,
+            &|z: &SVector<f64, S>, w: &SVector<f64, M>, f: &SVector<f64, M>| map.linearize(z, w, f),
+        )
+    }
+
+    fn solve_with(
+        &self,
+        guess: Guess<'_, S, M>,
+        linearize: StepMap<'_, S, M>,
+    ) -> Result<BvpSolution<S, M>, Error> {
+        self.validate()?;
+        let mut v = match guess {
+            Guess::Spline => self.spline_guess()?,
+            Guess::Solution(previous) => self.guess_from_solution(previous)?,
+            Guess::States(states) => self.guess_from_states(states)?,
+        };
+        if let Some((obstacle, step, clearance)) = self.first_collision(&v) {
+            return Err(Error::GuessThroughObstacle {
+                obstacle,
+                step,
+                clearance,
+            });
+        }
+        let layout = self.layout();
+        let size = layout.size();
+        let options = &self.options;
+        let mut r = vec![0.0; size];
+        self.residual(&v, &mut r);
+        if !all_finite(&v) || !all_finite(&r) {
+            return Err(Error::NonFinite {
+                iteration: 0,
+                location: "boundary-value residual of the first guess",
+            });
+        }
+        let mut band: Option<BandMatrix> = None;
+        let mut maps = Vec::with_capacity(self.steps);
+        let mut delta = vec![0.0; size];
+        let mut trial = vec![0.0; size];
+        let mut r_trial = vec![0.0; size];
+        let mut r_norm = max_abs(&r);
+        let mut iterations = 0;
+        while r_norm > options.residual_tolerance {
+            if iterations == options.max_iterations {
+                return Err(Error::NoConvergence {
+                    iterations,
+                    residual_norm: r_norm,
+                });
+            }
+            iterations += 1;
+            // the condensed direction (O(N) small dense work); the banded factorisation of the
+            // whole Jacobian if condensing fails or its direction is not a descent direction
+            let mut accepted = options.linear_solver == LinearSolver::Condensed
+                && condensed_direction(self, &v, &r, &mut delta, linearize, &mut maps)
+                && self.line_search(&v, &r, &delta, &mut trial, &mut r_trial);
+            if !accepted {
+                let band = band.get_or_insert_with(|| {
+                    let bw = layout.bandwidth();
+                    BandMatrix::zeros(size, bw, bw)
+                });
+                self.banded_direction(&v, &r, band, &mut delta, iterations)?;
+                accepted = self.line_search(&v, &r, &delta, &mut trial, &mut r_trial);
+            }
+            if !accepted {
+                return Err(Error::LineSearchFailed {
+                    iteration: iterations,
+                    residual_norm: r_norm,
+                });
+            }
+            std::mem::swap(&mut v, &mut trial);
+            std::mem::swap(&mut r, &mut r_trial);
+            r_norm = max_abs(&r);
+        }
+        self.finish(&v, iterations, r_norm)
+    }
+
+    /// The Newton direction from the banded LU of the whole Jacobian.
+    fn banded_direction(
+        &self,
+        v: &[f64],
+        r: &[f64],
+        band: &mut BandMatrix,
+        delta: &mut [f64],
+        iteration: usize,
+    ) -> Result<(), Error> {
+        self.jacobian(v, band);
+        band.factor()
+            .map_err(|_| Error::SingularJacobian { iteration })?;
+        for (d, ri) in delta.iter_mut().zip(r) {
+            *d = -ri;
+        }
+        band.solve(delta);
+        if all_finite(delta) {
+            Ok(())
+        } else {
+            Err(Error::SingularJacobian { iteration })
+        }
+    }
+
+    /// Backtracking along `delta` from `v` (residual `r`): on success `trial` holds the
+    /// accepted point and `r_trial` its residual.
+    fn line_search(
+        &self,
+        v: &[f64],
+        r: &[f64],
+        delta: &[f64],
+        trial: &mut [f64],
+        r_trial: &mut [f64],
+    ) -> bool {
+        let options = &self.options;
+        let phi: f64 = r.iter().map(|x| x * x).sum();
+        let mut alpha = 1.0;
+        for _ in 0..=options.max_backtracks {
+            for ((t, vi), di) in trial.iter_mut().zip(v).zip(delta) {
+                *t = vi + alpha * di;
+            }
+            self.residual(trial, r_trial);
+            if all_finite(r_trial) {
+                let phi_trial: f64 = r_trial.iter().map(|x| x * x).sum();
+                if phi_trial <= (1.0 - 2.0 * options.armijo * alpha) * phi {
+                    return true;
+                }
+            }
+            alpha *= 0.5;
+        }
+        false
+    }
+
+    /// The first (obstacle, state, clearance) with negative (or NaN) clearance.
+    fn first_collision(&self, v: &[f64]) -> Option<(usize, usize, f64)> {
+        let (count, f) = self.clearance?;
+        let mut buffer = vec![0.0; count];
+        for step in 0..=self.steps {
+            f(&self.state(v, step), &mut buffer);
+            if let Some((obstacle, &c)) = buffer
+                .iter()
+                .enumerate()
+                .find(|(_, c)| c.is_nan() || **c < 0.0)
+            {
+                return Some((obstacle, step, c));
+            }
+        }
+        None
+    }
+
+    fn finish(
+        &self,
+        v: &[f64],
+        iterations: usize,
+        residual_norm: f64,
+    ) -> Result<BvpSolution<S, M>, Error> {
+        let (h, theta) = (self.h(), self.options.theta);
+        let states: Vec<_> = (0..=self.steps).map(|i| self.state(v, i)).collect();
+        let unknowns: Vec<_> = (0..self.steps).map(|i| self.unknowns(v, i)).collect();
+        let cost = states
+            .iter()
+            .zip(&unknowns)
+            .map(|(z, w)| self.system.step_cost(z, w, h, theta))
+            .sum();
+        if let Some((obstacle, step, clearance)) = self.first_collision(v) {
+            return Err(Error::ThroughObstacle {
+                obstacle,
+                step,
+                clearance,
+            });
+        }
+        let mut clearance = Vec::new();
+        if let Some((count, f)) = self.clearance {
+            clearance = vec![f64::INFINITY; count];
+            let mut buffer = vec![0.0; count];
+            for z in &states {
+                f(z, &mut buffer);
+                for (best, &c) in clearance.iter_mut().zip(&buffer) {
+                    *best = best.min(c);
+                }
+            }
+        }
+        Ok(BvpSolution {
+            h,
+            theta,
+            states,
+            unknowns,
+            cost,
+            clearance,
+            iterations,
+            residual_norm,
+        })
+    }
+}
+
+/// The linearisation of step $i$ from $z_i$, $w_i$ and the step's residual $F_i$; `None` if
+/// singular.
+type StepMap<'a, const S: usize, const M: usize> =
+    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<Linearized<S, M>>;
+
+/// The linearised map of one step at the current iterate, $\delta w = \Phi \delta z + c$, with
+/// $\Phi$ and $c$ solving $\partial_z F\, \delta z + \partial_w F\, \delta w = -F$.
+struct Linearized<const S: usize, const M: usize> {
+    phi: SMatrix<f64, M, S>,
+    c: SVector<f64, M>,
+}
+
+impl<const S: usize, const M: usize> Linearized<S, M> {
+    /// $\Phi\, \delta z + c$.
+    fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M> {
+        let mut out = self.c;
+        self.add_product(&mut out, dz);
+        out
+    }
+
+    /// The $z$ rows of $\Phi x$.
+    fn linear_z(&self, x: &SVector<f64, S>) -> SVector<f64, S> {
+        let mut out = SVector::<f64, S>::zeros();
+        self.add_product(&mut out, x);
+        out
+    }
+
+    /// `out += ` the first `LEN` rows of $\Phi x$, column by column over slices of constant
+    /// length: the inner loop runs down a contiguous column and vectorises (nalgebra's generic
+    /// product on a row view does not).
+    fn add_product<const LEN: usize>(&self, out: &mut SVector<f64, LEN>, x: &SVector<f64, S>) {
+        for (column, &weight) in self.phi.as_slice().chunks_exact(M).zip(x.iter()) {
+            for (o, p) in out.as_mut_slice().iter_mut().zip(column) {
+                *o += p * weight;
+            }
+        }
+    }
+}
+
+/// $\Phi = -(\partial_w F)^{-1} \partial_z F$ and $c = -(\partial_w F)^{-1} F$ by one dense LU.
+fn general_step_map<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    f: &SVector<f64, M>,
+    h: f64,
+    theta: f64,
+) -> Option<Linearized<S, M>>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let mut phi = -system.jacobian_initial(z, w, h, theta);
+    let mut c = -f;
+    crate::linalg::solve_pair_in_place(system.jacobian(z, w, h, theta), &mut phi, &mut c)
+        .then_some(Linearized { phi, c })
+}
+
+/// The step maps of a [`ReducedScheme`]. With $F = A w + B z + n(y)$,
+/// $y = \theta E w + (1-\theta) E z$, $N = \partial n / \partial y$ at the iterate,
+/// $g = A^{-1} F$ and $H = A^{-1} N$, the linearised step is
+/// $(I + \theta E H)\, \delta y = G \delta z - \theta E g$ and
+/// $\delta w = T \delta z - g - H \delta y$ (notation of [`crate::reduced`]): a rank-$R$ change
+/// of the constant map $T$ (formed densely: the dense products vectorise, an index list of
+/// the nonzeros of $T$ measured slower).
+struct ReducedStepMap<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
+    system: &'a Sys,
+    factors: ReducedFactors<S, M, R>,
+    a_inv: SMatrix<f64, M, M>,
+}
+
+impl<'a, Sys, const S: usize, const M: usize, const R: usize> ReducedStepMap<'a, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    fn new(system: &'a Sys, h: f64, theta: f64) -> Result<Self, Error> {
+        let factors = ReducedFactors::new(system, h, theta)?;
+        let a_inv = crate::linalg::solve(
+            &system.linear_part(h, theta),
+            &SMatrix::<f64, M, M>::identity(),
+        )
+        .ok_or(Error::SingularJacobian { iteration: 0 })?;
+        Ok(Self {
+            system,
+            factors,
+            a_inv,
+        })
+    }
+
+    fn linearize(
+        &self,
+        z: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        f: &SVector<f64, M>,
+    ) -> Option<Linearized<S, M>> {
+        let ReducedFactors { h, theta, .. } = self.factors;
+        let y = SVector::<f64, R>::from_fn(|m, _| {
+            let c = Sys::CORE[m];
+            (1.0 - theta) * z[c] + theta * w[c]
+        });
+        let n = self.system.forcing_jacobian(&y, h, theta);
+        // g = A^{-1} F over the blocks of A (A^{-1} is block diagonal after permutation)
+        let mut g = SVector::<f64, M>::zeros();
+        for &(rows, cols) in Sys::BLOCKS {
+            for &c in cols {
+                g[c] = rows.iter().map(|&r| self.a_inv[(c, r)] * f[r]).sum();
+            }
+        }
+        let mut hm = SMatrix::<f64, M, R>::zeros();
+        for &q in Sys::FORCED {
+            for m in 0..R {
+                let nq = n[(q, m)];
+                if nq != 0.0 {
+                    for r in 0..M {
+                        hm[(r, m)] += self.a_inv[(r, q)] * nq;
+                    }
+                }
+            }
+        }
+        let mut lhs = SMatrix::<f64, R, R>::identity();
+        let mut x = self.factors.g;
+        let mut x0 = SVector::<f64, R>::zeros();
+        for (m, &c) in Sys::CORE.iter().enumerate() {
+            for l in 0..R {
+                lhs[(m, l)] += theta * hm[(c, l)];
+            }
+            x0[m] = -theta * g[c];
+        }
+        // delta y = X delta z + x0, so Phi = T - H X and c = -g - H x0
+        // delta y = X delta z + x0, so Phi = T - H X and c = -g - H x0
+        if !crate::linalg::solve_small_pair_in_place(lhs, &mut x, &mut x0) {
+            return None;
+        }
+        let (mut phi, mut c) = (self.factors.t, -g);
+        for m in 0..R {
+            for col in 0..S {
+                let weight = x[(m, col)];
+                for r in 0..M {
+                    phi[(r, col)] -= hm[(r, m)] * weight;
+                }
+            }
+            for r in 0..M {
+                c[r] -= hm[(r, m)] * x0[m];
+            }
+        }
+        Some(Linearized { phi, c })
+    }
+}
+
+/// The condensed Newton direction.
+///
+/// Eliminating $\delta w_i = \Phi_i \delta z_i + c_i$ step by step leaves the recursion
+/// $\delta z_{i+1} = \Phi^z_i \delta z_i + c^z_i$ ($z$ rows), with $\delta x_0 = -(x_0 - a)$ known and
+/// $\delta p_0 = \xi$ free: $\delta z_i = Z_i \xi + \zeta_i$, and $\xi$ solves the $nk \times nk$
+/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\, nk\, S M)$, no banded matrix.
+/// Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or the end
+/// system is singular or the direction is not finite.
+fn condensed_direction<Sys, const S: usize, const M: usize>(
+    problem: &BoundaryValueProblem<'_, Sys, S, M>,
+    v: &[f64],
+    r: &[f64],
+    delta: &mut [f64],
+    linearize: StepMap<'_, S, M>,
+    maps: &mut Vec<Linearized<S, M>>,
+) -> bool
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let layout = problem.layout();
+    let (nk, steps) = (layout.nk, problem.steps);
+    maps.clear();
+    for i in 0..steps {
+        let f = SVector::<f64, M>::from_column_slice(&r[layout.row(i)..layout.row(i) + M]);
+        match linearize(&problem.state(v, i), &problem.unknowns(v, i), &f) {
+            Some(map) => maps.push(map),
+            None => return false,
+        }
+    }
+    // forward sweep of the sensitivity Z_i (nk columns) and the offset zeta_i
+    let mut sensitivity: Vec<SVector<f64, S>> = (0..nk)
+        .map(|j| SVector::from_fn(|row, _| if row == nk + j { 1.0 } else { 0.0 }))
+        .collect();
+    let mut zeta = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { 0.0 });
+    for map in maps.iter() {
+        for column in &mut sensitivity {
+            *column = map.linear_z(column);
+        }
+        zeta = map.affine(&zeta).fixed_rows::<S>(0).into_owned();
+    }
+    let end = layout.row(steps);
+    let lhs = DMatrix::<f64>::from_fn(nk, nk, |row, j| sensitivity[j][row]);
+    let rhs = DVector::<f64>::from_fn(nk, |row, _| -r[end + row] - zeta[row]);
+    let Some(xi) = lhs.lu().solve(&rhs) else {
+        return false;
+    };
+    // second sweep: delta z_i and delta u_i
+    let mut dz = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { xi[row - nk] });
+    delta[layout.z(0)..layout.z(0) + S].copy_from_slice(dz.as_slice());
+    for (i, map) in maps.iter().enumerate() {
+        let dw = map.affine(&dz);
+        delta[layout.z(i + 1)..layout.z(i + 1) + S].copy_from_slice(&dw.as_slice()[..S]);
+        delta[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&dw.as_slice()[S..]);
+        dz = dw.fixed_rows::<S>(0).into_owned();
+    }
+    all_finite(delta)
+}
+
+/// Solves a sequence of problems whose system depends on a parameter (e.g. a barrier weight
+/// from large to small), each warm-started from the previous solution, the first from
+/// `first_guess`. Returns the last solution.
+///
+/// # Errors
+/// The first failing solve's error.
+#[allow(clippy::too_many_arguments)]
+pub fn continuation<Sys, F, const S: usize, const M: usize>(
+    make: F,
+    parameters: &[f64],
+    start: &[f64],
+    goal: &[f64],
+    t_end: f64,
+    steps: usize,
+    options: BvpOptions,
+    clearance: Option<(usize, ClearanceFn<'_, S>)>,
+    first_guess: Guess<'_, S, M>,
+) -> Result<BvpSolution<S, M>, Error>
+where
+    Sys: LiftedSystem<S, M>,
+    F: Fn(f64) -> Sys,
+{
+    let mut previous: Option<BvpSolution<S, M>> = None;
+    for &parameter in parameters {
+        let system = make(parameter);
+        let mut problem =
+            BoundaryValueProblem::new(&system, start, goal, t_end, steps).with_options(options);
+        if let Some((count, f)) = clearance {
+            problem = problem.with_clearance(count, f);
+        }
+        let guess = match &previous {
+            Some(solution) => Guess::Solution(solution),
+            None => first_guess,
+        };
+        previous = Some(problem.solve(guess)?);
+    }
+    previous.ok_or(Error::InvalidArgument {
+        name: "parameters",
+        requirement: "continuation needs at least one parameter value",
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::PlanarBarrier;
+
+    #[test]
+    fn a_failing_condensation_falls_back_to_the_banded_solve() {
+        let system = PlanarBarrier {
+            tau: 1e-2,
+            radius: 1.0,
+            mass: 1.0,
+        };
+        let (start, goal) = ([-2.0, 1.5, 1.0, 0.0], [2.0, 1.5, 1.0, 0.0]);
+        let problem = BoundaryValueProblem::new(&system, &start, &goal, 4.0, 100);
+        let never = |_: &SVector<f64, 8>, _: &SVector<f64, 10>, _: &SVector<f64, 10>| {
+            None::<Linearized<8, 10>>
+        };
+        let fallback = problem.solve_with(Guess::Spline, &never).unwrap();
+        let condensed = problem.solve(Guess::Spline).unwrap();
+        assert_eq!(fallback.iterations, condensed.iterations);
+        for (a, b) in fallback.states.iter().zip(&condensed.states) {
+            assert!((a - b).amax() < 1e-10);
+        }
+    }
+}
