@@ -333,6 +333,23 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     pub(super) options: PlanOptions,
 }
 
+impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
+    for OptimalControlProblem<'_, Sys, N, K, X>
+{
+    fn clone(&self) -> Self {
+        Self {
+            system: self.system,
+            equalities: self.equalities.clone(),
+            inequalities: self.inequalities.clone(),
+            start: self.start,
+            goal: self.goal,
+            t_end: self.t_end,
+            steps: self.steps,
+            options: self.options,
+        }
+    }
+}
+
 impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     OptimalControlProblem<'a, Sys, N, K, X>
 {
@@ -370,7 +387,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 
     /// Adds the inequality $g(x_{\theta,i}, u_i) \ge 0$ at the evaluation point of every step
     /// (obstacle clearance, a keep-out cone, a torque limit $\tau_{\max} - \tau \ge 0$),
-    /// handled by the interior-point iteration with slacks ([`super::barrier`]): the first
+    /// handled by the interior-point iteration with slacks (see the module docs): the first
     /// guess need not satisfy it.
     pub fn with_inequality(mut self, constraint: &'a dyn JetFunction<N, K>) -> Self {
         self.inequalities
@@ -522,19 +539,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
-        let capped = OptimalControlProblem {
-            system: self.system,
-            equalities: self.equalities.clone(),
-            inequalities: self.inequalities.clone(),
-            start: self.start,
-            goal: self.goal,
-            t_end: self.t_end,
-            steps: self.steps,
-            options: PlanOptions {
-                max_iterations: iterations.max(1),
-                ..self.options
-            },
-        };
+        let mut capped = self.clone();
+        capped.options.max_iterations = iterations.max(1);
         match capped.solve(guess) {
             Ok(plan) => Ok(RealTime {
                 plan,
