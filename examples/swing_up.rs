@@ -9,7 +9,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use retract::bvp::{OptimalControlProblem, PlanGuess};
+use retract::bvp::{OptimalControlProblem, PlanGuess, PlanOptions};
 use retract::{higher_order_lagrangian, jet_function};
 
 /// Double pendulum (point masses at the rod ends, angles from the downward vertical, the
@@ -67,10 +67,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "quick");
     let horizons: &[f64] = if quick { &[1.0] } else { &[2.0, 3.0, 4.0] };
     let pendulum = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    // the line reports the smallest eigenvalue, so compute it (the inertia alone certifies)
+    let options = PlanOptions::default().with_min_eigenvalue(true);
     for &t_end in horizons {
         let steps = (100.0 * t_end) as usize;
         let problem =
-            OptimalControlProblem::new(&pendulum, &[0.0; 4], &[PI, 0.0, 0.0, 0.0], t_end, steps);
+            OptimalControlProblem::new(&pendulum, &[0.0; 4], &[PI, 0.0, 0.0, 0.0], t_end, steps)
+                .with_options(options);
         let start = Instant::now();
         let plan = problem.solve(PlanGuess::Spline)?;
         report(
@@ -87,7 +90,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         let steps = (100.0 * t_end) as usize;
         let problem =
             OptimalControlProblem::new(&cart, &[0.0; 4], &[0.0, PI, 0.0, 0.0], t_end, steps)
-                .with_equality(&unactuated);
+                .with_equality(&unactuated)
+                .with_options(options);
         let start = Instant::now();
         let plan = problem.solve(PlanGuess::Spline)?;
         report(

@@ -127,7 +127,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
         beta = dot(&w, &w).sqrt();
         alphas.push(alpha);
         betas.push(beta);
-        if m % 5 == 4 || beta <= 1e-14 * alpha.abs() {
+        if m >= 2 || beta <= 1e-14 * alpha.abs() {
             let size = alphas.len();
             let t = DMatrix::<f64>::from_fn(size, size, |r, c| {
                 if r == c {
@@ -149,7 +149,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
             };
             let bound = beta * eig.eigenvectors[(size - 1, index)].abs();
             largest = top;
-            if bound <= 1e-9 * top.abs() || beta <= 1e-14 * alpha.abs() {
+            if bound <= 1e-6 * top.abs() || beta <= 1e-14 * alpha.abs() {
                 return 1.0 / largest;
             }
         }

@@ -60,6 +60,10 @@ pub struct PlanOptions {
     pub max_backtracks: usize,
     /// Initial barrier parameter $\mu$ of the inequalities (per unit time).
     pub initial_barrier: f64,
+    /// Also compute [`Certificate::min_reduced_hessian_eig`] (Lanczos, about as much time as
+    /// a few iterations). The inertia count that proves the reduced Hessian positive definite
+    /// is always done.
+    pub min_eigenvalue: bool,
 }
 
 impl Default for PlanOptions {
@@ -74,6 +78,7 @@ impl Default for PlanOptions {
             armijo: 1e-4,
             max_backtracks: 40,
             initial_barrier: 0.1,
+            min_eigenvalue: false,
         }
     }
 }
@@ -97,6 +102,11 @@ impl PlanOptions {
     /// Sets $\theta$.
     pub fn with_theta(mut self, theta: f64) -> Self {
         self.theta = theta;
+        self
+    }
+    /// Also computes the smallest eigenvalue of the reduced Hessian for the certificate.
+    pub fn with_min_eigenvalue(mut self, min_eigenvalue: bool) -> Self {
+        self.min_eigenvalue = min_eigenvalue;
         self
     }
     /// Sets the number of chord points checked by the singularity guard per step.
@@ -141,7 +151,8 @@ pub struct Certificate {
     pub negative_directions: usize,
     /// The smallest eigenvalue of $Z^T \nabla^2 J\, Z$, $Z$ an orthonormal basis of the null
     /// space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
-    /// u_{N-1})$; positive for a strict local minimum. NaN when not computed.
+    /// u_{N-1})$; positive for a strict local minimum. NaN unless
+    /// [`PlanOptions::min_eigenvalue`] is set (the inertia count proves positivity either way).
     pub min_reduced_hessian_eig: f64,
 }
 

@@ -319,13 +319,19 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         }
         let d_sym = (d + d.transpose()) * 0.5;
         // the symmetric part for the inertia, the matrix itself for the solve
-        let neg_d = invert_counting(d_sym).map_or_else(
-            || {
-                singular = true;
-                0
-            },
-            |(_, neg)| neg,
-        );
+        // D_N is negative definite when W is positive definite: a Cholesky of -D_N settles
+        // the common case without an eigendecomposition
+        let neg_d = if (-d_sym).cholesky().is_some() {
+            X
+        } else {
+            invert_counting(d_sym).map_or_else(
+                || {
+                    singular = true;
+                    0
+                },
+                |(_, neg)| neg,
+            )
+        };
         // by LU with partial pivoting (nalgebra's closed-form 4x4 inverse loses digits here)
         let d_end_inv = crate::linalg::solve(&d, &SMatrix::identity()).unwrap_or_else(|| {
             singular = true;

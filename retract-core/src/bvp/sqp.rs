@@ -109,15 +109,15 @@ where
         (cost.is_finite() && violation.is_finite()).then_some((cost, violation))
     }
 
-    /// The model of stage `i`: the Hessian of $h L + y^T g$, the gradient of $h L$, the
-    /// defect and the constraints with their Jacobians.
+    /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h z^T g^{\ge}$,
+    /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
+    /// own terms are added by [`Barrier::add_to_stage`]).
     fn stage(
         &self,
         iterate: &Iterate<N, X>,
         i: usize,
         y: &SVector<f64, N>,
         barrier: &Barrier,
-        inequalities: &[Linearized<N, X>],
     ) -> StageModel<N, X> {
         let (h, system) = (self.dynamics.h, self.problem.system);
         let u = &iterate.u[i];
@@ -162,7 +162,6 @@ where
             }
         }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
-        barrier.add_to_stage(&mut stage, i, inequalities, h);
         stage
     }
 
@@ -183,9 +182,9 @@ where
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
-            let g = system.gradient(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
-            cost_gradient.push((SVector::from_fn(|r, _| h * g.x[r / N][r % N]), g.u * h));
-            let stage = self.stage(iterate, i, &y[i], barrier, own);
+            let mut stage = self.stage(iterate, i, &y[i], barrier);
+            cost_gradient.push((stage.gx, stage.gu));
+            barrier.add_to_stage(&mut stage, i, own, h);
             let finite = stage
                 .hxx
                 .iter()
@@ -434,8 +433,10 @@ where
             };
             return Err((failure, certificate));
         }
-        certificate.min_reduced_hessian_eig =
-            min_reduced_eigenvalue(&exact, &self.dynamics, self.problem.steps);
+        if self.problem.options.min_eigenvalue {
+            certificate.min_reduced_hessian_eig =
+                min_reduced_eigenvalue(&exact, &self.dynamics, self.problem.steps);
+        }
         Ok(certificate)
     }
 
@@ -451,7 +452,7 @@ where
         let count = barrier.count;
         let mut stages = Vec::with_capacity(iterate.u.len());
         for (i, yi) in y.iter().enumerate() {
-            let mut stage = self.stage(iterate, i, yi, barrier, &[]);
+            let mut stage = self.stage(iterate, i, yi, barrier);
             for (k, c) in lin.iter().enumerate().skip(i * count).take(count) {
                 if barrier.s[k] < barrier.z[k] {
                     let m = stage.constraints;
