@@ -448,7 +448,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 d.dx.push(x);
             }
             let miss = r_end - x;
-            if refinement == 1 || miss.amax() <= 1e-14 * (1.0 + r_end.amax() + x.amax()) {
+            if refinement == 1 || miss.amax() <= 1e-12 * (1.0 + r_end.amax() + x.amax()) {
                 break;
             }
             nu += self.d_end_inv * miss;

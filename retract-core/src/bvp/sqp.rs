@@ -185,17 +185,16 @@ where
             let mut stage = self.stage(iterate, i, &y[i], barrier);
             cost_gradient.push((stage.gx, stage.gu));
             barrier.add_to_stage(&mut stage, i, own, h);
-            let finite = stage
-                .hxx
-                .iter()
-                .chain(stage.hux.iter())
-                .chain(stage.huu.iter())
-                .chain(stage.gx.iter())
-                .chain(stage.gu.iter())
-                .chain(stage.cx.iter())
-                .chain(stage.cu.iter())
-                .chain(stage.value.iter())
-                .all(|v| v.is_finite());
+            // a NaN or an infinity anywhere makes the sum non-finite
+            let finite = (stage.hxx.sum()
+                + stage.hux.sum()
+                + stage.huu.sum()
+                + stage.gx.sum()
+                + stage.gu.sum()
+                + stage.cx.sum()
+                + stage.cu.sum()
+                + stage.value.sum())
+            .is_finite();
             if !finite {
                 return None;
             }
