@@ -17,6 +17,7 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use retract::LiftedSystem;
 use retract::bvp::{
     BoundaryValueProblem, BvpOptions, Guess, LinearSolver, OptimalControlProblem, PlanGuess,
+    PlanOptions,
 };
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
@@ -321,6 +322,36 @@ fn print_comparison(system: &Scene<'_>) {
     );
 }
 
+/// Richardson extrapolation on the one-disc scene: for N = 40, 50, 100 the time of
+/// `solve_extrapolated` (best of 10) and its cost error against an extrapolation at N = 400
+/// solved to 1e-10 (the reference), with the error estimate.
+fn print_extrapolation() {
+    let system = OneDisc { tau: 1e-2 };
+    let extrapolate = |steps: usize, tolerance: f64| {
+        let (_, x, u) = bump_guess(&system, steps);
+        OptimalControlProblem::new(&system, &DISC_START, &DISC_GOAL, DISC_T, steps)
+            .with_options(PlanOptions::default().with_tolerance(tolerance))
+            .solve_extrapolated(PlanGuess::Path { x: &x, u: &u })
+            .expect("the one-disc scene extrapolates")
+    };
+    let reference = extrapolate(400, 1e-10);
+    println!("one-disc Richardson extrapolation (N, 2N, 4N), against N = 400 extrapolated:");
+    for steps in [40, 50, 100] {
+        let e = extrapolate(steps, 1e-9);
+        let ms = best_ms(10, || extrapolate(steps, 1e-9).cost);
+        let momentum_error = (e.momenta[0] - reference.momenta[0]).amax();
+        println!(
+            "extrapolated N={steps}: J={:.12} cost error {:.1e} (estimate {:.1e}), p(0) error \
+             {momentum_error:.1e}, iterations {:?}, time {ms:.2} ms",
+            e.cost,
+            (e.cost - reference.cost).abs() / reference.cost,
+            e.cost_error / reference.cost,
+            e.iterations()
+        );
+    }
+    println!();
+}
+
 fn solve(c: &mut Criterion) {
     let system = Scene {
         tau: 0.05,
@@ -328,6 +359,7 @@ fn solve(c: &mut Criterion) {
     };
     print_table(&system);
     print_comparison(&system);
+    print_extrapolation();
     let mut group = c.benchmark_group("bvp");
     group.sample_size(10);
     for steps in [100, 200, 400, 800, 1600, 3200] {
