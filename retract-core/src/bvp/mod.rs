@@ -53,6 +53,7 @@ pub use optimize::{
 };
 
 mod root_finder;
+mod shift;
 
 pub use root_finder::{
     BoundaryValueProblem, BvpOptions, BvpSolution, ClearanceFn, Guess, LinearSolver, continuation,

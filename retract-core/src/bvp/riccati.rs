@@ -25,6 +25,8 @@
 
 use nalgebra::{DMatrix, SMatrix, SVector, SymmetricEigen};
 
+use super::shift::{BlockColumn, BlockPoly};
+
 /// The constant linear dynamics of the lifted scheme's $x$-equations for one $(h, \theta)$:
 /// $x_{i+1} = \bar A x_i + \bar B u_i$ with $\bar A = W (I + h(1-\theta) A)$, $\bar B = W h B$,
 /// $W = (I - h\theta A)^{-1} = \sum_m (h \theta A)^m$, $A$ the block shift
@@ -33,7 +35,8 @@ use nalgebra::{DMatrix, SMatrix, SVector, SymmetricEigen};
 pub(crate) struct Dynamics<const N: usize, const X: usize> {
     pub h: f64,
     pub theta: f64,
-    /// $\bar A$.
+    /// $\bar A$ (dense, for the tests; the solver uses `poly_a`).
+    #[cfg(test)]
     pub a: SMatrix<f64, X, X>,
     /// $\bar B$.
     pub b: SMatrix<f64, X, N>,
@@ -41,6 +44,10 @@ pub(crate) struct Dynamics<const N: usize, const X: usize> {
     pub e: SMatrix<f64, X, X>,
     /// $W = (I - h\theta A)^{-1}$.
     pub w: SMatrix<f64, X, X>,
+    /// $\bar A$, $E$ and $\bar B$ as polynomials in the block shift ([`super::shift`]).
+    pub poly_a: BlockPoly<N, X>,
+    pub poly_e: BlockPoly<N, X>,
+    pub poly_b: BlockColumn<N, X>,
 }
 
 impl<const N: usize, const X: usize> Dynamics<N, X> {
@@ -61,16 +68,20 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
         Self {
             h,
             theta,
+            #[cfg(test)]
             a,
             b,
             e,
             w,
+            poly_a: BlockPoly::of(&a),
+            poly_e: BlockPoly::of(&e),
+            poly_b: BlockColumn::of(&b),
         }
     }
 
     /// $x_{i+1} = \bar A x_i + \bar B u_i$.
     pub fn next(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> SVector<f64, X> {
-        self.a * x + self.b * u
+        self.poly_a.left(x) + self.poly_b.left(u)
     }
 }
 
@@ -192,11 +203,12 @@ pub(crate) struct StageLinear<const N: usize, const X: usize> {
 }
 
 /// Inverts a symmetric matrix and counts its negative eigenvalues; `None` if (nearly)
-/// singular or not finite. Cholesky first, the eigendecomposition when that fails.
+/// singular or not finite. An $L D L^T$ factorisation without pivoting first (a congruence, so
+/// by Sylvester's law the signs of the pivots are those of the eigenvalues), the
+/// eigendecomposition when a pivot is too small for that to be reliable.
 fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
-    if let Some(chol) = m.cholesky() {
-        let inv = chol.inverse();
-        return inv.iter().all(|v| v.is_finite()).then_some((inv, 0));
+    if let Some(pair) = ldlt_inverse(&m) {
+        return Some(pair);
     }
     if !m.iter().all(|v| v.is_finite()) {
         return None;
@@ -211,6 +223,53 @@ fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64
     let inv_diag = DMatrix::from_diagonal(&eig.eigenvalues.map(|l| 1.0 / l));
     let inv = &eig.eigenvectors * inv_diag * eig.eigenvectors.transpose();
     Some((SMatrix::from_column_slice(inv.as_slice()), negative))
+}
+
+/// $M^{-1}$ and the number of negative pivots of $M = L D L^T$ ($L$ unit lower triangular),
+/// or `None` if a pivot is below $10^{-10}$ of the largest diagonal entry in magnitude or a
+/// value is not finite.
+fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
+    let scale = (0..D).fold(0.0_f64, |s, i| s.max(m[(i, i)].abs()));
+    let mut l = SMatrix::<f64, D, D>::identity();
+    let mut d = [0.0_f64; D];
+    for j in 0..D {
+        let mut pivot = m[(j, j)];
+        for k in 0..j {
+            pivot -= l[(j, k)] * l[(j, k)] * d[k];
+        }
+        if !(pivot.abs() > 1e-10 * scale) {
+            return None;
+        }
+        d[j] = pivot;
+        for i in j + 1..D {
+            let mut v = m[(i, j)];
+            for k in 0..j {
+                v -= l[(i, k)] * l[(j, k)] * d[k];
+            }
+            l[(i, j)] = v / pivot;
+        }
+    }
+    // M^{-1} = L^{-T} D^{-1} L^{-1}, column by column
+    let mut inv = SMatrix::<f64, D, D>::zeros();
+    for c in 0..D {
+        let mut y = [0.0_f64; D];
+        for i in 0..D {
+            let mut v = if i == c { 1.0 } else { 0.0 };
+            for k in 0..i {
+                v -= l[(i, k)] * y[k];
+            }
+            y[i] = v;
+        }
+        for i in (0..D).rev() {
+            let mut v = y[i] / d[i];
+            for k in i + 1..D {
+                v -= l[(k, i)] * inv[(k, c)];
+            }
+            inv[(i, c)] = v;
+        }
+    }
+    let negative = d.iter().filter(|p| **p < 0.0).count();
+    inv.iter().all(|v| v.is_finite()).then_some((inv, negative))
 }
 
 /// One stage of the backward pass from $P_{i+1}$ and $S_{i+1}$:
@@ -228,19 +287,23 @@ fn stage_factor<const N: usize, const X: usize>(
     p: &SMatrix<f64, X, X>,
     sens: &SMatrix<f64, X, X>,
 ) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
-    let (a, b, e) = (&dynamics.a, &dynamics.b, &dynamics.e);
-    let fu = b * dynamics.theta;
+    let (a, b, e) = (&dynamics.poly_a, &dynamics.poly_b, &dynamics.poly_e);
+    let theta = dynamics.theta;
     let hxx = stage.hxx + SMatrix::<f64, X, X>::identity() * rho;
     let huu = stage.huu + SMatrix::<f64, N, N>::identity() * rho;
-    let hxx_e = hxx * e;
-    let pa = p * a;
-    let pb = p * b;
-    let qxx = e.transpose() * hxx_e + a.transpose() * pa;
-    let qux = fu.transpose() * hxx_e + stage.hux * e + b.transpose() * pa;
-    let cross = stage.hux * fu;
-    let quu = fu.transpose() * (hxx * fu) + cross + cross.transpose() + huu + b.transpose() * pb;
+    // fu = theta B: the evaluation point's dependence on the control
+    let hxx_e = e.right(&hxx);
+    let pa = a.right(p);
+    let qxx = e.left_t(&hxx_e) + a.left_t(&pa);
+    let qux = b.left_t(&hxx_e) * theta + e.right(&stage.hux) + b.left_t(&pa);
+    let cross = b.right(&stage.hux) * theta;
+    let quu = b.left_t(&b.right(&hxx)) * (theta * theta)
+        + cross
+        + cross.transpose()
+        + huu
+        + b.left_t(&b.right(p));
     let quu = (quu + quu.transpose()) * 0.5;
-    let bts = b.transpose() * sens;
+    let bts = b.left_t(sens);
     let mut factor = StageFactor {
         quu_inv: SMatrix::zeros(),
         quu,
@@ -284,7 +347,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     /// The backward pass over `stages` with $\rho$ added to the diagonal of every $H_i$
     /// (inertia correction), then the terminal system.
     pub fn factor(dynamics: &Dynamics<N, X>, stages: &[StageModel<N, X>], rho: f64) -> Self {
-        let (a, b) = (&dynamics.a, &dynamics.b);
+        let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let mut p = SMatrix::<f64, X, X>::zeros();
         let mut sens = SMatrix::<f64, X, X>::identity();
         let mut factors = Vec::with_capacity(stages.len());
@@ -305,9 +368,9 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             };
             p = (p_new + p_new.transpose()) * 0.5;
             sens = if factor.constrained {
-                (a + b * k).transpose() * sens + (qux + quu_k).transpose() * kn
+                a.left_t(&sens) + k.transpose() * b.left_t(&sens) + (qux + quu_k).transpose() * kn
             } else {
-                a.transpose() * sens + qux.transpose() * kn
+                a.left_t(&sens) + qux.transpose() * kn
             };
             factors.push(factor);
         }
@@ -315,23 +378,17 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         // D_N = d delta x_N / d nu: forward sweep of the closed-loop sensitivity
         let mut d = SMatrix::<f64, X, X>::zeros();
         for f in &factors {
-            d = (a + b * f.gain) * d + b * f.gain_nu;
+            d = a.left(&d) + b.left(&(f.gain * d + f.gain_nu));
         }
         let d_sym = (d + d.transpose()) * 0.5;
         // the symmetric part for the inertia, the matrix itself for the solve
-        // D_N is negative definite when W is positive definite: a Cholesky of -D_N settles
-        // the common case without an eigendecomposition
-        let neg_d = if (-d_sym).cholesky().is_some() {
-            X
-        } else {
-            invert_counting(d_sym).map_or_else(
-                || {
-                    singular = true;
-                    0
-                },
-                |(_, neg)| neg,
-            )
-        };
+        let neg_d = invert_counting(d_sym).map_or_else(
+            || {
+                singular = true;
+                0
+            },
+            |(_, neg)| neg,
+        );
         // by LU with partial pivoting (nalgebra's closed-form 4x4 inverse loses digits here)
         let d_end_inv = crate::linalg::solve(&d, &SMatrix::identity()).unwrap_or_else(|| {
             singular = true;
@@ -360,15 +417,15 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         r0: &SVector<f64, X>,
         r_end: &SVector<f64, X>,
     ) -> Direction<N, X> {
-        let fu = dynamics.b * dynamics.theta;
+        let theta = dynamics.theta;
         let linear = |i: usize| {
             let stage = &stages[i];
-            let offset = stage.defect * dynamics.theta;
+            let offset = stage.defect * theta;
             let gx = stage.gx + (stage.hxx + SMatrix::<f64, X, X>::identity() * rho) * offset;
             let gu = stage.gu + stage.hux * offset;
             StageLinear {
-                lx: dynamics.e.transpose() * gx,
-                lu: fu.transpose() * gx + gu,
+                lx: dynamics.poly_e.left_t(&gx),
+                lu: dynamics.poly_b.left_t(&gx) * theta + gu,
                 defect: stage.defect,
                 constraint: stage.value + stage.cx * offset,
             }
@@ -385,7 +442,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         r0: &SVector<f64, X>,
         r_end: &SVector<f64, X>,
     ) -> Direction<N, X> {
-        let (a, b) = (&dynamics.a, &dynamics.b);
+        let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         // backward: the feed-forward terms, q_u and s_{i+1} for these linear terms
         let mut feedforward = vec![SVector::<f64, N>::zeros(); steps];
@@ -397,8 +454,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let f = &self.stages[i];
             let l = linear(i);
             let pcs = f.p_next * l.defect + s;
-            let qx = l.lx + a.transpose() * pcs;
-            let qu = l.lu + b.transpose() * pcs;
+            let qx = l.lx + a.left_t(&pcs);
+            let qu = l.lu + b.left_t(&pcs);
             s_next[i] = s;
             defects[i] = l.defect;
             qus[i] = qu;
@@ -417,7 +474,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let mut x = *r0;
         for (i, f) in self.stages.iter().enumerate() {
             let du = f.gain * x + feedforward[i];
-            x = a * x + b * du + defects[i];
+            x = a.left(&x) + b.left(&du) + defects[i];
         }
         let mut nu = self.d_end_inv * (r_end - x);
         let mut d = Direction {
@@ -437,12 +494,12 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             for (i, f) in self.stages.iter().enumerate() {
                 let u = f.gain * x + feedforward[i] + f.gain_nu * nu;
                 if f.constrained {
-                    let dq = f.qux * x + f.quu * u + qus[i] + b.transpose() * (f.sens_next * nu);
+                    let dq = f.qux * x + f.quu * u + qus[i] + b.left_t(&(f.sens_next * nu));
                     d.multipliers.push(-(f.pinv.transpose() * dq));
                 } else {
                     d.multipliers.push(SVector::zeros());
                 }
-                x = a * x + b * u + defects[i];
+                x = a.left(&x) + b.left(&u) + defects[i];
                 d.costate.push(f.p_next * x + s_next[i] + f.sens_next * nu);
                 d.du.push(u);
                 d.dx.push(x);
