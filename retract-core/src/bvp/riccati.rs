@@ -237,7 +237,8 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
         for k in 0..j {
             pivot -= l[(j, k)] * l[(j, k)] * d[k];
         }
-        if !(pivot.abs() > 1e-10 * scale) {
+        // (a NaN pivot fails the comparison too)
+        if pivot.abs().partial_cmp(&(1e-10 * scale)) != Some(core::cmp::Ordering::Greater) {
             return None;
         }
         d[j] = pivot;
