@@ -172,6 +172,7 @@ struct StageFactor<const N: usize, const X: usize> {
 
 /// The factorised KKT system of one iteration.
 pub(crate) struct Riccati<const N: usize, const X: usize> {
+    /// The stages' factors, last step first.
     stages: Vec<StageFactor<N, X>>,
     /// $D_N^{-1}$.
     d_end_inv: SMatrix<f64, X, X>,
@@ -375,10 +376,10 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             };
             factors.push(factor);
         }
-        factors.reverse();
+        // (kept in the order of the backward pass: `step_factor(i)` reads step i)
         // D_N = d delta x_N / d nu: forward sweep of the closed-loop sensitivity
         let mut d = SMatrix::<f64, X, X>::zeros();
-        for f in &factors {
+        for f in factors.iter().rev() {
             d = a.left(&d) + b.left(&(f.gain * d + f.gain_nu));
         }
         let d_sym = (d + d.transpose()) * 0.5;
@@ -401,6 +402,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             negative: (negative + neg_d).saturating_sub(X),
             singular,
         }
+    }
+
+    /// The factor of step `i`.
+    fn step_factor(&self, i: usize) -> &StageFactor<N, X> {
+        &self.stages[self.stages.len() - 1 - i]
     }
 
     /// True when the reduced Hessian is positive definite.
@@ -452,7 +458,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let mut defects = vec![SVector::<f64, X>::zeros(); steps];
         let mut s = SVector::<f64, X>::zeros();
         for i in (0..steps).rev() {
-            let f = &self.stages[i];
+            let f = self.step_factor(i);
             let l = linear(i);
             let pcs = f.p_next * l.defect + s;
             let qx = l.lx + a.left_t(&pcs);
@@ -473,7 +479,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         }
         // forward without nu, then nu from the terminal condition
         let mut x = *r0;
-        for (i, f) in self.stages.iter().enumerate() {
+        for (i, f) in self.stages.iter().rev().enumerate() {
             let du = f.gain * x + feedforward[i];
             x = a.left(&x) + b.left(&du) + defects[i];
         }
@@ -492,7 +498,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             d.multipliers.clear();
             let mut x = *r0;
             d.dx.push(x);
-            for (i, f) in self.stages.iter().enumerate() {
+            for (i, f) in self.stages.iter().rev().enumerate() {
                 let u = f.gain * x + feedforward[i] + f.gain_nu * nu;
                 if f.constrained {
                     let dq = f.qux * x + f.quu * u + qus[i] + b.left_t(&(f.sens_next * nu));
