@@ -30,6 +30,27 @@ impl BandMatrix {
         }
     }
 
+    /// [`Self::zeros`], or `None` when the storage cannot be allocated (its size overflows or
+    /// the allocation fails): never a panic or an allocation abort.
+    pub fn try_zeros(n: usize, kl: usize, ku: usize) -> Option<Self> {
+        let ld = kl.checked_mul(2)?.checked_add(ku)?.checked_add(1)?;
+        let len = ld.checked_mul(n)?;
+        let mut data = Vec::new();
+        data.try_reserve_exact(len).ok()?;
+        data.resize(len, 0.0);
+        let mut pivots = Vec::new();
+        pivots.try_reserve_exact(n).ok()?;
+        pivots.resize(n, 0);
+        Some(Self {
+            n,
+            kl,
+            ku,
+            ld,
+            data,
+            pivots,
+        })
+    }
+
     /// Size n.
     pub fn size(&self) -> usize {
         self.n

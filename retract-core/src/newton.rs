@@ -11,7 +11,13 @@
 //! Convergence (max-norms):
 //! - residual: $|F(w)|_\infty \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty$, or
 //! - step: $|\Delta|_\infty \le \text{step\_abs} + \text{step\_rel}\,|w|_\infty$ (the step is
-//!   then applied, so the returned iterate carries the quadratic-convergence gain).
+//!   then applied, so the returned iterate carries the quadratic-convergence gain), and the
+//!   residual there small row by row against the Jacobian's scale of the unknowns,
+//!   $|F_i| \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty +
+//!   \sum_j |J_{ij}|\,(\text{step\_abs} + \text{step\_rel}\,|w_j|)$ (what a step within the
+//!   tolerance could leave). A small step alone is not convergence: with one unknown of
+//!   $10^{154}$, every step is small against $|w|_\infty$, while a row of positions of
+//!   order 1 may still be off by 1. Such an iterate is not returned; Newton goes on from it.
 //!
 //! Nothing here allocates or panics.
 
@@ -116,6 +122,29 @@ impl NewtonOptions {
     #[inline]
     pub(crate) fn converged(&self, r_norm: f64, r_start: f64) -> bool {
         r_norm <= self.residual_abs + self.residual_rel * r_start
+    }
+
+    /// The residual test of an iterate accepted on the step test: every row $i$ of the
+    /// residual must be what a step within the step tolerance could leave,
+    /// $|F_i| \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty +
+    /// \sum_j |J_{ij}| (\text{step\_abs} + \text{step\_rel}\,|w_j|)$; row by row, so that
+    /// an iterate whose step is small against its largest entry (a momentum of 1e154) but not
+    /// against the entries of a row (a position of order 1) is not taken for a root.
+    /// `jacobian` is the last one factorised (a scale only).
+    #[inline]
+    pub(crate) fn small_residual<const M: usize>(
+        &self,
+        r: &SVector<f64, M>,
+        jacobian: &SMatrix<f64, M, M>,
+        w: &SVector<f64, M>,
+        r_start: f64,
+    ) -> bool {
+        let floor = self.residual_abs + self.residual_rel * r_start;
+        let allowed = w.abs() * self.step_rel + SVector::<f64, M>::repeat(self.step_abs);
+        let bound = jacobian.abs() * allowed;
+        r.iter()
+            .zip(bound.iter())
+            .all(|(ri, bi)| ri.abs() <= floor + bi)
     }
 
     /// The first option out of its domain, as an error (the slow path of `validate`).
@@ -265,19 +294,23 @@ where
             _ => return Err(Error::SingularJacobian { iteration }),
         };
         if max_abs(&delta) <= options.step_abs + options.step_rel * max_abs(&w) {
-            w += delta;
-            r = problem.residual(&w);
-            if !all_finite(&r) {
+            let next = w + delta;
+            let r_next = problem.residual(&next);
+            if !all_finite(&r_next) {
                 return Err(Error::NonFinite {
                     iteration,
                     location: "residual",
                 });
             }
-            return Ok(Solution {
-                w,
-                iterations: iteration,
-                residual_norm: max_abs(&r),
-            });
+            if options.small_residual(&r_next, &jacobian, &next, r_start) {
+                return Ok(Solution {
+                    w: next,
+                    iterations: iteration,
+                    residual_norm: max_abs(&r_next),
+                });
+            }
+            // the step is small against the largest unknown only: keep iterating (the line
+            // search below starts from this full step)
         }
         let phi = r.norm_squared();
         let mut alpha = 1.0;

@@ -351,18 +351,30 @@ where
     max_abs(&residual) <= 1e-10 * scale
 }
 
-/// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps: a composition cycles
-/// through its distinct stage sizes (2 for order 4, 5 and 8 for the Kahan-Li methods of
-/// orders 6 and 8), and each miss costs a factorisation.
-const CACHED: usize = 8;
+/// How many $(h, \theta)$ factorisations a [`ReducedStepper`] keeps (about 4 KB each for the
+/// planar rigid body, in the stepper itself: no heap). The least recently used pair is
+/// replaced, so a controller that cycles through at most this many distinct step sizes
+/// factorises once per size: every composition of [`crate::compose`] (at most 8 distinct
+/// stage sizes), a controller alternating up to 16 sizes. A cycle through more sizes than
+/// this, or an adaptive controller whose sizes never repeat, factorises on every step with a
+/// size not used among the last `CACHE_SIZE` distinct ones
+/// ([`ReducedStepper::factorisations`] counts them).
+pub const CACHE_SIZE: usize = 16;
 
-/// Steps a [`ReducedScheme`] with Newton on its core; caches [`ReducedFactors`] for the last
-/// few step sizes. No heap.
+/// Steps a [`ReducedScheme`] with Newton on its core; caches [`ReducedFactors`] for the
+/// [`CACHE_SIZE`] most recently used $(h, \theta)$ pairs (least recently used replaced). No
+/// heap.
 #[derive(Clone, Debug)]
 pub struct ReducedStepper<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,
-    factors: [Option<ReducedFactors<S, M, R>>; CACHED],
-    next_slot: usize,
+    factors: [Option<ReducedFactors<S, M, R>>; CACHE_SIZE],
+    /// When each slot was last used (0: never); only stamped when the slot in use changes.
+    used: [u64; CACHE_SIZE],
+    clock: u64,
+    /// The slot of the last step, looked at first (a constant step size never scans).
+    last: usize,
+    /// Factors computed so far (cache misses).
+    factorisations: usize,
 }
 
 /// $r(y)$ of the module docs as a Newton problem. One call computes $r$ and its Jacobian; the
@@ -461,28 +473,44 @@ where
     pub fn new(system: &'a Sys) -> Self {
         Self {
             system,
-            factors: [const { None }; CACHED],
-            next_slot: 0,
+            factors: [const { None }; CACHE_SIZE],
+            used: [0; CACHE_SIZE],
+            clock: 0,
+            last: 0,
+            factorisations: 0,
         }
     }
 
-    /// Factorises for a new $(h, \theta)$ into the next slot (out of line: the cold path).
+    /// How many times the stepper computed [`ReducedFactors`] (one per cache miss: a step
+    /// size and theta not among the [`CACHE_SIZE`] most recently used ones).
+    pub fn factorisations(&self) -> usize {
+        self.factorisations
+    }
+
+    /// Factorises for a new $(h, \theta)$ into the least recently used slot (an empty one
+    /// first) (out of line: the cold path).
     #[cold]
     #[inline(never)]
     fn insert(&mut self, h: f64, theta: f64) -> Result<usize, Error> {
-        let slot = self.next_slot;
-        self.factors[slot] = Some(ReducedFactors::new(self.system, h, theta)?);
-        self.next_slot = (slot + 1) % CACHED;
+        let mut slot = 0;
+        for (i, &used) in self.used.iter().enumerate() {
+            if used < self.used[slot] {
+                slot = i;
+            }
+        }
+        self.factorisations = self.factorisations.saturating_add(1);
+        let factors = ReducedFactors::new(self.system, h, theta)?;
+        if let Some(entry) = self.factors.get_mut(slot) {
+            *entry = Some(factors);
+        }
         Ok(slot)
     }
 
-    /// The cached factors for the options' $(h, \theta)$, validated and computed if new (a
-    /// cached pair passed [`StepOptions`]' checks when it was inserted; NaN matches none).
-    fn factors(
-        &mut self,
-        h: f64,
-        options: &StepOptions,
-    ) -> Result<&ReducedFactors<S, M, R>, Error> {
+    /// The slot holding $(h, \theta)$ when it is not the last one used: a scan of the
+    /// cache, else a new factorisation (validated first); marks the slot as the most
+    /// recently used.
+    #[inline(never)]
+    fn lookup(&mut self, h: f64, options: &StepOptions) -> Result<usize, Error> {
         let theta = options.theta;
         let slot = match self
             .factors
@@ -495,8 +523,35 @@ where
                 self.insert(h, theta)?
             }
         };
-        self.factors[slot]
-            .as_ref()
+        self.clock = self.clock.wrapping_add(1);
+        if let Some(used) = self.used.get_mut(slot) {
+            *used = self.clock;
+        }
+        self.last = slot;
+        Ok(slot)
+    }
+
+    /// The cached factors for the options' $(h, \theta)$, validated and computed if new (a
+    /// cached pair passed [`StepOptions`]' checks when it was inserted; NaN matches none).
+    #[inline]
+    fn factors(
+        &mut self,
+        h: f64,
+        options: &StepOptions,
+    ) -> Result<&ReducedFactors<S, M, R>, Error> {
+        let theta = options.theta;
+        let hit = matches!(
+            self.factors.get(self.last),
+            Some(Some(f)) if f.h == h && f.theta == theta
+        );
+        let slot = if hit {
+            self.last
+        } else {
+            self.lookup(h, options)?
+        };
+        self.factors
+            .get(slot)
+            .and_then(Option::as_ref)
             .ok_or(Error::SingularJacobian { iteration: 0 })
     }
 

@@ -298,7 +298,8 @@ impl<F, const S: usize> OneStep<S> for F where
 ///
 /// # Errors
 /// [`Interrupted`], with the trajectory computed so far, at the first failed step (with no
-/// state at all for a non-finite `z0`).
+/// state at all for a non-finite `z0`, or with [`Error::InvalidArgument`] for `steps` whose
+/// states and reports cannot be allocated, e.g. $2^{40}$ or `usize::MAX`).
 pub fn trajectory<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
@@ -334,9 +335,17 @@ pub fn drive<const S: usize>(
 ) -> Result<Trajectory<S>, Interrupted<S>> {
     let mut trajectory = Trajectory {
         h,
-        states: Vec::with_capacity(steps + 1),
-        reports: Vec::with_capacity(steps),
+        states: Vec::new(),
+        reports: Vec::new(),
     };
+    if let Err(error) = reserve(&mut trajectory, steps) {
+        return Err(Interrupted {
+            trajectory,
+            step: 0,
+            error,
+            crossing_time: None,
+        });
+    }
     if !z0.iter().all(|v| v.is_finite()) {
         return Err(Interrupted {
             trajectory,
@@ -374,6 +383,26 @@ pub fn drive<const S: usize>(
         }
     }
     Ok(trajectory)
+}
+
+#[cfg(feature = "std")]
+/// Reserves the states and reports of `steps` steps, or [`Error::InvalidArgument`] if they
+/// do not fit in memory (`steps + 1` overflows, or the allocation fails): never a capacity
+/// overflow panic or an allocation abort.
+fn reserve<const S: usize>(trajectory: &mut Trajectory<S>, steps: usize) -> Result<(), Error> {
+    let too_many = Error::InvalidArgument {
+        name: "steps",
+        requirement: "the states and reports of a trajectory must fit in memory",
+    };
+    let states = steps.checked_add(1).ok_or(too_many)?;
+    trajectory
+        .states
+        .try_reserve_exact(states)
+        .map_err(|_| too_many)?;
+    trajectory
+        .reports
+        .try_reserve_exact(steps)
+        .map_err(|_| too_many)
 }
 
 #[cfg(feature = "std")]

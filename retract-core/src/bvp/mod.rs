@@ -23,12 +23,13 @@
 //! The hand-written disc system of [`crate::models`] (with `retract`, a `#[higher_order_lagrangian]`
 //! type is used the same way): from rest at $(2, 0)$ to rest at $(3, 1)$ in $T = 1$.
 //! ```
-//! use retract_core::bvp::{OptimalControlProblem, PlanGuess};
+//! use retract_core::bvp::{OptimalControlProblem, PlanGuess, PlanOptions};
 //! use retract_core::models::PlanarBarrier;
 //!
 //! let system = PlanarBarrier { tau: 1e-12, radius: 1.0, mass: 1.0 };
 //! let (start, goal) = ([2.0, 0.0, 0.0, 0.0], [3.0, 1.0, 0.0, 0.0]);
 //! let plan = OptimalControlProblem::new(&system, &start, &goal, 1.0, 50)
+//!     .with_options(PlanOptions::default().with_min_eigenvalue(true))
 //!     .solve(PlanGuess::Spline)
 //!     .expect("a certified minimum");
 //! // without the (here negligible) barrier the optimum costs 6 |q(T) - q(0)|^2 / T^3 = 12

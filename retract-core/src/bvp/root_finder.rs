@@ -212,6 +212,25 @@ impl Layout {
     }
 }
 
+/// The error for a problem too large to hold in memory.
+const TOO_LARGE: Error = Error::InvalidArgument {
+    name: "steps",
+    requirement: "the unknowns of the boundary-value problem must fit in memory",
+};
+
+/// `len` copies of `value`, or [`TOO_LARGE`] (named `name`) when they cannot be allocated:
+/// never a capacity overflow panic or an allocation abort.
+fn filled<T: Clone>(len: usize, value: T, name: &'static str) -> Result<Vec<T>, Error> {
+    let mut out = Vec::new();
+    out.try_reserve_exact(len)
+        .map_err(|_| Error::InvalidArgument {
+            name,
+            requirement: "the unknowns of the boundary-value problem must fit in memory",
+        })?;
+    out.resize(len, value);
+    Ok(out)
+}
+
 fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -297,8 +316,32 @@ where
             return invalid("theta", "theta must lie in [0, 1]");
         }
         let tolerance = self.options.residual_tolerance;
-        if self.options.max_iterations == 0 || tolerance.is_nan() || tolerance < 0.0 {
-            return invalid("options", "need max_iterations >= 1 and a tolerance >= 0");
+        if self.options.max_iterations == 0 || !(tolerance.is_finite() && tolerance >= 0.0) {
+            return invalid(
+                "options",
+                "need max_iterations >= 1 and a finite tolerance >= 0",
+            );
+        }
+        // the unknowns, their index arithmetic and the obstacle buffers must be addressable
+        // (whether they can be allocated is checked when they are)
+        let bytes = self
+            .steps
+            .checked_mul(M)
+            .and_then(|n| n.checked_add(S))
+            .and_then(|n| n.checked_mul(8 * core::mem::size_of::<f64>()));
+        if bytes.is_none_or(|b| b > isize::MAX as usize) {
+            return invalid(
+                "steps",
+                "the unknowns of the boundary-value problem must fit in memory",
+            );
+        }
+        if let Some((count, _)) = self.clearance
+            && count > isize::MAX as usize / (2 * core::mem::size_of::<f64>())
+        {
+            return invalid(
+                "obstacles",
+                "the clearances of the obstacles must fit in memory",
+            );
         }
         Ok(())
     }
@@ -309,7 +352,7 @@ where
         let spline = Hermite::new(self.start, self.goal, self.t_end, n, k)?;
         let layout = self.layout();
         let h = self.h();
-        let mut v = vec![0.0; layout.size()];
+        let mut v = filled(layout.size(), 0.0, "steps")?;
         for step in 0..=self.steps {
             let t = step as f64 * h;
             let jet = SVector::<f64, S>::from_fn(|r, _| spline.jet_entry(r, t));
@@ -333,7 +376,7 @@ where
             });
         }
         let layout = self.layout();
-        let mut v = vec![0.0; layout.size()];
+        let mut v = filled(layout.size(), 0.0, "steps")?;
         for (i, z) in guess.states.iter().enumerate() {
             v[layout.z(i)..layout.z(i) + S].copy_from_slice(z.as_slice());
         }
@@ -351,7 +394,7 @@ where
             });
         }
         let layout = self.layout();
-        let mut v = vec![0.0; layout.size()];
+        let mut v = filled(layout.size(), 0.0, "steps")?;
         for (i, z) in states.iter().enumerate() {
             v[layout.z(i)..layout.z(i) + S].copy_from_slice(z.as_slice());
             if i < self.steps {
@@ -453,6 +496,7 @@ where
     where
         Sys: ReducedScheme<S, M, R>,
     {
+        self.validate()?;
         let (h, theta) = (self.h(), self.options.theta);
         let map = ReducedStepMap::new(self.system, h, theta)?;
         self.solve_with(
@@ -467,22 +511,29 @@ where
         linearize: StepMap<'_, S, M>,
     ) -> Result<BvpSolution<S, M>, Error> {
         self.validate()?;
+        let layout = self.layout();
+        let size = layout.size();
+        // every buffer before the guess, so that a problem too large for memory stops here
+        let mut r = filled(size, 0.0, "steps")?;
+        let mut delta = filled(size, 0.0, "steps")?;
+        let mut trial = filled(size, 0.0, "steps")?;
+        let mut r_trial = filled(size, 0.0, "steps")?;
+        let mut maps = Vec::new();
+        maps.try_reserve_exact(self.steps).map_err(|_| TOO_LARGE)?;
+        let mut buffer = filled(self.obstacles(), 0.0, "obstacles")?;
         let mut v = match guess {
             Guess::Spline => self.spline_guess()?,
             Guess::Solution(previous) => self.guess_from_solution(previous)?,
             Guess::States(states) => self.guess_from_states(states)?,
         };
-        if let Some((obstacle, step, clearance)) = self.first_collision(&v) {
+        if let Some((obstacle, step, clearance)) = self.first_collision(&v, &mut buffer) {
             return Err(Error::GuessThroughObstacle {
                 obstacle,
                 step,
                 clearance,
             });
         }
-        let layout = self.layout();
-        let size = layout.size();
         let options = &self.options;
-        let mut r = vec![0.0; size];
         self.residual(&v, &mut r);
         if !all_finite(&v) || !all_finite(&r) {
             return Err(Error::NonFinite {
@@ -491,10 +542,6 @@ where
             });
         }
         let mut band: Option<BandMatrix> = None;
-        let mut maps = Vec::with_capacity(self.steps);
-        let mut delta = vec![0.0; size];
-        let mut trial = vec![0.0; size];
-        let mut r_trial = vec![0.0; size];
         let mut r_norm = max_abs(&r);
         let mut iterations = 0;
         while r_norm > options.residual_tolerance {
@@ -511,10 +558,13 @@ where
                 && condensed_direction(self, &v, &r, &mut delta, linearize, &mut maps)
                 && self.line_search(&v, &r, &delta, &mut trial, &mut r_trial);
             if !accepted {
-                let band = band.get_or_insert_with(|| {
+                if band.is_none() {
                     let bw = layout.bandwidth();
-                    BandMatrix::zeros(size, bw, bw)
-                });
+                    band = Some(BandMatrix::try_zeros(size, bw, bw).ok_or(TOO_LARGE)?);
+                }
+                let Some(band) = band.as_mut() else {
+                    return Err(TOO_LARGE);
+                };
                 self.banded_direction(&v, &r, band, &mut delta, iterations)?;
                 accepted = self.line_search(&v, &r, &delta, &mut trial, &mut r_trial);
             }
@@ -528,7 +578,7 @@ where
             std::mem::swap(&mut r, &mut r_trial);
             r_norm = max_abs(&r);
         }
-        self.finish(&v, iterations, r_norm)
+        self.finish(&v, &mut buffer, iterations, r_norm)
     }
 
     /// The Newton direction from the banded LU of the whole Jacobian.
@@ -583,12 +633,17 @@ where
         false
     }
 
-    /// The first (obstacle, state, clearance) with negative (or NaN) clearance.
-    fn first_collision(&self, v: &[f64]) -> Option<(usize, usize, f64)> {
-        let (count, f) = self.clearance?;
-        let mut buffer = vec![0.0; count];
+    /// The number of obstacles of the clearance function (0 without one).
+    fn obstacles(&self) -> usize {
+        self.clearance.map_or(0, |(count, _)| count)
+    }
+
+    /// The first (obstacle, state, clearance) with negative (or NaN) clearance; `buffer` holds
+    /// one clearance per obstacle.
+    fn first_collision(&self, v: &[f64], buffer: &mut [f64]) -> Option<(usize, usize, f64)> {
+        let (_, f) = self.clearance?;
         for step in 0..=self.steps {
-            f(&self.state(v, step), &mut buffer);
+            f(&self.state(v, step), buffer);
             if let Some((obstacle, &c)) = buffer
                 .iter()
                 .enumerate()
@@ -603,18 +658,25 @@ where
     fn finish(
         &self,
         v: &[f64],
+        buffer: &mut [f64],
         iterations: usize,
         residual_norm: f64,
     ) -> Result<BvpSolution<S, M>, Error> {
         let (h, theta) = (self.h(), self.options.theta);
-        let states: Vec<_> = (0..=self.steps).map(|i| self.state(v, i)).collect();
-        let unknowns: Vec<_> = (0..self.steps).map(|i| self.unknowns(v, i)).collect();
+        let mut states = filled(self.steps + 1, SVector::zeros(), "steps")?;
+        for (i, z) in states.iter_mut().enumerate() {
+            *z = self.state(v, i);
+        }
+        let mut unknowns = filled(self.steps, SVector::zeros(), "steps")?;
+        for (i, w) in unknowns.iter_mut().enumerate() {
+            *w = self.unknowns(v, i);
+        }
         let cost = states
             .iter()
             .zip(&unknowns)
             .map(|(z, w)| self.system.step_cost(z, w, h, theta))
             .sum();
-        if let Some((obstacle, step, clearance)) = self.first_collision(v) {
+        if let Some((obstacle, step, clearance)) = self.first_collision(v, buffer) {
             return Err(Error::ThroughObstacle {
                 obstacle,
                 step,
@@ -623,11 +685,10 @@ where
         }
         let mut clearance = Vec::new();
         if let Some((count, f)) = self.clearance {
-            clearance = vec![f64::INFINITY; count];
-            let mut buffer = vec![0.0; count];
+            clearance = filled(count, f64::INFINITY, "obstacles")?;
             for z in &states {
-                f(z, &mut buffer);
-                for (best, &c) in clearance.iter_mut().zip(&buffer) {
+                f(z, buffer);
+                for (best, &c) in clearance.iter_mut().zip(buffer.iter()) {
                     *best = best.min(c);
                 }
             }
