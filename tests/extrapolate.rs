@@ -3,46 +3,11 @@
 //! moderate N agrees with one at a much larger N within its error estimate, and for the
 //! minimum-acceleration spline it recovers the exact continuous cost.
 
+mod common;
+
+use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 use retract::bvp::{Extrapolated, OptimalControlProblem, PlanError, PlanGuess, PlanOptions};
 use retract::higher_order_lagrangian;
-use retract::nalgebra::SVector;
-
-/// The one-disc scene of `../shared/BENCHMARKS.md`.
-#[higher_order_lagrangian(order = 2)]
-fn one_disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
-}
-
-const DISC_START: [f64; 4] = [-2.0, 0.2, 1.0, 0.0];
-const DISC_GOAL: [f64; 4] = [2.0, 0.2, 1.0, 0.0];
-
-/// The scene's feasible guess: the Hermite cubic (here the straight line at unit speed) plus a
-/// bump 1.3 * 16 s^2 (1 - s)^2 in y, with its derivatives.
-fn bump_guess(steps: usize) -> (Vec<SVector<f64, 4>>, Vec<SVector<f64, 2>>) {
-    let t_end = 4.0;
-    let h = t_end / steps as f64;
-    let y = |s: f64| {
-        (
-            1.3 * 16.0 * s * s * (1.0 - s).powi(2),
-            1.3 * 16.0 * (2.0 * s - 6.0 * s * s + 4.0 * s.powi(3)) / t_end,
-            1.3 * 16.0 * (2.0 - 12.0 * s + 12.0 * s * s) / (t_end * t_end),
-        )
-    };
-    let x = (0..=steps)
-        .map(|i| {
-            let t = i as f64 * h;
-            let (b, db, _) = y(t / t_end);
-            SVector::from([-2.0 + t, 0.2 + b, 1.0, db])
-        })
-        .collect();
-    let u = (0..steps)
-        .map(|i| {
-            let (_, _, ddb) = y((i as f64 + 0.5) * h / t_end);
-            SVector::from([0.0, ddb])
-        })
-        .collect();
-    (x, u)
-}
 
 fn disc_problem(steps: usize) -> OptimalControlProblem<'static, OneDisc, 2, 2, 4> {
     static SYSTEM: OneDisc = OneDisc { tau: 1e-2 };
@@ -53,7 +18,7 @@ fn extrapolate_disc(
     steps: usize,
     options: PlanOptions,
 ) -> Result<Extrapolated<2, 4>, PlanError<2, 4>> {
-    let (x, u) = bump_guess(steps);
+    let (x, u) = disc_bump_guess(steps);
     disc_problem(steps)
         .with_options(options)
         .solve_extrapolated(PlanGuess::Path { x: &x, u: &u })

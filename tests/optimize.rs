@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
+
 use std::f64::consts::PI;
 
 use retract::bvp::{
@@ -26,49 +28,12 @@ fn double_pendulum(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
     0.5 * (tau1 * tau1 + tau2 * tau2)
 }
 
-/// The one-disc scene of `../shared/BENCHMARKS.md`.
-#[higher_order_lagrangian(order = 2)]
-fn one_disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
-}
-
-const DISC_START: [f64; 4] = [-2.0, 0.2, 1.0, 0.0];
-const DISC_GOAL: [f64; 4] = [2.0, 0.2, 1.0, 0.0];
-
-/// The scene's feasible guess: the Hermite cubic (here the straight line at unit speed) plus a
-/// bump 1.3 * 16 s^2 (1 - s)^2 in y, with its derivatives.
-fn bump_guess(steps: usize) -> (Vec<SVector<f64, 4>>, Vec<SVector<f64, 2>>) {
-    let t_end = 4.0;
-    let h = t_end / steps as f64;
-    let y = |s: f64| {
-        (
-            1.3 * 16.0 * s * s * (1.0 - s).powi(2),
-            1.3 * 16.0 * (2.0 * s - 6.0 * s * s + 4.0 * s.powi(3)) / t_end,
-            1.3 * 16.0 * (2.0 - 12.0 * s + 12.0 * s * s) / (t_end * t_end),
-        )
-    };
-    let x = (0..=steps)
-        .map(|i| {
-            let t = i as f64 * h;
-            let (b, db, _) = y(t / t_end);
-            SVector::from([-2.0 + t, 0.2 + b, 1.0, db])
-        })
-        .collect();
-    let u = (0..steps)
-        .map(|i| {
-            let (_, _, ddb) = y((i as f64 + 0.5) * h / t_end);
-            SVector::from([0.0, ddb])
-        })
-        .collect();
-    (x, u)
-}
-
 fn solve_disc(
     steps: usize,
     options: PlanOptions,
 ) -> Result<Plan<2, 4>, retract::bvp::PlanError<2, 4>> {
     let system = OneDisc { tau: 1e-2 };
-    let (x, u) = bump_guess(steps);
+    let (x, u) = disc_bump_guess(steps);
     OptimalControlProblem::new(&system, &DISC_START, &DISC_GOAL, 4.0, steps)
         .with_options(options)
         .solve(PlanGuess::Path { x: &x, u: &u })

@@ -45,3 +45,48 @@ pub fn bounded_pais_uhlenbeck() -> (PaisUhlenbeck, retract::nalgebra::SVector<f6
     let z0 = system.legendre(&retract::nalgebra::SVector::from_column_slice(&jet));
     (system, z0)
 }
+
+/// The one-disc scene of `../shared/BENCHMARKS.md`: L = 1/2 |q''|^2 + tau / (x^2 + y^2 - 1).
+#[higher_order_lagrangian(order = 2)]
+pub fn one_disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
+    0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
+}
+
+/// The one-disc scene's boundary jets (q, q') at t = 0 and t = 4.
+pub const DISC_START: [f64; 4] = [-2.0, 0.2, 1.0, 0.0];
+pub const DISC_GOAL: [f64; 4] = [2.0, 0.2, 1.0, 0.0];
+
+/// The one-disc scene's feasible guess with `steps` steps on [0, 4]: the Hermite cubic (here
+/// the straight line at unit speed) plus a bump 1.3 * 16 s^2 (1 - s)^2 in y (s = t / 4):
+/// the jets (q, q') at the nodes and q'' at the step midpoints.
+pub fn disc_bump_guess(
+    steps: usize,
+) -> (
+    Vec<retract::nalgebra::SVector<f64, 4>>,
+    Vec<retract::nalgebra::SVector<f64, 2>>,
+) {
+    use retract::nalgebra::SVector;
+    let t_end = 4.0;
+    let h = t_end / steps as f64;
+    let y = |s: f64| {
+        (
+            1.3 * 16.0 * s * s * (1.0 - s).powi(2),
+            1.3 * 16.0 * (2.0 * s - 6.0 * s * s + 4.0 * s.powi(3)) / t_end,
+            1.3 * 16.0 * (2.0 - 12.0 * s + 12.0 * s * s) / (t_end * t_end),
+        )
+    };
+    let x = (0..=steps)
+        .map(|i| {
+            let t = i as f64 * h;
+            let (b, db, _) = y(t / t_end);
+            SVector::from([-2.0 + t, 0.2 + b, 1.0, db])
+        })
+        .collect();
+    let u = (0..steps)
+        .map(|i| {
+            let (_, _, ddb) = y((i as f64 + 0.5) * h / t_end);
+            SVector::from([0.0, ddb])
+        })
+        .collect();
+    (x, u)
+}
