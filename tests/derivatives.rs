@@ -79,6 +79,46 @@ fn transcendental(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], alpha: f64) -> f64 {
         + (1.0 + q[0].powi(2) + dq[1].powi(2)).sqrt()
 }
 
+/// n = 7 (above nalgebra's `SVector::new`, n <= 6), constant weights on q' with a coupling:
+/// the closed-form Legendre inverse (issue 14, item 1).
+#[higher_order_lagrangian(order = 1)]
+fn chain7(q: [f64; 7], dq: [f64; 7], kappa: f64) -> f64 {
+    let mut l = 0.0;
+    for i in 0..7 {
+        l += 0.5 * (1.0 + 0.25 * i as f64) * dq[i].powi(2) + kappa * q[i].cos();
+    }
+    for i in 0..6 {
+        l += 0.1 * dq[i] * dq[i + 1] - 0.5 * (q[i + 1] - q[i]).powi(2);
+    }
+    l
+}
+
+/// n = 12, k = 2, constant weights on q'' and a nonlinear potential.
+#[higher_order_lagrangian(order = 2)]
+fn chain12(q: [f64; 12], dq: [f64; 12], ddq: [f64; 12], kappa: f64) -> f64 {
+    let mut l = 0.0;
+    for i in 0..12 {
+        l += 0.5 * (2.0 - 0.05 * i as f64) * ddq[i].powi(2) + 0.05 * dq[i].powi(2);
+    }
+    for i in 0..11 {
+        l += 0.2 * ddq[i] * ddq[i + 1] - kappa * (q[i] * q[i + 1]).sin();
+    }
+    l
+}
+
+/// n = 24, constant weights on q'.
+#[higher_order_lagrangian(order = 1)]
+fn chain24(q: [f64; 24], dq: [f64; 24], kappa: f64) -> f64 {
+    let mut l = 0.0;
+    for i in 0..24 {
+        l += 0.5 * (1.0 + 0.1 * i as f64) * dq[i].powi(2) - kappa * q[i].powi(4);
+    }
+    for i in 0..23 {
+        l += 0.05 * dq[i] * dq[i + 1] - 0.5 * kappa * (q[i + 1] * q[i]).cos();
+    }
+    l
+}
+
 // ---- finite differences -----------------------------------------------------------------
 
 /// f'(0) of a scalar function of one variable, fourth-order central stencil.
@@ -350,6 +390,26 @@ proptest! {
     fn atan2_exp_sqrt_k2(mut v in point(8, -1.0, 1.0), alpha in -1.0..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
         v[0] += 2.0; // away from the atan2 branch point at the origin
         check_all(&Transcendental { alpha }, &v, h, theta);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Issue 14, item 1: n >= 7 with constant weights on the top derivative compiles (the
+    /// closed-form Legendre inverse), and all derivatives match finite differences.
+    #[test]
+    fn item_1_dimension_seven_and_more(v in point(48, -1.0, 1.0), kappa in 0.1..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
+        check_all(&Chain7 { kappa }, &v, h, theta);
+        check_all(&Chain12 { kappa }, &v, h, theta);
+        check_all(&Chain24 { kappa }, &v, h, theta);
+        // the closed-form inverse inverts the momentum map: u = A^{-1} (p - dL/du(x, 0))
+        let x = blocks::<24, 1>(&v);
+        let u = SVector::<f64, 24>::from_fn(|i, _| v[24 + i]);
+        let sys = Chain24 { kappa };
+        let p = sys.gradient(&x, &u).u;
+        let back = sys.top_derivative(&x, &p, &SVector::zeros()).expect("closed form");
+        prop_assert!((back - u).amax() < 1e-12 * (1.0 + u.amax()), "{}", (back - u).amax());
     }
 }
 

@@ -24,7 +24,7 @@ pub trait Leaves {
     /// The expression for a symbol.
     fn var(&self, var: Var) -> TokenStream;
     /// The slice parameter `param` to loop over, e.g. `self.obstacles`.
-    fn slice(&self, param: u16) -> TokenStream;
+    fn slice(&self, param: u32) -> TokenStream;
     /// The loop variable of the element of `param`.
     fn element(&self) -> TokenStream {
         quote!(__e)
@@ -54,7 +54,7 @@ pub(crate) fn constant(value: f64) -> TokenStream {
         }
     } else {
         let lit = Literal::f64_suffixed(value.abs());
-        if value < 0.0 {
+        if value.is_sign_negative() {
             quote!((-#lit))
         } else {
             quote!(#lit)
@@ -512,7 +512,7 @@ mod tests {
             quote!(#name)
         }
 
-        fn slice(&self, _param: u16) -> TokenStream {
+        fn slice(&self, _param: u32) -> TokenStream {
             quote!(slice)
         }
     }

@@ -61,7 +61,11 @@ impl Differentiator {
                 if g.is_const(da, 0.0) {
                     return da;
                 }
-                let p = g.powi(a, n - 1);
+                // a^(n-1), or a^n / a where n - 1 is below i32::MIN
+                let p = match n.checked_sub(1) {
+                    Some(m) => g.powi(a, m),
+                    None => g.div(node, a),
+                };
                 let c = g.constant(n as f64);
                 let cp = g.mul(c, p);
                 g.mul(cp, da)
@@ -219,7 +223,7 @@ pub fn total_derivative(g: &mut Graph, d: &mut Differentiator, f: Id, n: usize, 
         for index in 0..n {
             let var = Var::Jet {
                 order: order as u8,
-                index: index as u16,
+                index: index as u32,
             };
             let partial = d.diff(g, f, var);
             if g.is_const(partial, 0.0) {
@@ -227,7 +231,7 @@ pub fn total_derivative(g: &mut Graph, d: &mut Differentiator, f: Id, n: usize, 
             }
             let next = g.var(Var::Jet {
                 order: order as u8 + 1,
-                index: index as u16,
+                index: index as u32,
             });
             let term = g.mul(partial, next);
             acc = g.add_op(acc, term);
@@ -241,7 +245,7 @@ mod tests {
     use super::*;
     use crate::graph::tests::show;
 
-    fn q(g: &mut Graph, order: u8, index: u16) -> Id {
+    fn q(g: &mut Graph, order: u8, index: u32) -> Id {
         g.var(Var::Jet { order, index })
     }
 

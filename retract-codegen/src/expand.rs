@@ -114,7 +114,42 @@ fn sum_tree(terms: &[(bool, TokenStream)]) -> Option<(bool, TokenStream)> {
     ))
 }
 
-/// `check_domain`: each guard at the three points of a step, one loop per slice guard.
+/// The relative distance from zero below which a guarded expression counts as vanished.
+const VANISH_TOLERANCE: f64 = 1e-9;
+
+/// The "vanishes" rule of `check_domain`, emitted once as a local function: whether the
+/// quadratic through the samples `(0, a)`, `(theta, c)`, `(1, b)` (exact for an expression
+/// quadratic along the chord, such as `x^2 + y^2 - r^2` or `|q'|^2`) stays above
+/// `VANISH_TOLERANCE` times the largest sample in magnitude on `[0, 1]`, on the side of zero
+/// of the samples. For `theta` within `1e-3` of an end the fit is ill-conditioned and only
+/// the samples are compared.
+fn clear_of_zero_fn() -> TokenStream {
+    let tol = Literal::f64_suffixed(VANISH_TOLERANCE);
+    quote! {
+        #[inline(always)]
+        fn __clear_of_zero(a: f64, b: f64, c: f64, theta: f64) -> bool {
+            let sign = if a < 0.0 { -1.0 } else { 1.0 };
+            let (a, b, c) = (sign * a, sign * b, sign * c);
+            let scale = a.max(b).max(c);
+            let mut low = a.min(b).min(c);
+            if theta > 1e-3 && theta < 1.0 - 1e-3 {
+                // p(s) = a + beta s + alpha s^2 through the three samples
+                let alpha = ((c - a) - theta * (b - a)) / (theta * theta - theta);
+                let beta = (b - a) - alpha;
+                let vertex = -beta / (2.0 * alpha);
+                if alpha > 0.0 && vertex > 0.0 && vertex < 1.0 {
+                    low = low.min(a + 0.5 * beta * vertex);
+                }
+            }
+            low > #tol * scale
+        }
+    }
+}
+
+/// `check_domain`: each guard at the three points of a step, one loop per slice guard. A
+/// denominator (and each factor of a guarded expression) must be finite, non-zero and of one
+/// sign at the three points, a `sqrt` argument `>= 0`, `ln` and `powf` arguments `> 0`; and
+/// every guarded expression must stay clear of zero between them (`clear_of_zero_fn`).
 fn domain_check(
     g: &Graph,
     sig: &Signature,
@@ -125,24 +160,31 @@ fn domain_check(
     let check = |guard: &Guard, values: &[TokenStream], element: TokenStream| {
         let (a, b, c) = (&values[0], &values[1], &values[2]);
         let text = &guard.text;
-        let (condition, kind) = match guard.kind {
-            GuardKind::Denominator => (
-                // finite, non-zero and of one sign (NaN fails every comparison)
-                quote!((#a > 0.0 && #b > 0.0 && #c > 0.0 && #a < ::core::f64::INFINITY
-                        && #b < ::core::f64::INFINITY && #c < ::core::f64::INFINITY)
-                    || (#a < 0.0 && #b < 0.0 && #c < 0.0 && #a > ::core::f64::NEG_INFINITY
-                        && #b > ::core::f64::NEG_INFINITY && #c > ::core::f64::NEG_INFINITY)),
-                quote!(Denominator),
-            ),
-            GuardKind::SqrtArgument => (
-                quote!(#a >= 0.0 && #b >= 0.0 && #c >= 0.0),
-                quote!(SqrtArgument),
-            ),
-            GuardKind::LnArgument => (quote!(#a > 0.0 && #b > 0.0 && #c > 0.0), quote!(LnArgument)),
-            GuardKind::PowfBase => (quote!(#a > 0.0 && #b > 0.0 && #c > 0.0), quote!(PowfBase)),
+        let sign = if guard.factor {
+            GuardKind::Denominator
+        } else {
+            guard.kind
+        };
+        let condition = match sign {
+            // finite, non-zero and of one sign (NaN fails every comparison)
+            GuardKind::Denominator => quote!((#a > 0.0 && #b > 0.0 && #c > 0.0
+                    && #a < ::core::f64::INFINITY && #b < ::core::f64::INFINITY
+                    && #c < ::core::f64::INFINITY)
+                || (#a < 0.0 && #b < 0.0 && #c < 0.0 && #a > ::core::f64::NEG_INFINITY
+                    && #b > ::core::f64::NEG_INFINITY && #c > ::core::f64::NEG_INFINITY)),
+            GuardKind::SqrtArgument => quote!(#a >= 0.0 && #b >= 0.0 && #c >= 0.0),
+            GuardKind::LnArgument | GuardKind::PowfBase => {
+                quote!(#a > 0.0 && #b > 0.0 && #c > 0.0)
+            }
+        };
+        let kind = match guard.kind {
+            GuardKind::Denominator => quote!(Denominator),
+            GuardKind::SqrtArgument => quote!(SqrtArgument),
+            GuardKind::LnArgument => quote!(LnArgument),
+            GuardKind::PowfBase => quote!(PowfBase),
         };
         quote! {
-            if !(#condition) {
+            if !((#condition) && __clear_of_zero(#a, #b, #c, theta)) {
                 return ::core::result::Result::Err(#core::DomainViolation {
                     expression: #text,
                     kind: #core::DomainKind::#kind,
@@ -151,7 +193,7 @@ fn domain_check(
             }
         }
     };
-    let mut out = TokenStream::new();
+    let mut out = clear_of_zero_fn();
     let plain: Vec<&(Guard, [Id; 3])> = guards
         .iter()
         .filter(|(guard, _)| guard.slice.is_none())
@@ -218,7 +260,7 @@ fn index(i: usize) -> Literal {
 struct Names<'a> {
     sig: &'a Signature,
     /// q^(order)[index] as an expression.
-    jet: &'a dyn Fn(u8, u16) -> TokenStream,
+    jet: &'a dyn Fn(u8, u32) -> TokenStream,
 }
 
 impl Leaves for Names<'_> {
@@ -257,7 +299,7 @@ impl Leaves for Names<'_> {
         }
     }
 
-    fn slice(&self, param: u16) -> TokenStream {
+    fn slice(&self, param: u32) -> TokenStream {
         let name = &self.sig.params[param as usize].name;
         quote!(self.#name)
     }
@@ -265,7 +307,7 @@ impl Leaves for Names<'_> {
 
 /// q^(order)[i] inside a method taking `(x, u)`: `x[order][i]` below the top order k,
 /// `u[i]` at it.
-fn xu_leaf(k: usize, order: u8, i: u16) -> TokenStream {
+fn xu_leaf(k: usize, order: u8, i: u32) -> TokenStream {
     let i = index(i as usize);
     if (order as usize) < k {
         let o = index(order as usize);
@@ -409,7 +451,7 @@ pub(crate) fn scalar_bodies(
     let (n, k) = (sig.dim, sig.order);
     let core = quote!(::retract::__private::retract_core);
     let float = float_import();
-    let in_xu = |order: u8, i: u16| xu_leaf(k, order, i);
+    let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
     let xu = Names { sig, jet: &in_xu };
 
     let value_code = emit(g, &[value], &xu);
@@ -513,8 +555,8 @@ fn generate(
     );
 
     // q^(order)[index] in each method
-    let in_xu = |order: u8, i: u16| xu_leaf(k, order, i);
-    let in_jet = |order: u8, i: u16| {
+    let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
+    let in_jet = |order: u8, i: u32| {
         let i = index(i as usize);
         if (order as usize) < k {
             let o = index(order as usize);
@@ -524,7 +566,7 @@ fn generate(
             quote!(upper[#o][#i])
         }
     };
-    let none = |_: u8, _: u16| quote!(::core::f64::NAN);
+    let none = |_: u8, _: u32| quote!(::core::f64::NAN);
     let xu = Names { sig, jet: &in_xu };
     let jet = Names { sig, jet: &in_jet };
     let scheme = Names { sig, jet: &none };
@@ -569,7 +611,8 @@ fn generate(
                 });
                 quote! {
                     let __rhs: [f64; #n_lit] = [#(#rhs),*];
-                    ::core::result::Result::Ok(#vec_n_path::new(#(#rows),*))
+                    // `from` an array: nalgebra's `new` takes the entries only for n <= 6
+                    ::core::result::Result::Ok(#vec_n_path::from([#(#rows),*]))
                 }
             }
             None => {
@@ -643,12 +686,16 @@ fn generate(
     let vec_m_path = quote!(#na::SVector::<f64, #m_lit>);
     let check_domain = (!guards.is_empty()).then(|| {
         let body = domain_check(g, sig, guards, &scheme);
-        let list: Vec<String> = guards
-            .iter()
-            .map(|(guard, _)| format!("`{}`", guard.text))
-            .collect();
+        let mut list: Vec<String> = Vec::new();
+        for (guard, _) in guards {
+            let item = format!("`{}`", guard.text);
+            if !list.contains(&item) {
+                list.push(item);
+            }
+        }
         let doc = format!(
-            "Domain check at x_0, x_1 and x_theta of a step. Denominators that must keep their \
+            "Domain check at x_0, x_1 and x_theta of a step (and between them, by the quadratic through \
+             the three values). Denominators that must keep their \
              sign, and arguments of sqrt (>= 0), ln and powf (> 0): {}.",
             list.join(", ")
         );

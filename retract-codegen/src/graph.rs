@@ -15,22 +15,22 @@ pub struct Id(pub u32);
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Var {
     /// Component `index` of the derivative q^(order).
-    Jet { order: u8, index: u16 },
+    Jet { order: u8, index: u32 },
     /// Component `index` of parameter `param` (0 for a scalar).
-    Param { param: u16, index: u16 },
+    Param { param: u32, index: u32 },
     /// Component `index` of the current element of the slice parameter `param`.
-    Elem { param: u16, index: u16 },
+    Elem { param: u32, index: u32 },
     /// Component of the state z_0 at the start of a step.
-    Z0(u16),
+    Z0(u32),
     /// Component of the Newton unknowns w = (z_1, u) of a step.
-    W(u16),
+    W(u32),
     /// The step size h.
     Step,
     /// The scheme parameter theta.
     Theta,
     /// Core variable m of the reduced step: the value at the evaluation point of a jet
     /// component on which the Hessian of L depends.
-    Core(u16),
+    Core(u32),
 }
 
 /// A unary function.
@@ -102,7 +102,7 @@ pub enum Node {
     /// Sum over the elements of slice parameter `param` of `body` (which may use
     /// `Var::Elem { param, .. }`), evaluated by a run-time loop.
     Sum {
-        param: u16,
+        param: u32,
         body: Id,
     },
 }
@@ -140,9 +140,9 @@ impl Graph {
         id
     }
 
-    /// The constant `value` (`-0.0` is stored as `0.0`).
+    /// The constant `value`, by its bits: `-0.0` stays negative (`1 / -0.0` is `-inf`) and
+    /// NaN stays NaN, so that folding constants computes exactly what f64 does.
     pub fn constant(&mut self, value: f64) -> Id {
-        let value = if value == 0.0 { 0.0 } else { value };
         self.add(Node::Const(value.to_bits()))
     }
 
@@ -157,6 +157,11 @@ impl Graph {
     /// Whether `id` is the constant `value`.
     pub fn is_const(&self, id: Id, value: f64) -> bool {
         self.as_const(id) == Some(value)
+    }
+
+    /// Whether `id` is a constant that is infinite or NaN.
+    fn is_non_finite(&self, id: Id) -> bool {
+        self.as_const(id).is_some_and(|v| !v.is_finite())
     }
 
     /// A symbol.
@@ -189,14 +194,16 @@ impl Graph {
         if let Node::Neg(na) = *self.node(a) {
             return self.sub(b, na);
         }
-        // (x - b) + b = x
+        // (x - b) + b = x (not for a constant b = inf or NaN: inf - inf is NaN)
         if let Node::Sub(x, c) = *self.node(a)
             && c == b
+            && !self.is_non_finite(b)
         {
             return x;
         }
         if let Node::Sub(x, c) = *self.node(b)
             && c == a
+            && !self.is_non_finite(a)
         {
             return x;
         }
@@ -205,11 +212,14 @@ impl Graph {
     }
 
     pub fn sub(&mut self, a: Id, b: Id) -> Id {
+        // constants first: inf - inf and NaN - NaN are NaN, not 0
+        if let (Some(x), Some(y)) = (self.as_const(a), self.as_const(b)) {
+            return self.constant(x - y);
+        }
         if a == b {
             return self.constant(0.0);
         }
         match (self.as_const(a), self.as_const(b)) {
-            (Some(x), Some(y)) => return self.constant(x - y),
             (Some(0.0), _) => return self.neg(b),
             (_, Some(0.0)) => return a,
             _ => {}
@@ -217,14 +227,16 @@ impl Graph {
         if let Node::Neg(nb) = *self.node(b) {
             return self.add_op(a, nb);
         }
-        // a - (a - c) = c and (a - c) - a = -c
+        // a - (a - c) = c and (a - c) - a = -c (not for a constant a = inf or NaN)
         if let Node::Sub(x, c) = *self.node(b)
             && x == a
+            && !self.is_non_finite(a)
         {
             return c;
         }
         if let Node::Sub(x, c) = *self.node(a)
             && x == b
+            && !self.is_non_finite(b)
         {
             return self.neg(c);
         }
@@ -247,8 +259,11 @@ impl Graph {
         } else {
             (a, b)
         };
+        // only where c1 c2 neither overflows nor underflows, so that the value is that of
+        // c1 * (c2 * x) up to rounding
         if let (Some(x), Node::Mul(c, rest)) = (self.as_const(a), self.node(b).clone())
             && let Some(y) = self.as_const(c)
+            && (x * y).is_normal()
         {
             let folded = self.constant(x * y);
             return self.mul(folded, rest);
@@ -269,7 +284,8 @@ impl Graph {
 
     pub fn div(&mut self, a: Id, b: Id) -> Id {
         match (self.as_const(a), self.as_const(b)) {
-            (Some(x), Some(y)) if y != 0.0 => return self.constant(x / y),
+            // exactly as f64 evaluates it: 0 / 0 is NaN, x / 0 is +-inf
+            (Some(x), Some(y)) => return self.constant(x / y),
             (Some(0.0), _) => return self.constant(0.0),
             (_, Some(1.0)) => return a,
             (_, Some(-1.0)) => return self.neg(a),
@@ -310,6 +326,9 @@ impl Graph {
     }
 
     pub fn powf(&mut self, a: Id, b: Id) -> Id {
+        if let (Some(x), Some(y)) = (self.as_const(a), self.as_const(b)) {
+            return self.constant(x.powf(y));
+        }
         if let Some(y) = self.as_const(b) {
             if y == 0.0 {
                 return self.constant(1.0);
@@ -322,9 +341,6 @@ impl Graph {
             }
             if y == 0.5 {
                 return self.unary(Func::Sqrt, a);
-            }
-            if let Some(x) = self.as_const(a) {
-                return self.constant(x.powf(y));
             }
         }
         self.add(Node::Powf(a, b))
@@ -357,7 +373,7 @@ impl Graph {
         self.add(Node::Hypot(a, b))
     }
 
-    pub fn sum(&mut self, param: u16, body: Id) -> Id {
+    pub fn sum(&mut self, param: u32, body: Id) -> Id {
         if self.is_const(body, 0.0) {
             return body;
         }
@@ -406,7 +422,7 @@ pub mod tests {
         }
     }
 
-    fn q(g: &mut Graph, i: u16) -> Id {
+    fn q(g: &mut Graph, i: u32) -> Id {
         g.var(Var::Jet { order: 0, index: i })
     }
 

@@ -6,6 +6,12 @@
 //! slice parameters (a run-time sum: the body may only accumulate into outer variables with
 //! `+=` / `-=`). Everything else is a `syn::Error` at its span; errors are collected so the
 //! user sees all of them.
+//!
+//! Limits, each an error at its span beyond it: integers known at compile time (indices, loop
+//! bounds, `powi` exponents) are computed in i64 with overflow checks, `powi` exponents must
+//! fit in i32; indices (of the jet, of parameter arrays and of slice elements) go up to
+//! `u32::MAX` = 4 294 967 295 and are never truncated; range loops unroll at most
+//! [`MAX_UNROLLED`] statements in all.
 
 use std::collections::HashMap;
 
@@ -33,11 +39,11 @@ enum Binding {
     Int(i64),
     Jet(u8),
     Param {
-        param: u16,
+        param: u32,
         kind: Kind,
     },
     Element {
-        param: u16,
+        param: u32,
         len: usize,
     },
     /// A binding whose initialiser was already reported as an error: later uses are silent.
@@ -65,11 +71,19 @@ pub struct Guard {
     /// The expression as the user wrote it.
     pub text: String,
     /// The slice parameter whose elements it depends on, if any.
-    pub slice: Option<u16>,
+    pub slice: Option<u32>,
+    /// A factor of the guarded expression (the base of an even power, the argument of `abs`
+    /// or `sqrt`, a factor of a product): it is checked like a denominator (keeps its sign,
+    /// does not vanish), since the guarded expression vanishes where it does, even when the
+    /// expression itself does not change sign. Reported under `kind` and `text`.
+    pub factor: bool,
 }
 
+/// At most this many factors of one guarded expression are guarded separately.
+const MAX_FACTORS: usize = 64;
+
 struct SliceLoop {
-    param: u16,
+    param: u32,
     /// Scope depth of the loop body; bindings below it are outer.
     depth: usize,
     /// Accumulated contributions per outer variable.
@@ -86,6 +100,8 @@ pub struct Lower<'a> {
     /// Guarded expressions that depend on the jet, in order of appearance, deduplicated.
     pub guards: Vec<Guard>,
     unrolled: usize,
+    /// Whether "loop too long to unroll" was reported (once, not per outer iteration).
+    too_long: bool,
 }
 
 impl<'a> Lower<'a> {
@@ -99,7 +115,7 @@ impl<'a> Lower<'a> {
             top.insert(
                 p.name.to_string(),
                 Binding::Param {
-                    param: i as u16,
+                    param: i as u32,
                     kind: p.kind,
                 },
             );
@@ -112,6 +128,7 @@ impl<'a> Lower<'a> {
             errors: Vec::new(),
             guards: Vec::new(),
             unrolled: 0,
+            too_long: false,
         }
     }
 
@@ -377,17 +394,38 @@ impl<'a> Lower<'a> {
                     return;
                 };
                 let Some(start) = start else { return };
+                // in i128, so that neither `end + 1` nor `end - start` overflows at the ends
+                // of i64; the unrolled work is counted with checked arithmetic
                 let end = match r.limits {
-                    syn::RangeLimits::HalfOpen(_) => end,
-                    syn::RangeLimits::Closed(_) => end + 1,
+                    syn::RangeLimits::HalfOpen(_) => i128::from(end),
+                    syn::RangeLimits::Closed(_) => i128::from(end) + 1,
                 };
-                let count = (end - start).max(0) as usize;
-                self.unrolled += count * f.body.stmts.len().max(1);
-                if self.unrolled > MAX_UNROLLED {
-                    self.error(r.span(), "loop too long to unroll at compile time");
+                let count = (end - i128::from(start)).max(0);
+                let iterations = usize::try_from(count).ok();
+                let total = iterations
+                    .and_then(|count| count.checked_mul(f.body.stmts.len().max(1)))
+                    .and_then(|work| work.checked_add(self.unrolled))
+                    .filter(|&total| total <= MAX_UNROLLED);
+                let (Some(iterations), Some(total)) = (iterations, total) else {
+                    if !self.too_long {
+                        self.too_long = true;
+                        // at the bound (on stable, the span of a range is its first token)
+                        let span = r.end.as_ref().map_or(r.span(), |end| end.span());
+                        self.error(
+                            span,
+                            format!(
+                                "loop too long to unroll at compile time: {count} iterations, \
+                                 but at most {MAX_UNROLLED} statements are unrolled in all the \
+                                 loops of a Lagrangian; a long sum over data is a loop over a \
+                                 slice parameter `&[[f64; N]]` (a run-time loop)"
+                            ),
+                        );
+                    }
                     return;
-                }
-                for i in start..end {
+                };
+                self.unrolled = total;
+                // `count` iterations from `start`, each index in i64 (it is below `end`)
+                for i in (start..=i64::MAX).take(iterations) {
                     self.scopes.push(HashMap::new());
                     if let Some(v) = &var {
                         self.bind(v.clone(), Binding::Int(i));
@@ -476,23 +514,44 @@ impl<'a> Lower<'a> {
             );
             None
         };
+        let overflow = |this: &mut Self, span: Span| {
+            this.error(
+                span,
+                "integer overflow at compile time: integers in a Lagrangian (indices, loop \
+                 bounds, exponents) are computed in i64",
+            );
+            None
+        };
         match e {
             Expr::Lit(l) => match &l.lit {
-                Lit::Int(i) => i.base10_parse().ok().or_else(|| fail(self, i.span())),
+                Lit::Int(i) => i.base10_parse().ok().or_else(|| overflow(self, i.span())),
                 other => fail(self, other.span()),
             },
             Expr::Paren(p) => self.int(&p.expr),
             Expr::Group(g) => self.int(&g.expr),
-            Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => self.int(&u.expr).map(|v| -v),
+            Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => {
+                // `-9223372036854775808` is i64::MIN although its digits are not an i64
+                if let Expr::Lit(syn::ExprLit {
+                    lit: Lit::Int(i), ..
+                }) = &*u.expr
+                    && let Some(v) = i
+                        .base10_parse::<i128>()
+                        .ok()
+                        .and_then(|v| i64::try_from(-v).ok())
+                {
+                    return Some(v);
+                }
+                let v = self.int(&u.expr)?;
+                v.checked_neg().or_else(|| overflow(self, u.span()))
+            }
             Expr::Binary(b) => {
                 let (l, r) = (self.int(&b.left)?, self.int(&b.right)?);
                 match b.op {
-                    BinOp::Add(_) => l.checked_add(r),
-                    BinOp::Sub(_) => l.checked_sub(r),
-                    BinOp::Mul(_) => l.checked_mul(r),
-                    _ => None,
+                    BinOp::Add(_) => l.checked_add(r).or_else(|| overflow(self, b.span())),
+                    BinOp::Sub(_) => l.checked_sub(r).or_else(|| overflow(self, b.span())),
+                    BinOp::Mul(_) => l.checked_mul(r).or_else(|| overflow(self, b.span())),
+                    _ => fail(self, b.span()),
                 }
-                .or_else(|| fail(self, b.span()))
             }
             Expr::Path(p) => match p.path.get_ident().and_then(|i| self.lookup(&i.to_string())) {
                 Some((_, Binding::Int(v))) => Some(v),
@@ -673,33 +732,17 @@ impl<'a> Lower<'a> {
             return self.g.constant(0.0);
         };
         let (len, var) = match self.lookup(&name) {
-            Some((_, Binding::Jet(order))) if !self.sig.scalar_jet => (
-                self.sig.dim,
-                Var::Jet {
-                    order,
-                    index: i.clamp(0, u16::MAX as i64) as u16,
-                },
-            ),
+            Some((_, Binding::Jet(order))) if !self.sig.scalar_jet => {
+                (self.sig.dim, Var::Jet { order, index: 0 })
+            }
             Some((
                 _,
                 Binding::Param {
                     param,
                     kind: Kind::Array(len),
                 },
-            )) => (
-                len,
-                Var::Param {
-                    param,
-                    index: i.clamp(0, u16::MAX as i64) as u16,
-                },
-            ),
-            Some((_, Binding::Element { param, len })) => (
-                len,
-                Var::Elem {
-                    param,
-                    index: i.clamp(0, u16::MAX as i64) as u16,
-                },
-            ),
+            )) => (len, Var::Param { param, index: 0 }),
+            Some((_, Binding::Element { param, len })) => (len, Var::Elem { param, index: 0 }),
             _ => {
                 return self.error(
                     ident.span(),
@@ -707,12 +750,28 @@ impl<'a> Lower<'a> {
                 );
             }
         };
-        if i < 0 || i as usize >= len {
+        let Some(at) = usize::try_from(i).ok().filter(|&at| at < len) else {
             return self.error(
                 ix.index.span(),
                 format!("index {i} out of range for `{name}`, which has {len} components"),
             );
-        }
+        };
+        // indices are stored as u32: never truncated, larger ones are an error
+        let Ok(index) = u32::try_from(at) else {
+            return self.error(
+                ix.index.span(),
+                format!(
+                    "index {i} of `{name}` is too large: indices up to {} are supported",
+                    u32::MAX
+                ),
+            );
+        };
+        let var = match var {
+            Var::Jet { order, .. } => Var::Jet { order, index },
+            Var::Param { param, .. } => Var::Param { param, index },
+            Var::Elem { param, .. } => Var::Elem { param, index },
+            other => other,
+        };
         self.g.var(var)
     }
 
@@ -810,6 +869,12 @@ impl<'a> Lower<'a> {
             match f {
                 Func::Sqrt => self.guard(GuardKind::SqrtArgument, x, x_expr),
                 Func::Ln => self.guard(GuardKind::LnArgument, x, x_expr),
+                Func::Tan => {
+                    // tan = sin / cos: singular where cos(x) = 0
+                    let cos = self.g.unary(Func::Cos, x);
+                    let text = format!("{}.cos()", atom_text(x_expr));
+                    self.guard_text(GuardKind::Denominator, cos, text);
+                }
                 _ => {}
             }
             return self.g.unary(f, x);
@@ -821,7 +886,13 @@ impl<'a> Lower<'a> {
                 self.g.div(one, x)
             }
             "powi" => match self.int(args[0]) {
-                Some(n) if i32::try_from(n).is_ok() => self.g.powi(x, n as i32),
+                Some(n) if i32::try_from(n).is_ok() => {
+                    if n < 0 {
+                        // x^-m = 1 / x^m
+                        self.guard(GuardKind::Denominator, x, x_expr);
+                    }
+                    self.g.powi(x, n as i32)
+                }
                 Some(_) => self.error(args[0].span(), "exponent out of range for powi"),
                 None => self.g.constant(0.0),
             },
@@ -834,26 +905,63 @@ impl<'a> Lower<'a> {
                          `(b * a.ln()).exp()` for a variable exponent",
                     );
                 }
-                if !matches!(self.g.as_const(e), Some(v) if v.fract() == 0.0) {
-                    self.guard(GuardKind::PowfBase, x, x_expr);
+                match self.g.as_const(e) {
+                    // an integer power: singular at 0 only when negative
+                    Some(v) if v.fract() == 0.0 => {
+                        if v < 0.0 {
+                            self.guard(GuardKind::Denominator, x, x_expr);
+                        }
+                    }
+                    _ => self.guard(GuardKind::PowfBase, x, x_expr),
                 }
                 self.g.powf(x, e)
             }
-            "atan2" => {
-                let other = self.expr(args[0]);
-                self.g.atan2(x, other)
-            }
+            // "atan2" | "hypot"
             _ => {
                 let other = self.expr(args[0]);
-                self.g.hypot(x, other)
+                // both are singular (in their derivatives) where both arguments vanish: the
+                // denominator of d atan2 and d hypot is x^2 + y^2
+                let (sx, so) = (self.g.powi(x, 2), self.g.powi(other, 2));
+                let squares = self.g.add_op(sx, so);
+                let text = format!("{}.hypot({})", atom_text(x_expr), text_of(args[0]));
+                self.guard_text(GuardKind::Denominator, squares, text);
+                if name == "atan2" {
+                    self.g.atan2(x, other)
+                } else {
+                    self.g.hypot(x, other)
+                }
             }
         }
     }
 
     /// Records `node` (written as `expr`) as a guarded expression if it depends on the jet.
     fn guard(&mut self, kind: GuardKind, node: Id, expr: &Expr) {
-        if !self.depends_on_jet(node)
-            || self.guards.iter().any(|g| g.node == node && g.kind == kind)
+        if self.depends_on_jet(node) {
+            self.guard_text(kind, node, text_of(expr));
+        }
+    }
+
+    /// Records `node` (described by `text`) and its factors as guarded expressions.
+    fn guard_text(&mut self, kind: GuardKind, node: Id, text: String) {
+        if !self.depends_on_jet(node) {
+            return;
+        }
+        self.push_guard(kind, node, text.clone(), false);
+        let factors = zero_factors(self.g, node);
+        if factors.len() <= MAX_FACTORS {
+            for f in factors {
+                if f != node && self.depends_on_jet(f) {
+                    self.push_guard(kind, f, text.clone(), true);
+                }
+            }
+        }
+    }
+
+    fn push_guard(&mut self, kind: GuardKind, node: Id, text: String, factor: bool) {
+        if self
+            .guards
+            .iter()
+            .any(|g| g.node == node && g.kind == kind && g.factor == factor)
         {
             return;
         }
@@ -862,15 +970,12 @@ impl<'a> Lower<'a> {
             .as_ref()
             .map(|s| s.param)
             .filter(|_| self.depends_on_element(node));
-        let mut expr = expr;
-        while let Expr::Paren(p) = expr {
-            expr = &p.expr;
-        }
         self.guards.push(Guard {
             kind,
             node,
-            text: crate::expand::tidy(&expr.to_token_stream().to_string()),
+            text,
             slice,
+            factor,
         });
     }
 
@@ -924,4 +1029,53 @@ fn is_const_name(name: &str) -> bool {
         && name
             .chars()
             .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// `expr` as written, without enclosing parentheses.
+fn text_of(mut expr: &Expr) -> String {
+    while let Expr::Paren(p) = expr {
+        expr = &p.expr;
+    }
+    crate::expand::tidy(&expr.to_token_stream().to_string())
+}
+
+/// `expr` as the receiver of a method call: parenthesised unless it is an atom.
+fn atom_text(expr: &Expr) -> String {
+    let text = text_of(expr);
+    match expr {
+        Expr::Path(_) | Expr::Index(_) | Expr::MethodCall(_) | Expr::Call(_) | Expr::Field(_) => {
+            text
+        }
+        Expr::Lit(_) | Expr::Paren(_) if !text.starts_with('-') => text,
+        _ => format!("({text})"),
+    }
+}
+
+/// The factors of `node` whose zeros are zeros of `node`: through products, quotients
+/// (numerators), negation, positive powers, `abs`, `sqrt` and `powf`; `hypot(a, b)` as
+/// `a^2 + b^2`; `exp` and negative powers never vanish. Anything else is its own factor.
+fn zero_factors(g: &mut Graph, node: Id) -> Vec<Id> {
+    let mut out = Vec::new();
+    let mut stack = vec![node];
+    while let Some(id) = stack.pop() {
+        if out.len() > MAX_FACTORS {
+            break;
+        }
+        match *g.node(id) {
+            Node::Mul(a, b) => stack.extend([b, a]),
+            Node::Div(a, _)
+            | Node::Neg(a)
+            | Node::Unary(Func::Abs | Func::Sqrt, a)
+            | Node::Powf(a, _) => stack.push(a),
+            Node::Powi(a, n) if n > 0 => stack.push(a),
+            Node::Powi(..) | Node::Unary(Func::Exp, _) | Node::Const(_) => {}
+            Node::Hypot(a, b) => {
+                let (sa, sb) = (g.powi(a, 2), g.powi(b, 2));
+                out.push(g.add_op(sa, sb));
+            }
+            _ => out.push(id),
+        }
+    }
+    out.dedup();
+    out
 }

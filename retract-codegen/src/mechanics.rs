@@ -50,7 +50,7 @@ pub enum Degenerate {
 fn jet(order: usize, index: usize) -> Var {
     Var::Jet {
         order: order as u8,
-        index: index as u16,
+        index: index as u32,
     }
 }
 
@@ -208,12 +208,12 @@ fn evaluation_point(g: &mut Graph, n: usize, k: usize) -> (Vec<Id>, Vec<Id>) {
     for j in 0..k {
         for i in 0..n {
             let (x0, x1) = (
-                g.var(Var::Z0((j * n + i) as u16)),
-                g.var(Var::W((j * n + i) as u16)),
+                g.var(Var::Z0((j * n + i) as u32)),
+                g.var(Var::W((j * n + i) as u32)),
             );
             let (ta, tb) = (g.mul(one_minus_theta, x0), g.mul(theta, x1));
             x_th.push(g.add_op(ta, tb));
-            let c = ((k + j) * n + i) as u16;
+            let c = ((k + j) * n + i) as u32;
             let (p0, p1) = (g.var(Var::Z0(c)), g.var(Var::W(c)));
             let (ta, tb) = (g.mul(theta, p0), g.mul(one_minus_theta, p1));
             p_th.push(g.add_op(ta, tb));
@@ -240,11 +240,11 @@ fn residual_from(
             let rate = if j + 1 < k {
                 x_th[(j + 1) * n + i]
             } else {
-                g.var(Var::W((s + i) as u16))
+                g.var(Var::W((s + i) as u32))
             };
             let (a, b) = (
-                g.var(Var::W((j * n + i) as u16)),
-                g.var(Var::Z0((j * n + i) as u16)),
+                g.var(Var::W((j * n + i) as u32)),
+                g.var(Var::Z0((j * n + i) as u32)),
             );
             let diff = g.sub(a, b);
             let hr = g.mul(h, rate);
@@ -254,7 +254,7 @@ fn residual_from(
             if j > 0 {
                 force = g.sub(force, p_th[(j - 1) * n + i]);
             }
-            let c = ((k + j) * n + i) as u16;
+            let c = ((k + j) * n + i) as u32;
             let (a, b) = (g.var(Var::W(c)), g.var(Var::Z0(c)));
             let diff = g.sub(a, b);
             let hf = g.mul(h, force);
@@ -296,10 +296,10 @@ fn jacobians(
     let mut by_z0 = Vec::with_capacity(m * s);
     for &row in f {
         for c in 0..m {
-            by_w.push(d.diff(g, row, Var::W(c as u16)));
+            by_w.push(d.diff(g, row, Var::W(c as u32)));
         }
         for c in 0..s {
-            by_z0.push(d.diff(g, row, Var::Z0(c as u16)));
+            by_z0.push(d.diff(g, row, Var::Z0(c as u32)));
         }
     }
     (by_w, by_z0)
@@ -320,7 +320,7 @@ fn scheme(
         Some(if j < k {
             x_th[j * n + i]
         } else {
-            g.var(Var::W((s + i) as u16))
+            g.var(Var::W((s + i) as u32))
         })
     };
     let g_at = gradient_at(g, gradient, &at);
@@ -479,9 +479,9 @@ pub fn reduce(
     let at = |g: &mut Graph, j: usize, i: usize| {
         let a = j * n + i;
         Some(match core.iter().position(|&c| c == a) {
-            Some(pos) => g.var(Var::Core(pos as u16)),
+            Some(pos) => g.var(Var::Core(pos as u32)),
             None if j < k => x_th[a],
-            None => g.var(Var::W((s + i) as u16)),
+            None => g.var(Var::W((s + i) as u32)),
         })
     };
     let g_at = gradient_at(g, gradient, &at);
@@ -513,7 +513,7 @@ pub fn reduce(
     let mut nonlinear_jacobian = Vec::with_capacity(rows.len() * core.len());
     for &e in &nonlinear {
         for c in 0..core.len() {
-            nonlinear_jacobian.push(d.diff(g, e, Var::Core(c as u16)));
+            nonlinear_jacobian.push(d.diff(g, e, Var::Core(c as u32)));
         }
     }
     let pattern = |entries: &[Id], cols: usize| -> Vec<Vec<bool>> {
@@ -641,7 +641,7 @@ pub fn at_step_points(g: &mut Graph, node: Id, n: usize, k: usize) -> [Id; 3] {
     let point = |which: usize| {
         move |g: &mut Graph, v: Var| match v {
             Var::Jet { order, index } if (order as usize) < k => {
-                let c = (order as usize * n + index as usize) as u16;
+                let c = (order as usize * n + index as usize) as u32;
                 Some(match which {
                     0 => g.var(Var::Z0(c)),
                     1 => g.var(Var::W(c)),
@@ -653,7 +653,7 @@ pub fn at_step_points(g: &mut Graph, node: Id, n: usize, k: usize) -> [Id; 3] {
                 })
             }
             Var::Jet { order, index } if order as usize == k => {
-                Some(g.var(Var::W((s + index as usize) as u16)))
+                Some(g.var(Var::W((s + index as usize) as u32)))
             }
             _ => None,
         }

@@ -150,8 +150,9 @@ fn kind_of(ty: &Type) -> Option<Kind> {
     }
 }
 
-/// "UpperCamelCase" of a snake_case name.
-fn camel(name: &Ident) -> Ident {
+/// "UpperCamelCase" of a snake_case name, or an error at the name when that is not an
+/// identifier of a type (`_1` gives `1`, `_2d_arm` gives `2dArm`, `self_` gives `Self`).
+fn camel(name: &Ident, attribute: Attribute) -> syn::Result<Ident> {
     let s: String = name
         .to_string()
         .trim_start_matches("r#")
@@ -166,7 +167,26 @@ fn camel(name: &Ident) -> Ident {
         })
         .collect();
     let s = if s.is_empty() { "Lagrangian".into() } else { s };
-    Ident::new(&s, name.span())
+    // syn rejects what is not an identifier and the keywords (`Self`), without panicking
+    match syn::parse_str::<Ident>(&s) {
+        Ok(ident) => Ok(Ident::new(&ident.to_string(), name.span())),
+        Err(_) => {
+            let why = if s.starts_with(|c: char| c.is_ascii_digit()) {
+                "a type name cannot start with a digit"
+            } else {
+                "it is a keyword or not an identifier"
+            };
+            Err(syn::Error::new(
+                name.span(),
+                format!(
+                    "the generated type is named after the function in UpperCamelCase, but \
+                     `{name}` gives `{s}`, which is not a valid type name ({why}); name the type \
+                     with #[{}(order = k, name = TypeName)] or rename the function",
+                    attribute.name()
+                ),
+            ))
+        }
+    }
 }
 
 /// Checks the attribute and the signature of `item` under `attribute`.
@@ -336,6 +356,13 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         })
         .collect();
 
+    let type_name = match options.name {
+        Some(name) => name,
+        None => camel(&sig.ident, attribute).unwrap_or_else(|e| {
+            errors.push(e);
+            Ident::new("Lagrangian", sig.ident.span())
+        }),
+    };
     if let Some(e) = crate::expand::combine(errors) {
         return Err(e);
     }
@@ -345,7 +372,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         scalar_jet,
         jet,
         params,
-        type_name: options.name.unwrap_or_else(|| camel(&sig.ident)),
+        type_name,
         guard: options.guard,
         attribute,
     })

@@ -18,6 +18,12 @@ use proc_macro::TokenStream;
 /// public fields of the generated type (`Obstacle`, from the function's name, or
 /// `name = ...`). The function stays callable. Options: `order = k` (1..=4, required),
 /// `name = TypeName`. See the `retract` crate docs for the generated API.
+///
+/// The type name is the function's in UpperCamelCase; where that is not a type name (`_1`,
+/// `_2d_arm`, `self_`) the macro asks for `name = ...`. Compile-time integers (indices, loop
+/// bounds, `powi` exponents) are i64 with overflow checks; indices go up to 4 294 967 295,
+/// range loops unroll at most 100 000 statements; beyond, an error at the span. Constants
+/// are folded exactly as f64 evaluates them (NaN and infinities included).
 #[proc_macro_attribute]
 pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand(attr.into(), item.into()).into()
