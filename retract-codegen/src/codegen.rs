@@ -12,7 +12,20 @@
 //! on an estimate of each value's latency), so a long chain does not wait on its slowest
 //! operand at every step: `h * (t * (y * r))` with `r = 1/s` known last becomes
 //! `(y * (h * t)) * r`. This reassociates floating-point operations, which changes results
-//! in the last bits only.
+//! in the last bits only. Each chain is collected once, from its head, and balanced with a
+//! binary heap: O(m log m) for m operands, so that a sum of 10 000 terms costs no more per
+//! term than a short one (the cost was cubic: a balancing per node of the chain, each a
+//! linear search per merge).
+//!
+//! The emitted code nests at most [`MAX_DEPTH`] + 2 levels (parentheses, operators, calls):
+//! an inlined node that would nest deeper is bound to its `let` instead, and a chain whose
+//! balanced tree would is cut into `let __cN` temporaries (which changes no operation), so
+//! that 1000 chained `let`s or a recurrence unrolled 10 000 times compile (rustc's parser
+//! overflows its stack on a few thousand nested parentheses).
+
+use std::cell::{Cell, RefCell};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -165,20 +178,28 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     let mut emitter = Emitter {
         g,
         leaves,
-        inline: &inline,
+        inline,
         reciprocal: &reciprocal,
-        latency: Vec::new(),
+        latency: vec![0; len],
+        depth: vec![0; len],
+        pending: RefCell::new(TokenStream::new()),
+        cuts: Cell::new(0),
     };
-    emitter.latency = vec![0; len];
-    for i in 0..len {
-        emitter.latency[i] = emitter.estimate(Id(i as u32));
+    // the nodes emitted at function level or in a loop (the graph holds others)
+    let mut emitted = top.clone();
+    for marks in body_of.iter().filter(|m| !m.is_empty()) {
+        for (e, &m) in emitted.iter_mut().zip(marks) {
+            *e |= m;
+        }
     }
+    emitter.plan(&emitted);
+    let emitter = emitter;
     let reference = |id: Id| emitter.reference(id, false);
-    let value = |id: Id| emitter.value(id, false);
 
     let mut stmts = TokenStream::new();
     let bind_reciprocal = |stmts: &mut TokenStream, id: Id| {
         let (r, b) = (reciprocal_name(id), reference(id));
+        stmts.extend(emitter.take_pending());
         stmts.extend(quote!(let #r: f64 = 1.0 / #b;));
     };
     for (i, _) in reciprocal.iter().enumerate().filter(|(_, r)| **r) {
@@ -190,7 +211,7 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     for i in 0..len {
         let id = Id(i as u32);
         let node = g.node(id);
-        if !top[i] || is_leaf(node) || inline[i] {
+        if !top[i] || is_leaf(node) || emitter.inline[i] {
             continue;
         }
         let t = temp(id);
@@ -202,12 +223,14 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
                 if m && !is_leaf(g.node(jd)) {
                     let tj = temp(jd);
                     let v = emitter.value(jd, true);
+                    inside.extend(emitter.take_pending());
                     inside.extend(quote!(let #tj: f64 = #v;));
                 }
             }
             let slice = leaves.slice(param);
             let element = leaves.element();
             let b = emitter.reference(body, true);
+            inside.extend(emitter.take_pending());
             stmts.extend(quote! {
                 let mut #t: f64 = 0.0;
                 for #element in #slice.iter() {
@@ -216,17 +239,17 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
                 }
             });
         } else {
-            let v = value(id);
+            let v = emitter.value(id, false);
+            stmts.extend(emitter.take_pending());
             stmts.extend(quote!(let #t: f64 = #v;));
         }
         if reciprocal[i] {
             bind_reciprocal(&mut stmts, id);
         }
     }
-    Emitted {
-        stmts,
-        exprs: roots.iter().map(|&r| reference(r)).collect(),
-    }
+    let exprs = roots.iter().map(|&r| reference(r)).collect();
+    stmts.extend(emitter.take_pending());
+    Emitted { stmts, exprs }
 }
 
 /// The temporary holding `1.0 / node`.
@@ -239,11 +262,20 @@ fn reciprocal_name(id: Id) -> TokenStream {
 struct Emitter<'a> {
     g: &'a Graph,
     leaves: &'a dyn Leaves,
-    inline: &'a [bool],
+    /// Nodes inlined into their only parent ([`Emitter::plan`] binds those that would nest
+    /// deeper than [`MAX_DEPTH`]).
+    inline: Vec<bool>,
     /// Denominators bound once as a reciprocal (function level only).
     reciprocal: &'a [bool],
     /// Estimated cycles from the function's inputs to each node's value.
     latency: Vec<u32>,
+    /// Nesting depth of each node's value as emitted (see [`MAX_DEPTH`]).
+    depth: Vec<u32>,
+    /// `let`s of the parts of long chains cut by [`Emitter::bind_deep`], to be emitted before
+    /// the statement being built.
+    pending: RefCell<TokenStream>,
+    /// Number of such `let`s so far (their names `__cN`).
+    cuts: Cell<usize>,
 }
 
 /// Latencies (cycles) of the operations on a current x86 core, for the balancing only.
@@ -251,6 +283,25 @@ const ADD: u32 = 4;
 const DIV: u32 = 14;
 const SQRT: u32 = 18;
 const CALL: u32 = 40;
+
+/// Bound on the nesting of an emitted expression, in levels: a parenthesis, an operator, a
+/// method call or a unary minus each count one (so the parentheses nest less deeply still).
+/// rustc's parser recurses once per level and overflows its stack (SIGSEGV) at a few
+/// thousand; a node whose inlined value would nest deeper is bound to a `let` instead, and a
+/// chain is cut into `let`s where its balanced tree would. Every emitted statement nests at
+/// most `MAX_DEPTH + 2` levels.
+pub(crate) const MAX_DEPTH: u32 = 64;
+
+/// Nesting of a leaf as emitted (at most `(-1.5f64)`, `(path)` or `self.c[3]`).
+const LEAF_DEPTH: u32 = 2;
+
+/// Nesting of `(a op b)` from its operands' (one level for the parentheses, one for the
+/// operator), after an operand nested more than `MAX_DEPTH - 2` levels is bound to a `let`
+/// (nesting 0): at most `MAX_DEPTH`.
+fn merged_depth(a: u32, b: u32) -> u32 {
+    let bound = |d: u32| if d > MAX_DEPTH - 2 { 0 } else { d };
+    2 + bound(a).max(bound(b))
+}
 
 /// The two operations whose chains are balanced.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -268,7 +319,45 @@ enum Operand {
     Reciprocal(Id),
 }
 
+/// A term of a chain being balanced: (negated, tokens, nesting).
+type Term = (bool, TokenStream, u32);
+
 impl Emitter<'_> {
+    /// Latencies and nesting depths of all nodes, and which inlined nodes to bind instead
+    /// because they would nest too deeply. Linear in the graph except for the chains, each
+    /// collected and balanced once, in O(m log m) for m operands.
+    fn plan(&mut self, emitted: &[bool]) {
+        let len = self.g.len();
+        // nodes inside the chain of another (an inlined operand of the same operation or a
+        // negation): their latency and depth are their chain's, computed at its head; from
+        // the parents down, so that each chain is walked once from its head
+        let mut absorbed = vec![false; len];
+        let mut ops = Vec::new();
+        for i in (0..len).rev() {
+            let id = Id(i as u32);
+            if absorbed[i] || !emitted[i] {
+                continue;
+            }
+            if let Some(kind) = self.head(id, false) {
+                ops.clear();
+                self.operands(id, kind, false, &mut ops, |c| absorbed[c.0 as usize] = true);
+            }
+        }
+        // children first; binding a node that is not absorbed changes no chain
+        for i in 0..len {
+            if absorbed[i] || !emitted[i] {
+                continue;
+            }
+            let id = Id(i as u32);
+            let (latency, depth) = self.estimate(id);
+            self.latency[i] = latency;
+            self.depth[i] = depth;
+            if self.inline[i] && depth + 1 > MAX_DEPTH {
+                self.inline[i] = false;
+            }
+        }
+    }
+
     /// The chain `id` heads, if it is a sum or a product (a function-level `Neg` heads the
     /// chain of its operand).
     fn chain(&self, id: Id, in_loop: bool) -> Option<Chain> {
@@ -280,46 +369,65 @@ impl Emitter<'_> {
         }
     }
 
-    /// The operands of the chain of `kind` at `id` with their signs (`true`: negated), through
-    /// inlined nodes of the same chain and negations; `Neg` of a node of the other kind (or a
-    /// bound one) is an operand with a sign.
+    /// The operands of the chain of `kind` at `id` with their signs (`true`: negated), left to
+    /// right, through inlined nodes of the same chain and negations (each passed to
+    /// `through`); `Neg` of a node of the other kind (or a bound one) is an operand with a
+    /// sign. Iterative: a chain may have any length.
     fn operands(
         &self,
         id: Id,
         kind: Chain,
         in_loop: bool,
-        negate: bool,
         out: &mut Vec<(Operand, bool)>,
+        mut through: impl FnMut(Id),
     ) {
-        let through = |c: Id| !in_loop && self.inline[c.0 as usize];
-        let push = |this: &Self, c: Id, negate: bool, out: &mut Vec<(Operand, bool)>| {
-            if through(c)
-                && (this.chain(c, in_loop) == Some(kind) || matches!(this.g.node(c), Node::Neg(_)))
-            {
-                this.operands(c, kind, in_loop, negate, out);
+        enum Step {
+            Walk(Id, bool),
+            Push(Operand, bool),
+        }
+        let mut step = |c: Id, negate: bool| {
+            let passes = !in_loop
+                && self.inline[c.0 as usize]
+                && (self.chain(c, in_loop) == Some(kind) || matches!(self.g.node(c), Node::Neg(_)));
+            if passes {
+                through(c);
+                Step::Walk(c, negate)
             } else {
-                out.push((Operand::Node(c), negate));
+                Step::Push(Operand::Node(c), negate)
             }
         };
-        match *self.g.node(id) {
-            Node::Neg(a) => push(self, a, !negate, out),
-            Node::Add(a, b) if kind == Chain::Sum => {
-                push(self, a, negate, out);
-                push(self, b, negate, out);
+        let mut stack = vec![Step::Walk(id, false)];
+        while let Some(next) = stack.pop() {
+            let (id, negate) = match next {
+                Step::Push(op, negate) => {
+                    count_work(1);
+                    out.push((op, negate));
+                    continue;
+                }
+                Step::Walk(id, negate) => (id, negate),
+            };
+            count_work(1);
+            // the right operand first onto the stack: the left one is walked first
+            match *self.g.node(id) {
+                Node::Neg(a) => stack.push(step(a, !negate)),
+                Node::Add(a, b) if kind == Chain::Sum => {
+                    stack.push(step(b, negate));
+                    stack.push(step(a, negate));
+                }
+                Node::Sub(a, b) if kind == Chain::Sum => {
+                    stack.push(step(b, !negate));
+                    stack.push(step(a, negate));
+                }
+                Node::Mul(a, b) if kind == Chain::Product => {
+                    stack.push(step(b, false));
+                    stack.push(step(a, negate));
+                }
+                Node::Div(a, b) if kind == Chain::Product => {
+                    stack.push(Step::Push(Operand::Reciprocal(b), false));
+                    stack.push(step(a, negate));
+                }
+                _ => out.push((Operand::Node(id), negate)),
             }
-            Node::Sub(a, b) if kind == Chain::Sum => {
-                push(self, a, negate, out);
-                push(self, b, !negate, out);
-            }
-            Node::Mul(a, b) if kind == Chain::Product => {
-                push(self, a, negate, out);
-                push(self, b, false, out);
-            }
-            Node::Div(a, b) if kind == Chain::Product => {
-                push(self, a, negate, out);
-                out.push((Operand::Reciprocal(b), false));
-            }
-            _ => out.push((Operand::Node(id), negate)),
         }
     }
 
@@ -327,6 +435,24 @@ impl Emitter<'_> {
         match op {
             Operand::Node(id) => self.latency[id.0 as usize],
             Operand::Reciprocal(id) => self.latency[id.0 as usize] + DIV,
+        }
+    }
+
+    /// Nesting of a reference to `id` (as [`Emitter::reference`] emits it).
+    fn reference_depth(&self, id: Id, in_loop: bool) -> u32 {
+        if is_leaf(self.g.node(id)) {
+            LEAF_DEPTH
+        } else if !in_loop && self.inline[id.0 as usize] {
+            self.depth[id.0 as usize] + 1
+        } else {
+            0
+        }
+    }
+
+    fn operand_depth(&self, op: Operand, in_loop: bool) -> u32 {
+        match op {
+            Operand::Node(id) => self.reference_depth(id, in_loop),
+            Operand::Reciprocal(_) => 0,
         }
     }
 
@@ -338,42 +464,86 @@ impl Emitter<'_> {
         }
     }
 
-    /// Latency of `id` as emitted (function level), from its children's.
-    fn estimate(&self, id: Id) -> u32 {
-        let l = |c: Id| self.latency[c.0 as usize];
+    /// Latency and nesting of `id` as emitted (function level), from its children's.
+    fn estimate(&self, id: Id) -> (u32, u32) {
         if let Some(kind) = self.head(id, false) {
             let mut ops = Vec::new();
-            self.operands(id, kind, false, false, &mut ops);
-            let latencies = ops.iter().map(|&(op, _)| ((), self.operand_latency(op)));
-            return earliest_first(latencies.collect(), |(), ()| ()).map_or(0, |(_, l)| l);
+            self.operands(id, kind, false, &mut ops, |_| {});
+            let terms = ops
+                .iter()
+                .map(|&(op, negate)| {
+                    (
+                        (negate, self.operand_depth(op, false)),
+                        self.operand_latency(op),
+                    )
+                })
+                .collect();
+            let merge = |(na, da): (bool, u32), (nb, db): (bool, u32)| match kind {
+                Chain::Product => (na ^ nb, merged_depth(da, db)),
+                Chain::Sum => (na && nb, merged_depth(da, db)),
+            };
+            return match earliest_first(terms, merge) {
+                None => (0, LEAF_DEPTH),
+                Some(((negated, depth), latency)) => (latency, depth + u32::from(negated)),
+            };
         }
-        match *self.g.node(id) {
-            Node::Const(_) | Node::Var(_) | Node::Named(_) => 0,
-            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => l(a).max(l(b)) + ADD,
-            Node::Div(a, b) => l(a).max(l(b)) + DIV,
-            Node::Neg(a) => l(a) + 1,
-            Node::Powi(a, n) => l(a) + ADD * (32 - n.unsigned_abs().leading_zeros()).max(1),
-            Node::Unary(Func::Sqrt, a) => l(a) + SQRT,
-            Node::Unary(Func::Abs | Func::Signum, a) => l(a) + 1,
-            Node::Unary(_, a) => l(a) + CALL,
-            Node::Powf(a, b) | Node::Atan2(a, b) | Node::Hypot(a, b) => l(a).max(l(b)) + CALL,
-            Node::Sum { .. } => CALL,
+        let l = |c: Id| self.latency[c.0 as usize];
+        let d = |c: Id| self.reference_depth(c, false);
+        // an operator, or a method call with its argument in parentheses
+        let (latency, depth) = match *self.g.node(id) {
+            Node::Const(_) | Node::Var(_) | Node::Named(_) => (0, LEAF_DEPTH),
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => {
+                (l(a).max(l(b)) + ADD, d(a).max(d(b)))
+            }
+            Node::Div(a, b) => (l(a).max(l(b)) + DIV, d(a).max(d(b))),
+            Node::Neg(a) => (l(a) + 1, d(a)),
+            Node::Powi(a, n) => {
+                let squarings = (32 - n.unsigned_abs().leading_zeros()).max(1);
+                (l(a) + ADD * squarings, d(a))
+            }
+            Node::Unary(Func::Sqrt, a) => (l(a) + SQRT, d(a)),
+            Node::Unary(Func::Abs | Func::Signum, a) => (l(a) + 1, d(a)),
+            Node::Unary(_, a) => (l(a) + CALL, d(a)),
+            Node::Powf(a, b) | Node::Atan2(a, b) | Node::Hypot(a, b) => {
+                (l(a).max(l(b)) + CALL, d(a).max(d(b)))
+            }
+            Node::Sum { .. } => (CALL, 0),
+        };
+        (latency, depth + 2)
+    }
+
+    /// Binds a term nested more deeply than a merge allows (see [`merged_depth`]) to a `let`.
+    fn bind_deep(&self, (negated, tokens, depth): Term) -> Term {
+        if depth <= MAX_DEPTH - 2 {
+            return (negated, tokens, depth);
         }
+        let n = self.cuts.get();
+        self.cuts.set(n + 1);
+        let name = format_ident!("__c{}", n);
+        self.pending
+            .borrow_mut()
+            .extend(quote!(let #name: f64 = #tokens;));
+        (negated, quote!(#name), 0)
+    }
+
+    /// The `let`s made by [`Emitter::bind_deep`] since the last call.
+    fn take_pending(&self) -> TokenStream {
+        std::mem::take(&mut *self.pending.borrow_mut())
     }
 
     /// A chain as a balanced tree: repeatedly combines the two operands available first.
     fn balanced(&self, id: Id, kind: Chain, in_loop: bool) -> TokenStream {
         let mut ops = Vec::new();
-        self.operands(id, kind, in_loop, false, &mut ops);
-        // ((negated, tokens), latency)
-        let mut terms: Vec<((bool, TokenStream), u32)> = ops
+        self.operands(id, kind, in_loop, &mut ops, |_| {});
+        let mut terms: Vec<(Term, u32)> = ops
             .iter()
             .map(|&(op, negate)| {
                 let tokens = match op {
                     Operand::Node(c) => self.reference(c, in_loop),
                     Operand::Reciprocal(b) => reciprocal_name(b),
                 };
-                ((negate, tokens), self.operand_latency(op))
+                let depth = self.operand_depth(op, in_loop);
+                ((negate, tokens, depth), self.operand_latency(op))
             })
             .collect();
         if kind == Chain::Product {
@@ -383,17 +553,21 @@ impl Emitter<'_> {
                 t.0.0 = i == 0 && negate;
             }
         }
-        let combined = earliest_first(terms, |a, b| match kind {
-            Chain::Product => {
-                let ((na, a), (nb, b)) = (a, b);
-                (na ^ nb, quote!((#a * #b)))
+        let combined = earliest_first(terms, |a, b| {
+            let ((na, a, da), (nb, b, db)) = (self.bind_deep(a), self.bind_deep(b));
+            let depth = merged_depth(da, db);
+            match kind {
+                Chain::Product => (na ^ nb, quote!((#a * #b)), depth),
+                Chain::Sum => {
+                    let (negated, tokens) = signed_add((na, a), (nb, b));
+                    (negated, tokens, depth)
+                }
             }
-            Chain::Sum => signed_add(a, b),
         });
         match combined {
             None => quote!(0.0),
-            Some(((false, tokens), _)) => tokens,
-            Some(((true, tokens), _)) => quote!(-#tokens),
+            Some(((false, tokens, _), _)) => tokens,
+            Some(((true, tokens, _), _)) => quote!(-#tokens),
         }
     }
 
@@ -460,23 +634,47 @@ impl Emitter<'_> {
 }
 
 /// Combines `terms` (each with the latency at which it is known) into one, repeatedly merging
-/// the two known first (the earlier position on ties) into a term known `ADD` later: the
-/// balanced tree of least latency. `None` for no terms.
-fn earliest_first<T>(
-    mut terms: Vec<(T, u32)>,
-    mut merge: impl FnMut(T, T) -> T,
-) -> Option<(T, u32)> {
-    let take = |terms: &mut Vec<(T, u32)>| {
-        let at = (0..terms.len()).min_by_key(|&i| (terms[i].1, i))?;
-        Some(terms.remove(at))
-    };
-    while terms.len() > 1 {
-        let (a, la) = take(&mut terms)?;
-        let (b, lb) = take(&mut terms)?;
-        terms.push((merge(a, b), la.max(lb) + ADD));
+/// the two known first (the earlier inserted on ties, merged terms inserted last) into a term
+/// known `ADD` later: the balanced tree of least latency. `None` for no terms. A binary heap:
+/// O(m log m) for m terms.
+fn earliest_first<T>(terms: Vec<(T, u32)>, mut merge: impl FnMut(T, T) -> T) -> Option<(T, u32)> {
+    type Heap = BinaryHeap<Reverse<(u32, usize)>>;
+    fn take<T>(heap: &mut Heap, slots: &mut [Option<T>]) -> Option<(T, u32)> {
+        count_work(1 + heap.len().max(1).ilog2() as usize);
+        let Reverse((latency, slot)) = heap.pop()?;
+        Some((slots[slot].take()?, latency))
     }
-    terms.pop()
+    let mut slots: Vec<Option<T>> = Vec::with_capacity(2 * terms.len());
+    let mut heap = Heap::with_capacity(terms.len());
+    count_work(terms.len());
+    for (term, latency) in terms {
+        heap.push(Reverse((latency, slots.len())));
+        slots.push(Some(term));
+    }
+    while heap.len() > 1 {
+        let (a, la) = take(&mut heap, &mut slots)?;
+        let (b, lb) = take(&mut heap, &mut slots)?;
+        count_work(1 + heap.len().max(1).ilog2() as usize);
+        heap.push(Reverse((la.max(lb) + ADD, slots.len())));
+        slots.push(Some(merge(a, b)));
+    }
+    take(&mut heap, &mut slots)
 }
+
+#[cfg(test)]
+thread_local! {
+    /// Work of the chains on this thread: operands walked and heap operations (each counted
+    /// 1 + log2 of the heap's size), for the tests' bounds on the expansion's cost.
+    static WORK: Cell<usize> = const { Cell::new(0) };
+}
+
+#[cfg(test)]
+fn count_work(n: usize) {
+    WORK.with(|w| w.set(w.get() + n));
+}
+
+#[cfg(not(test))]
+fn count_work(_: usize) {}
 
 /// `a + b` for terms `(negated, tokens)`, as `(negated, tokens)` with no negation inside.
 pub(crate) fn signed_add(
@@ -681,6 +879,91 @@ mod tests {
             Node::Powi(a, n) => m(a).powi(n),
             _ => direct(g, id, x).abs(),
         }
+    }
+
+    /// Nesting of parentheses in `tokens`.
+    fn paren_depth(tokens: &TokenStream) -> usize {
+        tokens
+            .clone()
+            .into_iter()
+            .map(|tree| match tree {
+                proc_macro2::TokenTree::Group(g) => {
+                    usize::from(g.delimiter() == proc_macro2::Delimiter::Parenthesis)
+                        + paren_depth(&g.stream())
+                }
+                _ => 0,
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Sum of `m` terms `x_(i mod 4) * c_i` (the constants distinct, so that the products
+    /// are), and the work its emission counts.
+    fn long_sum_work(m: usize) -> usize {
+        let mut g = Graph::default();
+        let x: Vec<Id> = (0..4).map(|i| g.var(Var::Z0(i))).collect();
+        let mut sum = g.constant(0.5);
+        for i in 0..m {
+            let c = g.constant(1.0 + i as f64);
+            let term = g.mul(x[i % 4], c);
+            sum = g.add_op(sum, term);
+        }
+        WORK.with(|w| w.set(0));
+        let code = emit(&g, &[sum], &Names);
+        assert!(paren_depth(&code.stmts) <= MAX_DEPTH as usize + 2);
+        WORK.with(|w| w.get())
+    }
+
+    /// Issue 14, item 5: each chain is collected once and balanced with a heap, so the work
+    /// of a sum of m terms is O(m log m) (it was O(m^3): a balancing at every node of the
+    /// chain, each with a linear search per merge, about 1.7e11 steps at m = 10 000).
+    #[test]
+    fn item_5_chains_cost_m_log_m_work() {
+        for m in [10, 100, 1000, 10_000] {
+            let work = long_sum_work(m);
+            let bound = 24 * m * (m.ilog2() as usize + 1);
+            assert!(work <= bound, "m = {m}: work {work} > {bound}");
+        }
+        // and grows quasi-linearly: 10x the terms, at most 15x the work
+        let (small, large) = (long_sum_work(1000), long_sum_work(10_000));
+        assert!(large <= 15 * small, "{small} -> {large}");
+    }
+
+    /// Issue 14, item 6: a recurrence x <- x * y + 1 through 5000 inlined nodes, or a chain
+    /// whose balanced tree is a path (operands known ever later), is emitted nesting at most
+    /// `MAX_DEPTH + 2` levels, and computes the same values.
+    #[test]
+    fn item_6_deep_graphs_are_emitted_with_bounded_nesting() {
+        let mut g = Graph::default();
+        let (y, z) = (g.var(Var::Z0(0)), g.var(Var::Z0(1)));
+        let one = g.constant(1.0);
+        let mut x = z;
+        for _ in 0..5000 {
+            let p = g.mul(x, y);
+            x = g.add_op(p, one);
+        }
+        // a sum whose operands come ever later: sqrt(z), sqrt(sqrt(z)), ...
+        let mut late = z;
+        let mut path = g.constant(0.25);
+        for _ in 0..300 {
+            late = g.unary(Func::Sqrt, late);
+            path = g.add_op(path, late);
+        }
+        let roots = [x, path];
+        let code = emit(&g, &roots, &Names);
+        let depth = paren_depth(&code.stmts);
+        assert!(depth <= MAX_DEPTH as usize + 2, "nesting {depth}");
+        let at = [0.5, 1.5];
+        let got = emitted(&g, &roots, &at);
+        // x_m = 2 - 0.5^m (1.5 - ... ) converges to 1 / (1 - y) = 2
+        assert!((got[0] - 2.0).abs() < 1e-12, "{}", got[0]);
+        let mut want = 0.25;
+        let mut s = at[1];
+        for _ in 0..300 {
+            s = s.sqrt();
+            want += s;
+        }
+        assert!((got[1] - want).abs() < 1e-12 * want, "{} vs {want}", got[1]);
     }
 
     proptest! {

@@ -36,18 +36,53 @@ pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
 
 /// The expansion, or the errors of the input combined into one `syn::Error`.
 pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
+    expand_counted(attr, item, &mut ExpansionStats::default())
+}
+
+/// The work of one expansion, counted in expression-graph nodes (deterministic, unlike wall
+/// time): for tests that bound the work (the grammar fuzzer) and for benchmarks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExpansionStats {
+    /// Nodes after lowering the body (the Lagrangian itself); 0 if the signature failed.
+    pub lowered_nodes: usize,
+    /// Nodes at the end (with the derivatives, the scheme and the guards at the step points).
+    pub graph_nodes: usize,
+    /// Guarded expressions (`check_domain`), factors included.
+    pub guards: usize,
+}
+
+/// [`try_expand`] and the work it took (also when it failed).
+pub fn expansion_stats(
+    attr: TokenStream,
+    item: TokenStream,
+) -> (syn::Result<TokenStream>, ExpansionStats) {
+    let mut stats = ExpansionStats::default();
+    let result = expand_counted(attr, item, &mut stats);
+    (result, stats)
+}
+
+fn expand_counted(
+    attr: TokenStream,
+    item: TokenStream,
+    stats: &mut ExpansionStats,
+) -> syn::Result<TokenStream> {
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;
     let mut graph = Graph::default();
     let (root, guards) = {
         let mut lower = Lower::new(&mut graph, &sig);
         let root = lower.body(&function.block);
+        stats.lowered_nodes = lower.g.len();
+        stats.graph_nodes = lower.g.len();
+        stats.guards = lower.guards.len();
         if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
             return Err(e);
         }
         (root, std::mem::take(&mut lower.guards))
     };
-    let mech = mechanics::build(&mut graph, root, sig.dim, sig.order).map_err(|reason| {
+    let mech = mechanics::build(&mut graph, root, sig.dim, sig.order);
+    stats.graph_nodes = graph.len();
+    let mech = mech.map_err(|reason| {
         let top = &sig.jet[sig.order];
         let msg = match reason {
             Degenerate::Independent => format!(
@@ -81,6 +116,7 @@ pub fn try_expand(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStre
     };
     let flat: Vec<Vec<Id>> = mech.hessian.clone();
     let reduced = mechanics::reduce(&mut graph, &mech.gradient, &flat, sig.dim, sig.order);
+    stats.graph_nodes = graph.len();
     Ok(generate(
         &function,
         &sig,
@@ -114,34 +150,43 @@ fn sum_tree(terms: &[(bool, TokenStream)]) -> Option<(bool, TokenStream)> {
     ))
 }
 
-/// The relative distance from zero below which a guarded expression counts as vanished.
+/// The relative distance from zero below which a guarded factor counts as vanished.
 const VANISH_TOLERANCE: f64 = 1e-9;
+/// The rounding error of the fitted minimum, relative to the largest sample, over
+/// `min(theta, 1 - theta)`: below it the fit cannot resolve anything.
+const FIT_NOISE: f64 = 1e-13;
 
-/// The "vanishes" rule of `check_domain`, emitted once as a local function: whether the
-/// quadratic through the samples `(0, a)`, `(theta, c)`, `(1, b)` (exact for an expression
-/// quadratic along the chord, such as `x^2 + y^2 - r^2` or `|q'|^2`) stays above
-/// `VANISH_TOLERANCE` times the largest sample in magnitude on `[0, 1]`, on the side of zero
-/// of the samples. For `theta` within `1e-3` of an end the fit is ill-conditioned and only
-/// the samples are compared.
+/// The "vanishes" rule of `check_domain`, emitted once as a local function: where the
+/// quadratic through the samples `(0, a)`, `(theta, c)`, `(1, b)` (of one sign, by the sign
+/// rule) has its extremum towards zero inside the step, it must stay more than
+/// `VANISH_TOLERANCE` times the largest sample away from zero. The fit is exact for a factor
+/// quadratic along the step (`x^2 + y^2 - r^2`, `|q'|^2`, `x^2 + y^2` of `atan2` and
+/// `hypot`), so a step that passes through such a zero between the samples is caught. It is
+/// skipped (only the sign rule applies) for `theta` within `1e-3` of an end and when the
+/// smallest sample is below the fit's rounding error (a factor growing by 13 orders of
+/// magnitude within one step), where it cannot resolve a zero.
 fn clear_of_zero_fn() -> TokenStream {
     let tol = Literal::f64_suffixed(VANISH_TOLERANCE);
+    let noise = Literal::f64_suffixed(FIT_NOISE);
     quote! {
         #[inline(always)]
+        #[allow(dead_code)]
         fn __clear_of_zero(a: f64, b: f64, c: f64, theta: f64) -> bool {
+            if !(theta > 1e-3 && theta < 1.0 - 1e-3) {
+                return true;
+            }
             let sign = if a < 0.0 { -1.0 } else { 1.0 };
             let (a, b, c) = (sign * a, sign * b, sign * c);
             let scale = a.max(b).max(c);
-            let mut low = a.min(b).min(c);
-            if theta > 1e-3 && theta < 1.0 - 1e-3 {
-                // p(s) = a + beta s + alpha s^2 through the three samples
-                let alpha = ((c - a) - theta * (b - a)) / (theta * theta - theta);
-                let beta = (b - a) - alpha;
-                let vertex = -beta / (2.0 * alpha);
-                if alpha > 0.0 && vertex > 0.0 && vertex < 1.0 {
-                    low = low.min(a + 0.5 * beta * vertex);
-                }
+            if a.min(b).min(c) <= #noise * scale / theta.min(1.0 - theta) {
+                return true;
             }
-            low > #tol * scale
+            // p(s) = a + beta s + alpha s^2 through the three samples
+            let alpha = ((c - a) - theta * (b - a)) / (theta * theta - theta);
+            let beta = (b - a) - alpha;
+            let vertex = -beta / (2.0 * alpha);
+            !(alpha > 0.0 && vertex > 0.0 && vertex < 1.0)
+                || a + 0.5 * beta * vertex > #tol * scale
         }
     }
 }
@@ -183,8 +228,13 @@ fn domain_check(
             GuardKind::LnArgument => quote!(LnArgument),
             GuardKind::PowfBase => quote!(PowfBase),
         };
+        let condition = if guard.touch {
+            quote!((#condition) && __clear_of_zero(#a, #b, #c, theta))
+        } else {
+            condition
+        };
         quote! {
-            if !((#condition) && __clear_of_zero(#a, #b, #c, theta)) {
+            if !(#condition) {
                 return ::core::result::Result::Err(#core::DomainViolation {
                     expression: #text,
                     kind: #core::DomainKind::#kind,

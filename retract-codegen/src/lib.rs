@@ -22,5 +22,5 @@ mod signature;
 
 pub mod samples;
 
-pub use expand::{expand, try_expand};
+pub use expand::{ExpansionStats, expand, expansion_stats, try_expand};
 pub use jet_function::{expand_jet_function, try_expand_jet_function};

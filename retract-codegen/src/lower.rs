@@ -28,7 +28,7 @@ pub const METHODS: &str =
     "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, abs";
 
 /// Unrolled iterations allowed in one function (a guard against runaway expansion).
-const MAX_UNROLLED: usize = 100_000;
+const MAX_UNROLLED: usize = 10_000;
 
 #[derive(Clone, Copy, Debug)]
 enum Binding {
@@ -51,6 +51,22 @@ enum Binding {
 }
 
 /// What a guarded expression must satisfy along a trajectory.
+///
+/// The singular operations the macro accepts, and what is guarded for each:
+/// - `a / b`, `a /= b`, `b.recip()`, `b.powi(-m)`, `b.powf(-m)` (a negative integer
+///   exponent): the denominator `b` ([`GuardKind::Denominator`]);
+/// - `x.tan()`: `x.cos()` as a denominator;
+/// - `y.atan2(x)` and `x.hypot(y)` (singular derivatives where both arguments vanish): `x^2 +
+///   y^2` as a denominator, reported as `x.hypot(y)`;
+/// - `x.ln()`: `x > 0`; `x.powf(e)` with `e` not an integer constant: `x > 0`; `x.sqrt()`:
+///   `x >= 0`.
+///
+/// `exp`, `sin`, `cos`, `tanh`, `powi` and `powf` with a non-negative integer exponent are
+/// entire; `abs` is a kink (its derivative is bounded), not a singularity, and is not guarded.
+/// Each guarded expression is also split into the factors whose zeros are its zeros
+/// (`zero_factors`: the base of an even power, the arguments of `abs` and `sqrt`, the factors
+/// of a product); those must keep their sign and not vanish, so that `1 / q'^2` is caught
+/// where `q'` changes sign although `q'^2` does not.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GuardKind {
     /// A denominator: must keep its sign and not vanish.
@@ -77,6 +93,11 @@ pub struct Guard {
     /// does not vanish), since the guarded expression vanishes where it does, even when the
     /// expression itself does not change sign. Reported under `kind` and `text`.
     pub factor: bool,
+    /// Whether the "vanishes" rule (the quadratic through the three samples stays clear of
+    /// zero) applies: to the irreducible factors only, which are usually linear or quadratic
+    /// along a step, where the quadratic is exact (a product such as `q^3` would be fitted
+    /// badly, its factor `q` exactly).
+    pub touch: bool,
 }
 
 /// At most this many factors of one guarded expression are guarded separately.
@@ -946,18 +967,27 @@ impl<'a> Lower<'a> {
         if !self.depends_on_jet(node) {
             return;
         }
-        self.push_guard(kind, node, text.clone(), false);
         let factors = zero_factors(self.g, node);
-        if factors.len() <= MAX_FACTORS {
-            for f in factors {
-                if f != node && self.depends_on_jet(f) {
-                    self.push_guard(kind, f, text.clone(), true);
-                }
+        if factors.len() > MAX_FACTORS || factors == [node] {
+            self.push_guard(kind, node, text, (false, true));
+            return;
+        }
+        self.push_guard(kind, node, text.clone(), (false, false));
+        for f in factors {
+            if self.depends_on_jet(f) {
+                self.push_guard(kind, f, text.clone(), (true, true));
             }
         }
     }
 
-    fn push_guard(&mut self, kind: GuardKind, node: Id, text: String, factor: bool) {
+    /// Records one guarded node; `(factor, touch)` as in [`Guard`].
+    fn push_guard(
+        &mut self,
+        kind: GuardKind,
+        node: Id,
+        text: String,
+        (factor, touch): (bool, bool),
+    ) {
         if self
             .guards
             .iter()
@@ -976,6 +1006,7 @@ impl<'a> Lower<'a> {
             text,
             slice,
             factor,
+            touch,
         });
     }
 

@@ -1,0 +1,171 @@
+//! Regression tests of issue 14, items 5, 6 and 8, at the level of the expansion: long sums
+//! expand in quasi-linear time, deep inputs expand to code of bounded nesting, and inputs
+//! beyond the documented limits are errors at their span, never an abort. (The work of the
+//! chains is counted in `codegen`'s unit tests; a deep case is compiled in the workspace's
+//! `tests/item_6_deep_nesting.rs`.)
+
+use std::time::{Duration, Instant};
+
+use proc_macro2::{Delimiter, TokenStream, TokenTree};
+use retract_codegen::try_expand;
+
+/// The expansion, or the error messages joined.
+fn expand(attr: &str, item: &str) -> Result<TokenStream, String> {
+    let attr: TokenStream = attr.parse().expect("attribute tokens");
+    let item: TokenStream = item.parse().expect("item tokens");
+    try_expand(attr, item).map_err(|e| {
+        e.into_iter()
+            .map(|e| e.to_string())
+            .collect::<Vec<_>>()
+            .join("\n")
+    })
+}
+
+/// Runs `f` on a thread with rustc's 8 MB stack (proc macros run on rustc's main thread; a
+/// test thread has 2 MB).
+fn on_rustc_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    std::thread::Builder::new()
+        .stack_size(8 << 20)
+        .spawn(f)
+        .expect("thread")
+        .join()
+        .expect("no panic")
+}
+
+/// Deepest nesting of parentheses in `tokens` (iterative: the input may nest deeply).
+fn paren_depth(tokens: TokenStream) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(tokens, 0)];
+    while let Some((tokens, depth)) = stack.pop() {
+        deepest = deepest.max(depth);
+        for tree in tokens {
+            if let TokenTree::Group(g) = tree {
+                let inner = depth + usize::from(g.delimiter() == Delimiter::Parenthesis);
+                stack.push((g.stream(), inner));
+            }
+        }
+    }
+    deepest
+}
+
+/// An order-1 Lagrangian on R with `body` before `0.5 * dq * dq + tail`.
+fn scalar(params: &str, body: &str, tail: &str) -> String {
+    format!("fn l(q: f64, dq: f64{params}) -> f64 {{ {body} 0.5 * dq * dq + {tail} }}")
+}
+
+#[test]
+fn item_5_long_sums_expand_in_quasi_linear_time() {
+    // a sum of m terms (and its gradient and Hessian, sums of m terms too); the balancing of
+    // each chain was cubic in m: 1000 terms took about a minute, 10 000 would take hours
+    let time = |m: usize| {
+        let body = format!("let mut acc = 0.0; for i in 0..{m} {{ acc += c[i] * q * q; }}");
+        let item = scalar(&format!(", c: [f64; {m}]"), &body, "acc");
+        let start = Instant::now();
+        let out = expand("order = 1", &item).expect("expands");
+        let elapsed = start.elapsed();
+        assert!(paren_depth(out) <= 66, "m = {m}");
+        elapsed
+    };
+    let small = (0..3).map(|_| time(1000)).min().unwrap_or_default();
+    let large = time(10_000);
+    eprintln!("1000 terms: {small:?}, 10 000 terms: {large:?}");
+    // generous: 10 000 terms take about 1 s in a release build
+    assert!(large < Duration::from_secs(60), "10 000 terms: {large:?}");
+    // 10x the terms: about 10x the time (m log m); cubic would be 1000x, quadratic 100x
+    assert!(
+        large < 40 * small + Duration::from_millis(500),
+        "{small:?} -> {large:?}"
+    );
+}
+
+#[test]
+fn item_6_deep_lets_and_long_recurrences_nest_boundedly() {
+    // 1000 chained `let`s, each a few operations on the last: the value of the last inlined
+    // into one expression nested about 4 parentheses per `let`, which overflowed rustc's stack
+    let mut body = String::from("let a0 = q;");
+    for i in 1..=1000 {
+        body += &format!("let a{i} = a{} * 0.5 + q.sin() * 0.25;", i - 1);
+    }
+    let lets = scalar("", &body, "a1000 * a1000");
+    // the same as an unrolled loop, 10 000 iterations
+    let looped = scalar(
+        "",
+        "let mut x = q; for _ in 0..10000 { x = x * 0.999 + 0.001 * q.sin(); }",
+        "x * x",
+    );
+    for (name, item) in [("lets", lets), ("loop", looped)] {
+        let depth = on_rustc_stack(move || {
+            let out = expand("order = 1", &item).expect("expands");
+            paren_depth(out)
+        });
+        // at most MAX_DEPTH + 2 = 66 levels, of which some are not parentheses
+        assert!(depth <= 66, "{name}: nesting {depth}");
+    }
+}
+
+/// The error of an expansion that must fail.
+fn error(attr: &str, item: &str) -> String {
+    match expand(attr, item) {
+        Ok(_) => panic!("expanded: {item}"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn item_8_sizes_beyond_the_limits_are_errors() {
+    let jet = |k: usize, n: &str| {
+        let args: Vec<String> = (0..=k).map(|o| format!("d{o}: [f64; {n}]")).collect();
+        format!(
+            "fn l({}) -> f64 {{ 0.5 * d{k}[0] * d{k}[0] }}",
+            args.join(", ")
+        )
+    };
+    // dimension: n k <= 64; n = 100 000 aborted with `capacity overflow` / out of memory
+    for (k, n) in [
+        (1, "65"),
+        (2, "33"),
+        (3, "22"),
+        (4, "17"),
+        (1, "100000"),
+        (4, "18446744073709551615"),
+    ] {
+        let e = on_rustc_stack(move || error(&format!("order = {k}"), &jet(k, n)));
+        assert!(
+            e.contains("dimension too large") && e.contains("n k = 64"),
+            "k = {k}, n = {n}: {e}"
+        );
+    }
+    // at the limit, no such error (n = 16 at order 4: 64 unknowns)
+    let within = expand("order = 4", &jet(4, "16"));
+    assert!(
+        within
+            .as_ref()
+            .err()
+            .is_none_or(|e| !e.contains("dimension")),
+        "{within:?}"
+    );
+    // array lengths of parameters and of list elements: at most u32::MAX, whose indices fit
+    for ty in ["[f64; 4294967296]", "&[[f64; 4294967296]]"] {
+        let e = error("order = 1", &scalar(&format!(", c: {ty}"), "", "q"));
+        assert!(
+            e.contains("exceeds the supported maximum of 4294967295"),
+            "{e}"
+        );
+    }
+    let longest = expand(
+        "order = 1",
+        &scalar(", c: [f64; 4294967295]", "", "c[4294967294] * q"),
+    );
+    assert!(longest.is_ok(), "{longest:?}");
+    // unrolled counts: a documented maximum of statements; beyond, an error, also where the
+    // count overflows usize
+    for loops in [
+        "for i in 0..1000000000 { acc += q; }",
+        "for i in 0..4000000000 { for j in 0..4000000000 { for k in 0..4000000000 { acc += q; } } }",
+        "for i in 0..1000 { for j in 0..1000 { acc += q; } }",
+    ] {
+        let item = scalar("", &format!("let mut acc = 0.0; {loops}"), "acc");
+        let e = on_rustc_stack(move || error("order = 1", &item));
+        assert!(e.contains("loop too long to unroll"), "{e}");
+    }
+}
