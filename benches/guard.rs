@@ -1,5 +1,8 @@
 //! Cost of the singularity guard on the paper's run: 400 midpoint steps of h = 0.01 on the
-//! SE(2) obstacle system (tau = 1e-2), with the domain check on and off.
+//! SE(2) obstacle system (tau = 1e-2), with the domain check on and off; and one check at the
+//! paper's closest approach: the three points, the step's check with the chord rule (a step of
+//! h = 0.01 is shorter than the default spacing 0.02: no pieces), and the chord of a long step
+//! (h = 0.1, 16 pieces at a spacing of 0.005).
 //! Run: `cargo bench --bench guard`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -41,6 +44,36 @@ fn guard(c: &mut Criterion) {
     });
     group.bench_function("check_domain", |b| {
         b.iter(|| system.check_domain(std::hint::black_box(&z), std::hint::black_box(&w), 0.5))
+    });
+    let checked = StepOptions::default();
+    group.bench_function("check_step_domain_short", |b| {
+        b.iter(|| {
+            retract::step::check_step_domain(
+                &system,
+                std::hint::black_box(&z),
+                std::hint::black_box(&w),
+                &checked,
+            )
+        })
+    });
+    let long = system.predictor(&z, 0.1, 0.5).expect("regular");
+    let (long, _) = retract::step::solve_step(&system, &z, long, 0.1, &options).expect("regular");
+    let fine = StepOptions::default().with_chord_check(0.005, 16);
+    let length = (0..6).map(|i| (long[i] - z[i]).abs()).fold(0.0, f64::max);
+    assert!(
+        length > 16.0 * 0.005,
+        "the long step must be cut into 16 pieces"
+    );
+    retract::step::check_step_domain(&system, &z, &long, &fine).expect("clear of the disc");
+    group.bench_function("check_step_domain_16_pieces", |b| {
+        b.iter(|| {
+            retract::step::check_step_domain(
+                &system,
+                std::hint::black_box(&z),
+                std::hint::black_box(&long),
+                &fine,
+            )
+        })
     });
     group.finish();
 }

@@ -613,7 +613,7 @@ where
             });
         }
         if options.check_domain {
-            system.check_domain(z0, &w, theta).map_err(Error::Domain)?;
+            crate::step::check_step_domain(system, z0, &w, options).map_err(Error::Domain)?;
         }
         Ok((
             w.fixed_rows::<S>(0).into_owned(),

@@ -19,8 +19,33 @@ pub struct StepOptions {
     /// Options of the Newton solve.
     pub newton: NewtonOptions,
     /// Check every step against the domain of the Lagrangian
-    /// ([`LiftedSystem::check_domain`]); on by default.
+    /// ([`LiftedSystem::check_domain`]) at $x_0$, $x_\theta$, $x_1$ and along the chord as
+    /// [`Self::chord_spacing`] says; on by default.
     pub check_domain: bool,
+    /// Longest piece of the chord $x(s) = (1-s) x_0 + s x_1$, $s \in [0, 1]$, of a step that
+    /// the domain check treats as a whole, in the max-norm of the jet $x$ (all of
+    /// $x_0, \dots, x_{k-1}$, in the units of the state); $0.02$ by default, `f64::INFINITY`
+    /// checks only the three points of [`LiftedSystem::check_domain`]. With
+    /// [`Self::check_domain`] on, a step whose chord has max-norm length
+    /// $\ell = |x_1 - x_0|_\infty$ above the spacing is cut into
+    /// $m = \min(\lceil \ell / \text{spacing} \rceil,$ [`Self::max_chord_pieces`]$)$ equal
+    /// pieces, and each piece is checked like a step of its own (at its two ends and its
+    /// midpoint, with the top derivative $u$ of the step), after the step itself.
+    ///
+    /// What this guarantees, and what not: the checked points are at most
+    /// $\ell / (2m)$ apart along the chord (max-norm): at most half the spacing, or
+    /// $\ell / (2\,\text{max\_chord\_pieces})$ when the cap binds. A guarded expression
+    /// that leaves its domain on a piece of the chord longer than that is reported. A
+    /// violation on a shorter piece (an obstacle thinner than that, or a chord grazing a
+    /// region) can still be missed: sampling is not a proof. The chord is the straight segment
+    /// between the step's end points; the scheme evaluates $L$ only at $x_\theta$, and the
+    /// continuous motion between $x_0$ and $x_1$ is not checked. A step shorter than the
+    /// spacing (the common case for small $h$) costs one max-norm of $x_1 - x_0$ beyond the
+    /// three points; a longer one about one more `check_domain` per piece.
+    pub chord_spacing: f64,
+    /// The most pieces a step's chord is cut into (see [`Self::chord_spacing`]); 16 by
+    /// default, at most [`MAX_CHORD_PIECES`]; 0 or 1 check only the three points.
+    pub max_chord_pieces: u32,
     /// When a trajectory stops at a domain violation, bisect the step size to locate the
     /// crossing time ([`Interrupted::crossing_time`]); off by default.
     pub locate_crossing: bool,
@@ -36,6 +61,8 @@ impl Default for StepOptions {
             theta: 0.5,
             newton: NewtonOptions::default(),
             check_domain: true,
+            chord_spacing: 0.02,
+            max_chord_pieces: 16,
             locate_crossing: false,
             max_halvings: 0,
         }
@@ -61,6 +88,14 @@ impl StepOptions {
         self
     }
 
+    /// Sets the chord spacing and the cap on chord pieces of the domain check
+    /// ([`Self::chord_spacing`]).
+    pub fn with_chord_check(mut self, spacing: f64, max_pieces: u32) -> Self {
+        self.chord_spacing = spacing;
+        self.max_chord_pieces = max_pieces;
+        self
+    }
+
     /// Switches the location of a domain crossing on or off.
     pub fn with_crossing_location(mut self, on: bool) -> Self {
         self.locate_crossing = on;
@@ -76,7 +111,13 @@ impl StepOptions {
     #[inline]
     pub(crate) fn validate(&self, h: f64) -> Result<(), Error> {
         // plain comparisons (NaN fails each): this runs every step
-        if self.theta >= 0.0 && self.theta <= 1.0 && h * 0.0 == 0.0 && h != 0.0 {
+        if self.theta >= 0.0
+            && self.theta <= 1.0
+            && h * 0.0 == 0.0
+            && h != 0.0
+            && self.chord_spacing > 0.0
+            && self.max_chord_pieces <= MAX_CHORD_PIECES
+        {
             return self.newton.validate();
         }
         self.invalid(h)
@@ -97,8 +138,92 @@ impl StepOptions {
                 requirement: "the step size must be finite and non-zero",
             });
         }
+        if !(self.chord_spacing > 0.0 && self.max_chord_pieces <= MAX_CHORD_PIECES) {
+            return Err(Error::InvalidArgument {
+                name: "chord_spacing",
+                requirement: "the chord spacing must be > 0 (infinity: the three points only) \
+                              and max_chord_pieces at most MAX_CHORD_PIECES",
+            });
+        }
         self.newton.validate()
     }
+}
+
+/// The largest [`StepOptions::max_chord_pieces`]: a step's chord is cut into at most this
+/// many pieces (one `check_domain` each, about 10 ns for the planar rigid body).
+pub const MAX_CHORD_PIECES: u32 = 1024;
+
+/// The domain check of a step from `z0` to the unknowns `w`: the three points of
+/// [`LiftedSystem::check_domain`], then the pieces of the chord of
+/// [`StepOptions::chord_spacing`] when the chord is longer than the spacing.
+///
+/// # Errors
+/// The first violated condition.
+#[inline]
+pub fn check_step_domain<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    options: &StepOptions,
+) -> Result<(), crate::DomainViolation>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    system.check_domain(z0, w, options.theta)?;
+    // |x1 - x0|_inf over the jet (the first half of the state); NaN compares false and is
+    // caught by the three points above
+    let half = S / 2;
+    let length = z0
+        .iter()
+        .zip(w.iter())
+        .take(half)
+        .fold(0.0f64, |m, (a, b)| m.max((b - a).abs()));
+    if length > options.chord_spacing {
+        check_chord(system, z0, w, length, options)
+    } else {
+        Ok(())
+    }
+}
+
+/// The pieces of the chord of a step longer than the spacing, each checked as a step of its
+/// own at its ends and its midpoint (out of line: the cold path). Checking pieces rather than
+/// points at other `theta` keeps whatever [`LiftedSystem::check_domain`] infers from its
+/// three samples local to a short piece.
+#[inline(never)]
+fn check_chord<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    length: f64,
+    options: &StepOptions,
+) -> Result<(), crate::DomainViolation>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    // ceil(length / spacing) >= 2 here; `as` saturates (an infinite length gives the cap)
+    let wanted = num_traits::Float::ceil(length / options.chord_spacing) as u32;
+    let pieces = wanted.min(options.max_chord_pieces.min(MAX_CHORD_PIECES));
+    if pieces < 2 {
+        return Ok(());
+    }
+    let count = f64::from(pieces);
+    // the point at s of the chord, as a state (only its jet x enters the guards) and as the
+    // unknowns of a piece ending there (the top derivative u of the step kept)
+    let mut start = *z0;
+    for j in 1..=pieces {
+        let s = f64::from(j) / count;
+        let mut end = *z0;
+        for (e, (a, b)) in end.iter_mut().zip(z0.iter().zip(w.iter())) {
+            *e = (1.0 - s) * a + s * b;
+        }
+        let mut unknowns = *w;
+        for (u, e) in unknowns.iter_mut().zip(end.iter()) {
+            *u = *e;
+        }
+        system.check_domain(&start, &unknowns, 0.5)?;
+        start = end;
+    }
+    Ok(())
 }
 
 /// What the Newton solve of one step reported.
@@ -171,9 +296,7 @@ where
     };
     let solution = newton::solve_validated(&problem, guess, &options.newton)?;
     if options.check_domain {
-        system
-            .check_domain(z0, &solution.w, options.theta)
-            .map_err(Error::Domain)?;
+        check_step_domain(system, z0, &solution.w, options).map_err(Error::Domain)?;
     }
     Ok((
         solution.w,

@@ -1,0 +1,165 @@
+//! Regression tests of runtime items 12 and 13 of the robustness issue (issue 14): the domain
+//! check samples the chord of a step (item 12), and the reduced step conserves the angular
+//! momentum of a rotation-invariant system (item 13).
+
+mod common;
+
+use retract::nalgebra::SVector;
+use retract::{
+    DomainKind, Error, LiftedSystem, ReducedStepper, StepOptions, higher_order_lagrangian, step,
+};
+
+type Z = SVector<f64, 12>;
+
+/// The SE(2) body with a disc obstacle (cx, cy, r) written through its distance: the guarded
+/// denominator |q - c| - r is not quadratic along a chord, so the quadratic fit of the three
+/// points of `check_domain` (exact for |q - c|^2 - r^2) does not see a disc between them.
+#[higher_order_lagrangian(order = 2)]
+fn distance_scene(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, disc: [f64; 3]) -> f64 {
+    let distance = ((q[0] - disc[0]).powi(2) + (q[1] - disc[1]).powi(2)).sqrt();
+    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2)) + tau / (distance - disc[2])
+}
+
+type Scene = DistanceScene;
+
+/// The SE(2) body at (x, y) moving at speed 3 along +x (no rotation), past the obstacles.
+fn moving_at(system: &Scene, x: f64, y: f64) -> Z {
+    let jet = [x, y, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    system.legendre(&Z::from_column_slice(&jet))
+}
+
+/// The general and the reduced step of size `h` from `z0`.
+fn both_steps(system: &Scene, z0: &Z, h: f64, options: &StepOptions) -> [Result<Z, Error>; 2] {
+    let general = step(system, z0, h, options).map(|(z, _)| z);
+    let reduced = ReducedStepper::new(system)
+        .step(z0, h, options)
+        .map(|(z, _)| z);
+    [general, reduced]
+}
+
+#[test]
+fn item_12_a_step_jumping_over_a_small_obstacle_is_an_error() {
+    // a disc of radius 0.05 at (-0.075, 0.03); the step of h = 0.1 at speed 3 goes from
+    // x = -0.15 to x = 0.15 along y = 0, 0.08 of it inside the disc: x0, the midpoint x = 0
+    // and x1 are all 0.08 or more from the centre, and the quadratic fit of the denominator
+    // |q - c| - r through them stays positive, so the three points saw nothing
+    let system = Scene {
+        tau: 1e-6,
+        disc: [-0.075, 0.03, 0.05],
+    };
+    let z0 = moving_at(&system, -0.15, 0.0);
+    let h = 0.1;
+    let three_points = StepOptions::default().with_chord_check(f64::INFINITY, 0);
+    for (which, result) in
+        ["general", "reduced"]
+            .iter()
+            .zip(both_steps(&system, &z0, h, &three_points))
+    {
+        let z1 = result.unwrap_or_else(|e| panic!("{which}: the three points miss it: {e}"));
+        assert!((z1[0] - 0.15).abs() < 1e-3, "{which}: x1 = {}", z1[0]);
+    }
+    // the chord check (spacing 0.02: 15 pieces, points 0.01 apart) finds it, in both steps
+    let options = StepOptions::default();
+    for (which, result) in ["general", "reduced"]
+        .iter()
+        .zip(both_steps(&system, &z0, h, &options))
+    {
+        match result {
+            Err(Error::Domain(v)) => assert_eq!(v.kind, DomainKind::Denominator, "{which}"),
+            other => panic!("{which}: a step through the obstacle returned {other:?}"),
+        }
+    }
+    // a coarser spacing still finds it as long as the gap between checked points,
+    // 0.3 / (2 m) for m pieces, is below the 0.08 of the chord inside the disc: m = 2
+    let coarse = StepOptions::default().with_chord_check(0.15, 16);
+    assert!(matches!(
+        step(&system, &z0, h, &coarse),
+        Err(Error::Domain(_))
+    ));
+    // a cap of 1 piece is the three points again, and misses it, as documented (the gap is
+    // then 0.15)
+    let capped = StepOptions::default().with_chord_check(0.02, 1);
+    assert!(step(&system, &z0, h, &capped).is_ok());
+}
+
+#[test]
+fn item_12_a_step_passing_near_an_obstacle_stays_ok() {
+    // the same step 0.06 beside the disc's centre (0.01 outside its radius) is accepted,
+    // with the full chord check, by both steps, and so is a trajectory along it
+    let system = Scene {
+        tau: 1e-6,
+        disc: [-0.075, 0.06, 0.05],
+    };
+    let z0 = moving_at(&system, -0.15, 0.0);
+    let options = StepOptions::default();
+    for (which, result) in ["general", "reduced"]
+        .iter()
+        .zip(both_steps(&system, &z0, 0.1, &options))
+    {
+        let z1 = result.unwrap_or_else(|e| panic!("{which}: a clear step failed: {e}"));
+        assert!(
+            (z1[0] - 0.15).abs() < 1e-3 && z1[1].abs() < 1e-3,
+            "{which}: {z1:?}"
+        );
+    }
+    let run = retract::trajectory(&system, &moving_at(&system, -0.6, 0.0), 0.05, 20, &options)
+        .expect("a clear run");
+    assert!((run.states[20][0] - 2.4).abs() < 1e-3);
+    // invalid settings are typed errors
+    for bad in [
+        StepOptions::default().with_chord_check(0.0, 16),
+        StepOptions::default().with_chord_check(f64::NAN, 16),
+        StepOptions::default().with_chord_check(0.02, retract::step::MAX_CHORD_PIECES + 1),
+    ] {
+        assert!(matches!(
+            step(&system, &z0, 0.1, &bad),
+            Err(Error::InvalidArgument {
+                name: "chord_spacing",
+                ..
+            })
+        ));
+    }
+}
+
+/// q x p_0 + q' x p_1 of the planar Pais-Uhlenbeck state (q, q', p_0, p_1).
+fn angular_momentum(z: &SVector<f64, 8>) -> f64 {
+    let cross = |a: usize, b: usize| z[a] * z[b + 1] - z[a + 1] * z[b];
+    cross(0, 4) + cross(2, 6)
+}
+
+#[test]
+#[ignore = "item 13 is open: the reduced step drifts 6.5e-10 over 1e7 steps (see the comment)"]
+fn item_13_the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
+    // The midpoint rule conserves the angular momentum of a rotation-invariant Lagrangian
+    // exactly; solved by the general step it stays within 9e-13 (relative) over 1e7 steps, a
+    // random walk of rounding errors. The reduced step drifts linearly, 6.5e-17 per step:
+    // its cached propagator T = -A^{-1} B is rounded once, so every step applies the same
+    // slightly non-symplectic linear map. Measured (h = 0.1, 1e6 steps, relative drift):
+    // 6.5e-11 with the cached factors (closed form or LU alike, any Newton tolerance, the core
+    // solved to 1e-17); 1.3e-13 when w = (T + T_lo) z0 - A^{-1} n is summed exactly with the
+    // correction T_lo = -A^{-1} (A T + B) (the rounding error of T); unchanged (6.5e-11) when
+    // T_lo z0 is added after the rounded recovery (a sub-ulp addition to a rounded value is
+    // lost). The fix needs the correction inside the emitted recovery, before its last
+    // rounding. Bound: 1e-11, ten times the general step's 9e-13 at 1e7 and 65 times below
+    // the drift today; 1e7 reduced steps take about a second in the test profile.
+    let (system, z0) = common::models::bounded_pais_uhlenbeck();
+    let j0 = angular_momentum(&z0);
+    let options = StepOptions::default();
+    let mut stepper = ReducedStepper::new(&system);
+    let mut z = z0;
+    let mut worst: f64 = 0.0;
+    for i in 0..10_000_000 {
+        z = stepper
+            .step(&z, 0.1, &options)
+            .unwrap_or_else(|e| panic!("step {i}: {e}"))
+            .0;
+        if i % 10_000 == 0 {
+            worst = worst.max(((angular_momentum(&z) - j0) / j0).abs());
+        }
+    }
+    worst = worst.max(((angular_momentum(&z) - j0) / j0).abs());
+    assert!(
+        worst < 1e-11,
+        "relative drift of the angular momentum {worst:e}"
+    );
+}
