@@ -6,6 +6,10 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+mod common;
+
+use common::{grad_entry, hess_entry};
+
 use proptest::prelude::*;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{SMatrix, SVector};
@@ -153,29 +157,6 @@ fn shifted<const N: usize, const K: usize>(
         u[c - N * K] += t;
     }
     (x, u)
-}
-
-/// Component `c` of the gradient blocks.
-fn grad_entry<const N: usize, const K: usize>(g: &retract::Gradient<N, K>, c: usize) -> f64 {
-    if c < N * K {
-        g.x[c / N][c % N]
-    } else {
-        g.u[c - N * K]
-    }
-}
-
-fn hess_entry<const N: usize, const K: usize>(
-    h: &retract::Hessian<N, K>,
-    a: usize,
-    b: usize,
-) -> f64 {
-    let (ja, ia, jb, ib) = (a / N, a % N, b / N, b % N);
-    match (ja < K, jb < K) {
-        (true, true) => h.xx[ja][jb][(ia, ib)],
-        (true, false) => h.xu[ja][(ia, ib)],
-        (false, true) => h.xu[jb][(ib, ia)],
-        (false, false) => h.uu[(ia, ib)],
-    }
 }
 
 /// Gradient and Hessian of L at (x, u) against finite differences.

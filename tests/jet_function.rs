@@ -6,6 +6,10 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+mod common;
+
+use common::{grad_entry, hess_entry};
+
 use proptest::prelude::*;
 use retract::JetFunction;
 use retract::jet_function;
@@ -63,30 +67,6 @@ fn close(what: &str, got: f64, want: f64, scale: f64) {
         "{what}: generated {got:e}, finite differences {want:e} (|diff| {:e} > {tol:e})",
         (got - want).abs()
     );
-}
-
-/// Component `c` of the gradient blocks.
-fn grad_entry<const N: usize, const K: usize>(g: &retract::Gradient<N, K>, c: usize) -> f64 {
-    if c < N * K {
-        g.x[c / N][c % N]
-    } else {
-        g.u[c - N * K]
-    }
-}
-
-/// Entry (a, b) of the Hessian blocks; the (u, x) block is the transpose of `xu`.
-fn hess_entry<const N: usize, const K: usize>(
-    h: &retract::Hessian<N, K>,
-    a: usize,
-    b: usize,
-) -> f64 {
-    let (ja, ia, jb, ib) = (a / N, a % N, b / N, b % N);
-    match (ja < K, jb < K) {
-        (true, true) => h.xx[ja][jb][(ia, ib)],
-        (true, false) => h.xu[ja][(ia, ib)],
-        (false, true) => h.xu[jb][(ib, ia)],
-        (false, false) => h.uu[(ia, ib)],
-    }
 }
 
 /// `value`, `gradient` and `hessian` of `f` at the flat jet `v` = (q, ..., q^(k)) against

@@ -78,3 +78,28 @@ pub fn largest_gap<const S: usize>(a: &[SVector<f64, S>], b: &[SVector<f64, S>])
         .map(|(a, b)| (a - b).amax())
         .fold(0.0, f64::max)
 }
+
+/// Component `c` of the gradient blocks over the flat (x, u).
+pub fn grad_entry<const N: usize, const K: usize>(g: &retract::Gradient<N, K>, c: usize) -> f64 {
+    if c < N * K {
+        g.x[c / N][c % N]
+    } else {
+        g.u[c - N * K]
+    }
+}
+
+/// Entry (a, b) of the Hessian blocks over the flat (x, u); the (u, x) block is the transpose
+/// of `xu`.
+pub fn hess_entry<const N: usize, const K: usize>(
+    h: &retract::Hessian<N, K>,
+    a: usize,
+    b: usize,
+) -> f64 {
+    let (ja, ia, jb, ib) = (a / N, a % N, b / N, b % N);
+    match (ja < K, jb < K) {
+        (true, true) => h.xx[ja][jb][(ia, ib)],
+        (true, false) => h.xu[ja][(ia, ib)],
+        (false, true) => h.xu[jb][(ib, ia)],
+        (false, false) => h.uu[(ia, ib)],
+    }
+}
