@@ -205,6 +205,47 @@ fn camel(name: &Ident, attribute: Attribute) -> syn::Result<Ident> {
     }
 }
 
+/// The function's qualifiers, generics and return type: errors for `const`, `async`,
+/// `unsafe`, generic parameters and a return type other than `f64`.
+fn check_qualifiers(sig: &syn::Signature, attribute: Attribute, errors: &mut Vec<syn::Error>) {
+    let fail = |errors: &mut Vec<syn::Error>, span: Span, msg: String| {
+        errors.push(syn::Error::new(span, attribute.reword(msg)))
+    };
+    if let Some(c) = &sig.constness {
+        fail(
+            errors,
+            c.span(),
+            "a Lagrangian cannot be a `const fn`".into(),
+        );
+    }
+    if let Some(a) = &sig.asyncness {
+        fail(errors, a.span(), "a Lagrangian cannot be `async`".into());
+    }
+    if let Some(u) = &sig.unsafety {
+        fail(errors, u.span(), "a Lagrangian cannot be `unsafe`".into());
+    }
+    if !sig.generics.params.is_empty() || sig.generics.where_clause.is_some() {
+        fail(
+            errors,
+            sig.generics.span(),
+            "a Lagrangian cannot be generic: write it for f64 and concrete array lengths".into(),
+        );
+    }
+    match &sig.output {
+        ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
+        ReturnType::Type(_, ty) => fail(
+            errors,
+            ty.span(),
+            "a Lagrangian returns a scalar: the return type must be `f64`".into(),
+        ),
+        ReturnType::Default => fail(
+            errors,
+            sig.ident.span(),
+            "a Lagrangian returns a scalar: add `-> f64`".into(),
+        ),
+    }
+}
+
 /// Checks the attribute and the signature of `item` under `attribute`.
 pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
     let options = parse_options(attr, attribute)?;
@@ -223,47 +264,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             ),
         ));
     };
-    if let Some(c) = &sig.constness {
-        fail(
-            &mut errors,
-            c.span(),
-            "a Lagrangian cannot be a `const fn`".into(),
-        );
-    }
-    if let Some(a) = &sig.asyncness {
-        fail(
-            &mut errors,
-            a.span(),
-            "a Lagrangian cannot be `async`".into(),
-        );
-    }
-    if let Some(u) = &sig.unsafety {
-        fail(
-            &mut errors,
-            u.span(),
-            "a Lagrangian cannot be `unsafe`".into(),
-        );
-    }
-    if !sig.generics.params.is_empty() || sig.generics.where_clause.is_some() {
-        fail(
-            &mut errors,
-            sig.generics.span(),
-            "a Lagrangian cannot be generic: write it for f64 and concrete array lengths".into(),
-        );
-    }
-    match &sig.output {
-        ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
-        ReturnType::Type(_, ty) => fail(
-            &mut errors,
-            ty.span(),
-            "a Lagrangian returns a scalar: the return type must be `f64`".into(),
-        ),
-        ReturnType::Default => fail(
-            &mut errors,
-            sig.ident.span(),
-            "a Lagrangian returns a scalar: add `-> f64`".into(),
-        ),
-    }
+    check_qualifiers(sig, attribute, &mut errors);
 
     let mut args: Vec<(Ident, Kind)> = Vec::new();
     let mut jet_span = sig.ident.span();
