@@ -324,6 +324,16 @@ fn failures_carry_the_last_iterate() {
         matches!(straight.failure, Failure::GuessOutsideDomain { .. }),
         "{straight}"
     );
+    // a chord spacing that is not > 0, or more pieces than the cap, is refused
+    for options in [
+        PlanOptions::default().with_chord_check(0.0, 16),
+        PlanOptions::default().with_chord_check(f64::NAN, 16),
+        PlanOptions::default().with_chord_check(0.02, retract::step::MAX_CHORD_PIECES + 1),
+    ] {
+        let error = solve_disc(20, options).unwrap_err();
+        assert!(matches!(error.failure, Failure::Invalid(_)), "{error}");
+        assert!(error.to_string().contains("chord"), "{error}");
+    }
 }
 
 /// The cart-pole of the swing-up suite: the cost 1/2 F^2 on the cart force.

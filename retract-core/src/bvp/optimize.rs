@@ -18,8 +18,9 @@
 //! so every direction descends and iterates are drawn to minima. The step length comes from a
 //! backtracking line search on the exact penalty $J + \pi \|c\|_1$ ($c$: all constraints),
 //! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
-//! $L$ (the generated singularity guard, at both ends, the evaluation point and
-//! `chord_samples` points of the chord of every step) is rejected. A point is returned only
+//! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
+//! and on pieces of its chord no longer than `chord_spacing`, as
+//! [`crate::step::check_step_domain`]) is rejected. A point is returned only
 //! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
 //! without correction; its [`Certificate`] holds the residuals and the smallest eigenvalue of
 //! the reduced Hessian (Lanczos on the inverse, [`super::certificate`]).
@@ -51,9 +52,13 @@ pub struct PlanOptions {
     pub max_iterations: usize,
     /// Wall-time budget; `None` for none.
     pub max_time: Option<Duration>,
-    /// Points of the chord of every step, besides its ends and evaluation point, at which the
-    /// singularity guard is checked.
-    pub chord_samples: usize,
+    /// The chord of a step longer than this (max-norm of $x_{i+1} - x_i$) is checked by the
+    /// singularity guard in pieces of at most this length, as
+    /// [`crate::StepOptions::chord_spacing`]; 0.02 by default.
+    pub chord_spacing: f64,
+    /// The most pieces a step's chord is cut into, as
+    /// [`crate::StepOptions::max_chord_pieces`]; 16 by default.
+    pub max_chord_pieces: u32,
     /// Armijo constant of the line search.
     pub armijo: f64,
     /// Step halvings per line search.
@@ -74,7 +79,8 @@ impl Default for PlanOptions {
             acceptable: 1e-6,
             max_iterations: 200,
             max_time: None,
-            chord_samples: 3,
+            chord_spacing: 0.02,
+            max_chord_pieces: 16,
             armijo: 1e-4,
             max_backtracks: 40,
             initial_barrier: 0.1,
@@ -109,9 +115,11 @@ impl PlanOptions {
         self.min_eigenvalue = min_eigenvalue;
         self
     }
-    /// Sets the number of chord points checked by the singularity guard per step.
-    pub fn with_chord_samples(mut self, chord_samples: usize) -> Self {
-        self.chord_samples = chord_samples;
+    /// Sets the chord spacing and the cap on chord pieces of the singularity guard
+    /// ([`Self::chord_spacing`]).
+    pub fn with_chord_check(mut self, spacing: f64, max_pieces: u32) -> Self {
+        self.chord_spacing = spacing;
+        self.max_chord_pieces = max_pieces;
         self
     }
 }
@@ -474,8 +482,15 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 "the initial barrier parameter must be finite and > 0",
             );
         }
-        if !(o.armijo > 0.0 && o.armijo < 0.5) || o.chord_samples > 64 {
-            return invalid("options", "need 0 < armijo < 1/2 and chord_samples <= 64");
+        if !(o.armijo > 0.0 && o.armijo < 0.5) {
+            return invalid("options", "need 0 < armijo < 1/2");
+        }
+        if !(o.chord_spacing > 0.0 && o.max_chord_pieces <= crate::step::MAX_CHORD_PIECES) {
+            return invalid(
+                "options",
+                "the chord spacing must be > 0 (infinity: the three points only) and \
+                 max_chord_pieces at most MAX_CHORD_PIECES",
+            );
         }
         Ok(())
     }
@@ -624,8 +639,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Ok(iterate)
     }
 
-    /// The singularity guard on every step: at its ends, its evaluation point and
-    /// `chord_samples` interior points of its chord.
+    /// The singularity guard on every step ([`crate::step::check_step_domain`]): at its ends,
+    /// its evaluation point and, for a chord longer than `chord_spacing`, on its pieces.
     pub(super) fn guard<const S: usize, const M: usize>(
         &self,
         iterate: &Iterate<N, X>,
@@ -633,7 +648,9 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: LiftedSystem<S, M>,
     {
-        let samples = self.options.chord_samples;
+        let options = crate::StepOptions::default()
+            .with_theta(self.options.theta)
+            .with_chord_check(self.options.chord_spacing, self.options.max_chord_pieces);
         for i in 0..self.steps {
             let z0 = SVector::<f64, S>::from_fn(|r, _| if r < X { iterate.x[i][r] } else { 0.0 });
             let w = SVector::<f64, M>::from_fn(|r, _| {
@@ -645,11 +662,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     0.0
                 }
             });
-            let at = |s: f64| self.system.check_domain(&z0, &w, s).map_err(|v| (i, v));
-            at(self.options.theta)?;
-            for j in 1..=samples {
-                at(j as f64 / (samples + 1) as f64)?;
-            }
+            crate::step::check_step_domain(self.system, &z0, &w, &options).map_err(|v| (i, v))?;
         }
         Ok(())
     }

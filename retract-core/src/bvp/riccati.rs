@@ -207,10 +207,17 @@ pub(crate) struct StageLinear<const N: usize, const X: usize> {
 /// singular or not finite. An $L D L^T$ factorisation without pivoting first (a congruence, so
 /// by Sylvester's law the signs of the pivots are those of the eigenvalues), the
 /// eigendecomposition when a pivot is too small for that to be reliable.
+#[inline]
 fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
-    if let Some(pair) = ldlt_inverse(&m) {
-        return Some(pair);
-    }
+    ldlt_inverse(&m).or_else(|| invert_by_eigen(&m))
+}
+
+/// The fallback of [`invert_counting`]: the inverse and the negative eigenvalues from the
+/// symmetric eigendecomposition; `None` if an eigenvalue is below $10^{-13}$ of the largest
+/// in magnitude or a value is not finite.
+#[cold]
+#[inline(never)]
+fn invert_by_eigen<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
     if !m.iter().all(|v| v.is_finite()) {
         return None;
     }
@@ -229,6 +236,7 @@ fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64
 /// $M^{-1}$ and the number of negative pivots of $M = L D L^T$ ($L$ unit lower triangular),
 /// or `None` if a pivot is below $10^{-10}$ of the largest diagonal entry in magnitude or a
 /// value is not finite.
+#[inline]
 fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
     let scale = (0..D).fold(0.0_f64, |s, i| s.max(m[(i, i)].abs()));
     let mut l = SMatrix::<f64, D, D>::identity();
@@ -282,12 +290,14 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
 /// space: $K = M - \Pi \tilde Q^{-1} \Pi (Q_{ux} + Q_{uu} M)$, $K_\nu = -\Pi \tilde Q^{-1}
 /// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + I - \Pi$. Returns the factor, $Q_{xx}$
 /// and the negative eigenvalues of $\tilde Q$ on the null space (`None`: singular).
+#[inline(always)]
 fn stage_factor<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stage: &StageModel<N, X>,
     rho: f64,
     p: &SMatrix<f64, X, X>,
     sens: &SMatrix<f64, X, X>,
+    bts: &SMatrix<f64, N, X>,
 ) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
     let (a, b, e) = (&dynamics.poly_a, &dynamics.poly_b, &dynamics.poly_e);
     let theta = dynamics.theta;
@@ -305,7 +315,6 @@ fn stage_factor<const N: usize, const X: usize>(
         + huu
         + b.left_t(&b.right(p));
     let quu = (quu + quu.transpose()) * 0.5;
-    let bts = b.left_t(sens);
     let mut factor = StageFactor {
         quu_inv: SMatrix::zeros(),
         quu,
@@ -355,33 +364,32 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let mut factors = Vec::with_capacity(stages.len());
         let mut negative = 0;
         let mut singular = false;
+        // D_N = d delta x_N / d nu = sum_i Phi(N, i+1) B K_nu,i with the closed-loop transition
+        // Phi(N, i+1) = S_{i+1}^T, so D_N = sum_i (B^T S_{i+1})^T K_nu,i: accumulated here,
+        // symmetric (K_nu,i = -Qtilde^-1 B^T S_{i+1}) up to rounding
+        let mut d = SMatrix::<f64, X, X>::zeros();
         for stage in stages.iter().rev() {
-            let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p, &sens);
+            let bts = b.left_t(&sens);
+            let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p, &sens, &bts);
             singular |= neg.is_none();
             negative += neg.unwrap_or(0);
             // V_i(dx) = Q(dx, K dx + k + K_nu nu): the general form (K need not minimise Q
             // over all du when the stage is constrained)
-            let (k, kn, qux, quu) = (&factor.gain, &factor.gain_nu, &factor.qux, &factor.quu);
-            let quu_k = quu * k;
+            let (k, qux) = (&factor.gain, &factor.qux);
             let p_new = if factor.constrained {
+                let quu_k = factor.quu * k;
                 qxx + k.transpose() * qux + qux.transpose() * k + k.transpose() * quu_k
             } else {
                 qxx + qux.transpose() * k
             };
             p = (p_new + p_new.transpose()) * 0.5;
-            sens = if factor.constrained {
-                a.left_t(&sens) + k.transpose() * b.left_t(&sens) + (qux + quu_k).transpose() * kn
-            } else {
-                a.left_t(&sens) + qux.transpose() * kn
-            };
+            d += bts.transpose() * factor.gain_nu;
+            // S_i = (A + B K)^T S_{i+1} (with constraints the term (Q_ux + Q_uu K)^T K_nu
+            // vanishes: Pi (Q_ux + Q_uu K) = 0)
+            sens = a.left_t(&sens) + k.transpose() * bts;
             factors.push(factor);
         }
         // (kept in the order of the backward pass: `step_factor(i)` reads step i)
-        // D_N = d delta x_N / d nu: forward sweep of the closed-loop sensitivity
-        let mut d = SMatrix::<f64, X, X>::zeros();
-        for f in factors.iter().rev() {
-            d = a.left(&d) + b.left(&(f.gain * d + f.gain_nu));
-        }
         let d_sym = (d + d.transpose()) * 0.5;
         // the symmetric part for the inertia, the matrix itself for the solve
         let neg_d = invert_counting(d_sym).map_or_else(
@@ -441,21 +449,60 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// The subproblem's solution for the stage linear terms, defects and constraint offsets
-    /// given by `linear(i)`.
+    /// given by `linear(i)`: a backward pass for the feed-forward terms, the terminal
+    /// multiplier $\nu$ from $D_N \nu = r_N - \delta x_N(0)$ (with one refinement when the
+    /// terminal condition is missed by more than rounding; both by the cheap forward pass of
+    /// [`Self::terminal`]), then one forward pass for the direction.
     pub fn solve_linear(
         &self,
         dynamics: &Dynamics<N, X>,
-        linear: &dyn Fn(usize) -> StageLinear<N, X>,
+        linear: &impl Fn(usize) -> StageLinear<N, X>,
         r0: &SVector<f64, X>,
         r_end: &SVector<f64, X>,
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
-        // backward: the feed-forward terms, q_u and s_{i+1} for these linear terms
-        let mut feedforward = vec![SVector::<f64, N>::zeros(); steps];
-        let mut qus = vec![SVector::<f64, N>::zeros(); steps];
-        let mut s_next = vec![SVector::<f64, X>::zeros(); steps];
-        let mut defects = vec![SVector::<f64, X>::zeros(); steps];
+        let backward = self.backward(dynamics, linear);
+        let mut nu = self.d_end_inv * (r_end - self.terminal(dynamics, &backward, r0, None));
+        let x_end = self.terminal(dynamics, &backward, r0, Some(&nu));
+        let miss = r_end - x_end;
+        if miss.amax() > 1e-12 * (1.0 + r_end.amax() + x_end.amax()) {
+            nu += self.d_end_inv * miss;
+        }
+        let mut d = Direction {
+            dx: Vec::with_capacity(steps + 1),
+            du: Vec::with_capacity(steps),
+            costate: Vec::with_capacity(steps),
+            multipliers: Vec::with_capacity(steps),
+        };
+        let mut x = *r0;
+        d.dx.push(x);
+        for (f, l) in self.stages.iter().rev().zip(&backward) {
+            let u = f.gain * x + l.feedforward + f.gain_nu * nu;
+            if f.constrained {
+                let dq = f.qux * x + f.quu * u + l.qu + b.left_t(&(f.sens_next * nu));
+                d.multipliers.push(-(f.pinv.transpose() * dq));
+            } else {
+                d.multipliers.push(SVector::zeros());
+            }
+            x = a.left(&x) + b.left(&u) + l.defect;
+            d.costate.push(f.p_next * x + l.s_next + f.sens_next * nu);
+            d.du.push(u);
+            d.dx.push(x);
+        }
+        d
+    }
+
+    /// The backward pass of a solve: per step (first step first) the feed-forward term, $q_u$,
+    /// $s_{i+1}$ and the defect for the linear terms `linear(i)`.
+    fn backward(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        linear: &impl Fn(usize) -> StageLinear<N, X>,
+    ) -> Vec<Backward<N, X>> {
+        let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
+        let steps = self.stages.len();
+        let mut out = Vec::with_capacity(steps);
         let mut s = SVector::<f64, X>::zeros();
         for i in (0..steps).rev() {
             let f = self.step_factor(i);
@@ -463,62 +510,56 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let pcs = f.p_next * l.defect + s;
             let qx = l.lx + a.left_t(&pcs);
             let qu = l.lu + b.left_t(&pcs);
-            s_next[i] = s;
-            defects[i] = l.defect;
-            qus[i] = qu;
-            if f.constrained {
+            let s_next = s;
+            let k = if f.constrained {
                 let m0 = -(f.pinv * l.constraint);
                 let k = m0 - f.projector * (f.quu_inv * (f.projector * (qu + f.quu * m0)));
                 s = qx + f.gain.transpose() * (qu + f.quu * k) + f.qux.transpose() * k;
-                feedforward[i] = k;
+                k
             } else {
                 let k = -(f.quu_inv * qu);
                 s = qx + f.qux.transpose() * k;
-                feedforward[i] = k;
-            }
+                k
+            };
+            out.push(Backward {
+                feedforward: k,
+                qu,
+                s_next,
+                defect: l.defect,
+            });
         }
-        // forward without nu, then nu from the terminal condition
-        let mut x = *r0;
-        for (i, f) in self.stages.iter().rev().enumerate() {
-            let du = f.gain * x + feedforward[i];
-            x = a.left(&x) + b.left(&du) + defects[i];
-        }
-        let mut nu = self.d_end_inv * (r_end - x);
-        let mut d = Direction {
-            dx: Vec::with_capacity(steps + 1),
-            du: Vec::with_capacity(steps),
-            costate: Vec::with_capacity(steps),
-            multipliers: Vec::with_capacity(steps),
-        };
-        // one refinement of nu when the terminal condition is missed by more than rounding
-        for refinement in 0..2 {
-            d.dx.clear();
-            d.du.clear();
-            d.costate.clear();
-            d.multipliers.clear();
-            let mut x = *r0;
-            d.dx.push(x);
-            for (i, f) in self.stages.iter().rev().enumerate() {
-                let u = f.gain * x + feedforward[i] + f.gain_nu * nu;
-                if f.constrained {
-                    let dq = f.qux * x + f.quu * u + qus[i] + b.left_t(&(f.sens_next * nu));
-                    d.multipliers.push(-(f.pinv.transpose() * dq));
-                } else {
-                    d.multipliers.push(SVector::zeros());
-                }
-                x = a.left(&x) + b.left(&u) + defects[i];
-                d.costate.push(f.p_next * x + s_next[i] + f.sens_next * nu);
-                d.du.push(u);
-                d.dx.push(x);
-            }
-            let miss = r_end - x;
-            if refinement == 1 || miss.amax() <= 1e-12 * (1.0 + r_end.amax() + x.amax()) {
-                break;
-            }
-            nu += self.d_end_inv * miss;
-        }
-        d
+        out.reverse();
+        out
     }
+
+    /// $\delta x_N$ of the closed loop from $\delta x_0 = $ `r0` with the terminal multiplier
+    /// `nu` (none: 0).
+    fn terminal(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        backward: &[Backward<N, X>],
+        r0: &SVector<f64, X>,
+        nu: Option<&SVector<f64, X>>,
+    ) -> SVector<f64, X> {
+        let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
+        let mut x = *r0;
+        for (f, l) in self.stages.iter().rev().zip(backward) {
+            let mut du = f.gain * x + l.feedforward;
+            if let Some(nu) = nu {
+                du += f.gain_nu * nu;
+            }
+            x = a.left(&x) + b.left(&du) + l.defect;
+        }
+        x
+    }
+}
+
+/// What the backward pass of a solve keeps of a step.
+struct Backward<const N: usize, const X: usize> {
+    feedforward: SVector<f64, N>,
+    qu: SVector<f64, N>,
+    s_next: SVector<f64, X>,
+    defect: SVector<f64, X>,
 }
 
 #[cfg(test)]

@@ -35,12 +35,10 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
         for j in 0..X / N {
             for d in 0..=j {
                 let c = self.c[d];
-                if c != 0.0 {
-                    for a in 0..N {
-                        let (to, from) = (j * N + a, (j - d) * N + a);
-                        for r in 0..R {
-                            out[(r, to)] += c * m[(r, from)];
-                        }
+                for a in 0..N {
+                    let (to, from) = (j * N + a, (j - d) * N + a);
+                    for r in 0..R {
+                        out[(r, to)] += c * m[(r, from)];
                     }
                 }
             }
@@ -55,10 +53,8 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
             for j in 0..X / N {
                 for d in 0..=j {
                     let c = self.c[d];
-                    if c != 0.0 {
-                        for a in 0..N {
-                            out[(j * N + a, col)] += c * m[((j - d) * N + a, col)];
-                        }
+                    for a in 0..N {
+                        out[(j * N + a, col)] += c * m[((j - d) * N + a, col)];
                     }
                 }
             }
@@ -74,10 +70,8 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
             for j in 0..k {
                 for d in 0..k - j {
                     let c = self.c[d];
-                    if c != 0.0 {
-                        for a in 0..N {
-                            out[(j * N + a, col)] += c * m[((j + d) * N + a, col)];
-                        }
+                    for a in 0..N {
+                        out[(j * N + a, col)] += c * m[((j + d) * N + a, col)];
                     }
                 }
             }
@@ -99,11 +93,9 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
         let mut out = SMatrix::<f64, R, N>::zeros();
         for j in 0..X / N {
             let b = self.b[j];
-            if b != 0.0 {
-                for a in 0..N {
-                    for r in 0..R {
-                        out[(r, a)] += b * m[(r, j * N + a)];
-                    }
+            for a in 0..N {
+                for r in 0..R {
+                    out[(r, a)] += b * m[(r, j * N + a)];
                 }
             }
         }
@@ -116,10 +108,8 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
         for col in 0..C {
             for j in 0..X / N {
                 let b = self.b[j];
-                if b != 0.0 {
-                    for a in 0..N {
-                        out[(a, col)] += b * m[(j * N + a, col)];
-                    }
+                for a in 0..N {
+                    out[(a, col)] += b * m[(j * N + a, col)];
                 }
             }
         }
