@@ -17,6 +17,8 @@
 //!   [`lifted`] assembles the scheme from a [`Lagrangian`].
 //! - [`newton`]: the solver; [`step`](mod@step): one step and trajectories;
 //!   [`diagnostics`]: energy, symplecticity, drift, RK4.
+//! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
+//!   among them.
 //! - [`models`]: a system written by hand.
 //!
 //! # References
@@ -41,6 +43,7 @@ pub mod diagnostics;
 mod error;
 pub mod lifted;
 pub mod linalg;
+pub mod map;
 pub mod models;
 pub mod newton;
 pub mod reduced;
