@@ -30,6 +30,7 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     }
 
     /// $M P(S)$: column block $j$ is $\sum_{d \le j} c_d$ times column block $j - d$ of $M$.
+    #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, X> {
         let mut out = SMatrix::<f64, R, X>::zeros();
         for j in 0..X / N {
@@ -47,6 +48,7 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     }
 
     /// $P(S)^T M$: row block $j$ is $\sum_{d \le j} c_d$ times row block $j - d$ of $M$.
+    #[inline(always)]
     pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
         let mut out = SMatrix::<f64, X, C>::zeros();
         for col in 0..C {
@@ -63,6 +65,7 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     }
 
     /// $P(S) M$: row block $j$ is $\sum_{j + d < k} c_d$ times row block $j + d$ of $M$.
+    #[inline(always)]
     pub fn left<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
         let k = X / N;
         let mut out = SMatrix::<f64, X, C>::zeros();
@@ -89,6 +92,7 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     }
 
     /// $M \bar B = \sum_j b_j$ (column block $j$ of $M$).
+    #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, N> {
         let mut out = SMatrix::<f64, R, N>::zeros();
         for j in 0..X / N {
@@ -103,6 +107,7 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     }
 
     /// $\bar B^T M = \sum_j b_j$ (row block $j$ of $M$).
+    #[inline(always)]
     pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, N, C> {
         let mut out = SMatrix::<f64, N, C>::zeros();
         for col in 0..C {
@@ -117,6 +122,7 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     }
 
     /// $\bar B M$: row block $j$ is $b_j M$.
+    #[inline(always)]
     pub fn left<const C: usize>(&self, m: &SMatrix<f64, N, C>) -> SMatrix<f64, X, C> {
         SMatrix::<f64, X, C>::from_fn(|r, col| self.b[r / N] * m[(r % N, col)])
     }
