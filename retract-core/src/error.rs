@@ -39,11 +39,53 @@ impl fmt::Display for DomainViolation {
             DomainKind::LnArgument => write!(f, "argument `{expression}` of ln left (0, inf)")?,
             DomainKind::PowfBase => write!(f, "base `{expression}` of powf left (0, inf)")?,
         }
-        if let Some(k) = self.element {
-            write!(f, " for element {k} of the parameter list")?;
-        }
-        Ok(())
+        element(f, self)
     }
+}
+
+/// " for element k of the parameter list", for a guard inside a loop over a slice parameter.
+fn element(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Result {
+    if let Some(k) = violation.element {
+        write!(f, " for element {k} of the parameter list")?;
+    }
+    Ok(())
+}
+
+/// What a guarded expression of this kind is, in words.
+fn kind_name(kind: DomainKind) -> &'static str {
+    match kind {
+        DomainKind::Denominator => "denominator",
+        DomainKind::SqrtArgument => "sqrt argument",
+        DomainKind::LnArgument => "ln argument",
+        DomainKind::PowfBase => "powf base",
+    }
+}
+
+/// The message of a given state (`data`) outside the domain.
+fn outside_domain(f: &mut fmt::Formatter<'_>, data: &str, error: &Error) -> fmt::Result {
+    write!(f, "the {data} lies outside the domain of the Lagrangian: ")?;
+    if let Some(violation) = error.violation() {
+        at_point(f, &violation)?;
+    }
+    write!(
+        f,
+        " there (e.g. it is inside an obstacle), so no guess or step size can fix it: move the \
+         {data} into the domain or change the parameters"
+    )
+}
+
+/// A violation at a single point (no step): the condition that fails there.
+fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Result {
+    let expression = violation.expression;
+    match violation.kind {
+        DomainKind::Denominator => {
+            write!(f, "denominator `{expression}` vanishes or is not finite")?
+        }
+        DomainKind::SqrtArgument => write!(f, "argument `{expression}` of sqrt is negative")?,
+        DomainKind::LnArgument => write!(f, "argument `{expression}` of ln is not positive")?,
+        DomainKind::PowfBase => write!(f, "base `{expression}` of powf is not positive")?,
+    }
+    element(f, violation)
 }
 
 /// Why a solve or a step failed.
@@ -67,14 +109,18 @@ pub enum Error {
         /// Newton iteration at which the factorisation failed.
         iteration: usize,
     },
-    /// The iteration cap was reached; `residual_norm` is max|F| at the last iterate.
+    /// The iteration cap of a Newton solve (a step of the scheme) was reached;
+    /// `residual_norm` is max|F| at the last iterate. The boundary-value solver reports
+    /// [`Error::BoundaryValueNoConvergence`] instead.
     NoConvergence {
         /// Newton iterations performed.
         iterations: usize,
         /// max-norm of the residual at the last iterate.
         residual_norm: f64,
     },
-    /// Backtracking could not decrease |F|^2 along the Newton direction.
+    /// Backtracking could not decrease |F|^2 along the Newton direction of a Newton solve (a
+    /// step of the scheme). The boundary-value solver reports
+    /// [`Error::BoundaryValueLineSearchFailed`] instead.
     LineSearchFailed {
         /// Newton iteration whose line search failed.
         iteration: usize,
@@ -111,6 +157,168 @@ pub enum Error {
         /// What is required of it.
         requirement: &'static str,
     },
+    /// The Newton iteration of a boundary-value problem
+    /// ([`BoundaryValueProblem`](crate::bvp::BoundaryValueProblem)) reached its iteration
+    /// cap; `residual_norm` is max|R| at the last iterate.
+    BoundaryValueNoConvergence {
+        /// Newton iterations performed.
+        iterations: usize,
+        /// max-norm of the residual at the last iterate.
+        residual_norm: f64,
+    },
+    /// Backtracking could not decrease |R|^2 along the Newton direction of a boundary-value
+    /// problem ([`BoundaryValueProblem`](crate::bvp::BoundaryValueProblem)).
+    BoundaryValueLineSearchFailed {
+        /// Newton iteration whose line search failed.
+        iteration: usize,
+        /// max-norm of the residual at the last accepted iterate.
+        residual_norm: f64,
+    },
+    /// The initial state of a trajectory lies outside the domain of the Lagrangian (e.g.
+    /// inside an obstacle): a guarded expression fails at that state alone (a denominator
+    /// vanishes or is not finite, a `sqrt` argument is negative, an `ln` argument or `powf`
+    /// base is not positive), so no step size can help. The fields are those of a
+    /// [`DomainViolation`] ([`Error::violation`] returns it).
+    InitialStateOutsideDomain {
+        /// The expression as written in the Lagrangian.
+        expression: &'static str,
+        /// The condition it violates.
+        kind: DomainKind,
+        /// For an expression inside a loop over a slice parameter: the element's index
+        /// (saturated at `u32::MAX`; a `u32` keeps [`Error`] as small as before).
+        element: Option<u32>,
+    },
+    /// The start jet of a boundary-value or optimal-control problem lies outside the domain of
+    /// the Lagrangian, as for [`Error::InitialStateOutsideDomain`]: no guess can help.
+    StartOutsideDomain {
+        /// The expression as written in the Lagrangian.
+        expression: &'static str,
+        /// The condition it violates.
+        kind: DomainKind,
+        /// For an expression inside a loop over a slice parameter: the element's index
+        /// (saturated at `u32::MAX`; a `u32` keeps [`Error`] as small as before).
+        element: Option<u32>,
+    },
+    /// The goal jet of a boundary-value or optimal-control problem lies outside the domain of
+    /// the Lagrangian, as for [`Error::InitialStateOutsideDomain`]: no guess can help.
+    GoalOutsideDomain {
+        /// The expression as written in the Lagrangian.
+        expression: &'static str,
+        /// The condition it violates.
+        kind: DomainKind,
+        /// For an expression inside a loop over a slice parameter: the element's index
+        /// (saturated at `u32::MAX`; a `u32` keeps [`Error`] as small as before).
+        element: Option<u32>,
+    },
+    /// The start and the goal of a boundary-value or optimal-control problem lie on opposite
+    /// sides of a singularity of the Lagrangian: a guarded expression (e.g. the denominator of
+    /// an obstacle's barrier) has opposite signs at them, typically because one of them is
+    /// inside an obstacle. Every path between them crosses the singularity, so no guess can
+    /// help. The fields are those of a [`DomainViolation`] ([`Error::violation`] returns it).
+    BoundariesSeparated {
+        /// The expression as written in the Lagrangian.
+        expression: &'static str,
+        /// The condition it violates.
+        kind: DomainKind,
+        /// For an expression inside a loop over a slice parameter: the element's index
+        /// (saturated at `u32::MAX`; a `u32` keeps [`Error`] as small as before).
+        element: Option<u32>,
+    },
+    /// The start or the goal of a boundary-value problem is inside obstacle `obstacle` (its
+    /// clearance is `clearance` < 0, or NaN), so no guess can help.
+    BoundaryInObstacle {
+        /// Which end: `"start"` or `"goal"`.
+        end: &'static str,
+        /// Index of the obstacle.
+        obstacle: usize,
+        /// The clearance there.
+        clearance: f64,
+    },
+}
+
+/// Which given data a domain check at single points concerns (the constructor of the
+/// variants of [`Error`] that carry a [`DomainViolation`]'s fields).
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Given {
+    /// [`Error::InitialStateOutsideDomain`].
+    InitialState,
+    /// [`Error::StartOutsideDomain`].
+    Start,
+    /// [`Error::GoalOutsideDomain`].
+    Goal,
+    /// [`Error::BoundariesSeparated`].
+    Separated,
+}
+
+impl Error {
+    /// The error of `given` data for which the domain check found `violation`.
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn given(given: Given, violation: DomainViolation) -> Self {
+        let DomainViolation {
+            expression,
+            kind,
+            element,
+        } = violation;
+        let element = element.map(|k| u32::try_from(k).unwrap_or(u32::MAX));
+        match given {
+            Given::InitialState => Error::InitialStateOutsideDomain {
+                expression,
+                kind,
+                element,
+            },
+            Given::Start => Error::StartOutsideDomain {
+                expression,
+                kind,
+                element,
+            },
+            Given::Goal => Error::GoalOutsideDomain {
+                expression,
+                kind,
+                element,
+            },
+            Given::Separated => Error::BoundariesSeparated {
+                expression,
+                kind,
+                element,
+            },
+        }
+    }
+
+    /// The guarded expression behind a domain error: the violation of a step
+    /// ([`Error::Domain`]) or of given data ([`Error::InitialStateOutsideDomain`],
+    /// [`Error::StartOutsideDomain`], [`Error::GoalOutsideDomain`],
+    /// [`Error::BoundariesSeparated`]); `None` for every other error.
+    pub fn violation(&self) -> Option<DomainViolation> {
+        match *self {
+            Error::Domain(violation) => Some(violation),
+            Error::InitialStateOutsideDomain {
+                expression,
+                kind,
+                element,
+            }
+            | Error::StartOutsideDomain {
+                expression,
+                kind,
+                element,
+            }
+            | Error::GoalOutsideDomain {
+                expression,
+                kind,
+                element,
+            }
+            | Error::BoundariesSeparated {
+                expression,
+                kind,
+                element,
+            } => Some(DomainViolation {
+                expression,
+                kind,
+                element: element.map(|k| usize::try_from(k).unwrap_or(usize::MAX)),
+            }),
+            _ => None,
+        }
+    }
 }
 
 impl fmt::Display for Error {
@@ -177,11 +385,66 @@ impl fmt::Display for Error {
             Error::Domain(violation) => write!(
                 f,
                 "{violation} within the step: the trajectory crossed a singularity of the \
-                 Lagrangian (e.g. entered an obstacle); the states before it are valid"
+                 Lagrangian (e.g. entered an obstacle, or left one it started inside); the \
+                 states before it are valid"
             ),
             Error::InvalidArgument { name, requirement } => {
                 write!(f, "invalid argument `{name}`: {requirement}")
             }
+            Error::BoundaryValueNoConvergence {
+                iterations,
+                residual_norm,
+            } => write!(
+                f,
+                "the boundary-value Newton iteration did not converge in {iterations} \
+                 iterations (last residual max-norm {residual_norm:e}): raise \
+                 BvpOptions::max_iterations, or start from a better guess (Guess::States along \
+                 the expected path, or a warm start from an easier problem with \
+                 bvp::continuation)"
+            ),
+            Error::BoundaryValueLineSearchFailed {
+                iteration,
+                residual_norm,
+            } => write!(
+                f,
+                "the boundary-value line search failed at Newton iteration {iteration} \
+                 (residual max-norm {residual_norm:e}): no step along the Newton direction \
+                 decreases the residual of the whole discrete trajectory; start from a better \
+                 guess (Guess::States along the expected path, or a warm start from an easier \
+                 problem with bvp::continuation, e.g. a larger barrier weight), or use the \
+                 optimizer (OptimalControlProblem), whose line search follows the cost"
+            ),
+            Error::InitialStateOutsideDomain { .. } => outside_domain(f, "initial state", self),
+            Error::StartOutsideDomain { .. } => outside_domain(f, "start", self),
+            Error::GoalOutsideDomain { .. } => outside_domain(f, "goal", self),
+            Error::BoundariesSeparated {
+                expression, kind, ..
+            } => {
+                write!(
+                    f,
+                    "the start and the goal lie on opposite sides of a singularity of the \
+                     Lagrangian: the {} `{expression}` has opposite signs at them",
+                    kind_name(kind),
+                )?;
+                if let Some(violation) = self.violation() {
+                    element(f, &violation)?;
+                }
+                write!(
+                    f,
+                    " (e.g. one of them is inside an obstacle), so every path between them \
+                     crosses it and no guess can fix it: move the start or the goal"
+                )
+            }
+            Error::BoundaryInObstacle {
+                end,
+                obstacle,
+                clearance,
+            } => write!(
+                f,
+                "the {end} is inside obstacle {obstacle} (clearance {clearance:e}), so no \
+                 guess can fix it (a solution begins at the start and ends at the goal): move \
+                 the {end} out of the obstacle"
+            ),
         }
     }
 }
@@ -271,7 +534,106 @@ mod tests {
                 },
                 vec!["`theta`", "[0, 1]"],
             ),
+            (
+                Error::BoundaryValueNoConvergence {
+                    iterations: 50,
+                    residual_norm: 1.5e-3,
+                },
+                vec![
+                    "boundary-value",
+                    "50 iterations",
+                    "1.5e-3",
+                    "max_iterations",
+                ],
+            ),
+            (
+                Error::BoundaryValueLineSearchFailed {
+                    iteration: 4,
+                    residual_norm: 2.0,
+                },
+                vec!["boundary-value line search", "iteration 4", "better guess"],
+            ),
+            (
+                Error::given(Given::Start, violation(DomainKind::Denominator)),
+                vec![
+                    "the start lies outside the domain",
+                    "denominator `x * x - 1.0` vanishes",
+                    "element 3",
+                    "no guess",
+                ],
+            ),
+            (
+                Error::given(Given::InitialState, violation(DomainKind::LnArgument)),
+                vec!["the initial state lies outside", "ln is not positive"],
+            ),
+            (
+                Error::given(Given::Goal, violation(DomainKind::SqrtArgument)),
+                vec!["the goal lies outside", "sqrt is negative", "no guess"],
+            ),
+            (
+                Error::given(Given::Separated, violation(DomainKind::Denominator)),
+                vec!["opposite sides", "`x * x - 1.0`", "element 3", "no guess"],
+            ),
+            (
+                Error::BoundaryInObstacle {
+                    end: "goal",
+                    obstacle: 2,
+                    clearance: -0.5,
+                },
+                vec!["the goal is inside obstacle 2", "-5e-1", "no guess"],
+            ),
         ]
+    }
+
+    #[test]
+    fn the_error_stays_small() {
+        // an Interrupted trajectory carries it by value (clippy's result_large_err)
+        assert!(core::mem::size_of::<Error>() <= 40);
+    }
+
+    #[test]
+    fn given_data_keep_their_violation() {
+        for given in [
+            Given::InitialState,
+            Given::Start,
+            Given::Goal,
+            Given::Separated,
+        ] {
+            for element in [None, Some(7)] {
+                let violation = DomainViolation {
+                    expression: "q - 1.0",
+                    kind: DomainKind::PowfBase,
+                    element,
+                };
+                assert_eq!(Error::given(given, violation).violation(), Some(violation));
+            }
+        }
+        let huge = DomainViolation {
+            expression: "q",
+            kind: DomainKind::Denominator,
+            element: Some(usize::MAX),
+        };
+        let kept = Error::given(Given::Start, huge)
+            .violation()
+            .map(|v| v.element);
+        assert_eq!(kept, Some(Some(u32::MAX as usize)));
+        assert_eq!(Error::SingularJacobian { iteration: 1 }.violation(), None);
+    }
+
+    #[test]
+    fn only_a_step_advises_a_smaller_step() {
+        for (error, _) in cases() {
+            let message = error.to_string();
+            let step = matches!(
+                error,
+                Error::NoConvergence { .. } | Error::LineSearchFailed { .. }
+            );
+            assert_eq!(
+                message.contains("step halving") || message.contains("reduce the step size"),
+                step,
+                "{message}"
+            );
+        }
     }
 
     #[test]

@@ -632,10 +632,13 @@ where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
     /// `steps` reduced steps of size `h` from `z0`, with the driver of [`crate::trajectory`]
-    /// (step halving, domain crossing location).
+    /// (the initial state checked against the domain, step halving, domain crossing
+    /// location).
     ///
     /// # Errors
-    /// [`crate::Interrupted`] with the states before the failed step.
+    /// [`crate::Interrupted`] with the states before the failed step; a `z0` outside the
+    /// domain of the Lagrangian is [`Error::InitialStateOutsideDomain`] at step 0, as in
+    /// [`crate::trajectory`].
     pub fn trajectory(
         &mut self,
         z0: &SVector<f64, S>,
@@ -643,7 +646,9 @@ where
         steps: usize,
         options: &StepOptions,
     ) -> Result<crate::Trajectory<S>, crate::Interrupted<S>> {
-        crate::step::drive(
+        let system = self.system;
+        crate::step::drive_system::<Sys, S, M>(
+            system,
             |z: &SVector<f64, S>, h, o: &StepOptions| self.step(z, h, o),
             z0,
             h,

@@ -226,6 +226,87 @@ where
     Ok(())
 }
 
+/// The unknowns $w = (z, u)$ of a step that ends at `z` with the top derivative `u` (entries
+/// of $w$ beyond `z` and `u` zero).
+#[cfg(feature = "std")]
+pub(crate) fn unknowns_at<const S: usize, const M: usize>(
+    z: &SVector<f64, S>,
+    u: &[f64],
+) -> SVector<f64, M> {
+    SVector::from_fn(|r, _| {
+        if r < S {
+            z[r]
+        } else {
+            u.get(r - S).copied().unwrap_or(0.0)
+        }
+    })
+}
+
+/// The domain check of the state `z` alone, with the top derivative `u`: a step of length zero
+/// (its three points coincide), so only what must hold at every point is checked: a
+/// denominator finite and non-zero, a `sqrt` argument $\ge 0$, an `ln` argument and a `powf`
+/// base $> 0$. Which side of a denominator's zero `z` lies on is not a condition (the guard
+/// asks only that the side not change along a step); [`check_same_side`] compares two states.
+///
+/// # Errors
+/// The first violated condition.
+#[cfg(feature = "std")]
+pub(crate) fn check_point_domain<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z: &SVector<f64, S>,
+    u: &[f64],
+) -> Result<(), crate::DomainViolation>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    system.check_domain(z, &unknowns_at::<S, M>(z, u), 0.5)
+}
+
+/// Whether the states `a` and `b` lie on the same side of every guarded expression, without
+/// looking at any path between them: the check of a "step" from `a` to `b` at $\theta = 1$,
+/// whose evaluation point is `b` itself (and where the generated guard does not fit a
+/// quadratic between the points), with the top derivative `u` at both.
+///
+/// # Errors
+/// The first guarded expression whose sign differs (or that fails at either state).
+#[cfg(feature = "std")]
+pub(crate) fn check_same_side<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    a: &SVector<f64, S>,
+    b: &SVector<f64, S>,
+    u: &[f64],
+) -> Result<(), crate::DomainViolation>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    system.check_domain(a, &unknowns_at::<S, M>(b, u), 1.0)
+}
+
+/// The initial state of a trajectory against the domain of the Lagrangian
+/// ([`check_point_domain`]), with its own top derivative (from the predictor; zero if the
+/// vector field cannot be evaluated there). A finite state that fails is
+/// [`Error::InitialStateOutsideDomain`]; non-finite states are left to the driver.
+#[cfg(feature = "std")]
+fn check_initial_state<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    options: &StepOptions,
+) -> Result<(), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    if !options.check_domain || !z0.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    let w = system
+        .predictor(z0, 0.0, 0.5)
+        .ok()
+        .filter(|w| w.iter().all(|v| v.is_finite()));
+    let u = w.as_ref().map_or(&[][..], |w| &w.as_slice()[S.min(M)..]);
+    check_point_domain::<Sys, S, M>(system, z0, u)
+        .map_err(|violation| Error::given(crate::error::Given::InitialState, violation))
+}
+
 /// What the Newton solve of one step reported.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepReport {
@@ -362,7 +443,10 @@ impl<const S: usize> Trajectory<S> {
 
 #[cfg(feature = "std")]
 /// A trajectory that stopped at a failed step. Nothing computed before it is lost.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Its `Debug` output summarises the trajectory (step size, number of states and reports,
+/// the last state) instead of listing every state.
+#[derive(Clone, PartialEq)]
 pub struct Interrupted<const S: usize> {
     /// The states up to and including the last valid one.
     pub trajectory: Trajectory<S>,
@@ -402,6 +486,34 @@ impl<const S: usize> core::fmt::Display for Interrupted<S> {
 }
 
 #[cfg(feature = "std")]
+impl<const S: usize> core::fmt::Debug for Interrupted<S> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        /// The trajectory as counts and its last state.
+        struct Summary<'a, const S: usize>(&'a Trajectory<S>);
+        impl<const S: usize> core::fmt::Debug for Summary<'_, S> {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                let trajectory = self.0;
+                f.debug_struct("Trajectory")
+                    .field("h", &trajectory.h)
+                    .field("states", &trajectory.states.len())
+                    .field("reports", &trajectory.reports.len())
+                    .field(
+                        "last_state",
+                        &trajectory.states.last().map(|z| z.as_slice()),
+                    )
+                    .finish()
+            }
+        }
+        f.debug_struct("Interrupted")
+            .field("step", &self.step)
+            .field("error", &self.error)
+            .field("crossing_time", &self.crossing_time)
+            .field("trajectory", &Summary(&self.trajectory))
+            .finish()
+    }
+}
+
+#[cfg(feature = "std")]
 impl<const S: usize> core::error::Error for Interrupted<S> {}
 
 /// A one-step map `(z, h, options) -> (z_1, report)`: [`step`] or
@@ -419,10 +531,19 @@ impl<F, const S: usize> OneStep<S> for F where
 #[cfg(feature = "std")]
 /// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
 ///
+/// With [`StepOptions::check_domain`] on, `z0` itself is checked first: a state where a
+/// guarded expression of $L$ fails (a denominator vanishes, a `sqrt` argument is negative, an
+/// `ln` argument is not positive) stops the trajectory at step 0 with
+/// [`Error::InitialStateOutsideDomain`] (no state kept). Which side of a denominator's zero
+/// `z0` lies on is not known to the guard: a state inside a barrier obstacle
+/// $\tau / (|q - c|^2 - r^2)$ is reported only when a step crosses the circle
+/// ([`Error::Domain`]).
+///
 /// # Errors
 /// [`Interrupted`], with the trajectory computed so far, at the first failed step (with no
-/// state at all for a non-finite `z0`, or with [`Error::InvalidArgument`] for `steps` whose
-/// states and reports cannot be allocated, e.g. $2^{40}$ or `usize::MAX`).
+/// state at all for a non-finite `z0` or one outside the domain, or with
+/// [`Error::InvalidArgument`] for `steps` whose states and reports cannot be allocated, e.g.
+/// $2^{40}$ or `usize::MAX`).
 pub fn trajectory<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
@@ -433,8 +554,33 @@ pub fn trajectory<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
-    drive(
+    drive_checked(
         |z: &SVector<f64, S>, h, o: &StepOptions| step(system, z, h, o),
+        |z: &SVector<f64, S>| check_initial_state::<Sys, S, M>(system, z, options),
+        z0,
+        h,
+        steps,
+        options,
+    )
+}
+
+#[cfg(feature = "std")]
+/// [`trajectory`] of a [`crate::ReducedStepper`]: [`drive`] with the initial state checked as
+/// in [`trajectory`].
+pub(crate) fn drive_system<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    one: impl OneStep<S>,
+    z0: &SVector<f64, S>,
+    h: f64,
+    steps: usize,
+    options: &StepOptions,
+) -> Result<Trajectory<S>, Interrupted<S>>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    drive_checked(
+        one,
+        |z: &SVector<f64, S>| check_initial_state::<Sys, S, M>(system, z, options),
         z0,
         h,
         steps,
@@ -445,12 +591,28 @@ where
 #[cfg(feature = "std")]
 /// The trajectory driver over any one-step map: `steps` steps of size `h`, halving a failed
 /// step when [`StepOptions::max_halvings`] allows, locating a domain crossing when
-/// [`StepOptions::locate_crossing`] is set.
+/// [`StepOptions::locate_crossing`] is set. The one-step map carries no system, so `z0` is not
+/// checked against the domain of the Lagrangian before the first step, as [`trajectory`] and
+/// [`crate::ReducedStepper::trajectory`] do.
 ///
 /// # Errors
-/// As [`trajectory`].
+/// As [`trajectory`], without [`Error::InitialStateOutsideDomain`].
 pub fn drive<const S: usize>(
+    one: impl OneStep<S>,
+    z0: &SVector<f64, S>,
+    h: f64,
+    steps: usize,
+    options: &StepOptions,
+) -> Result<Trajectory<S>, Interrupted<S>> {
+    drive_checked(one, |_: &SVector<f64, S>| Ok(()), z0, h, steps, options)
+}
+
+#[cfg(feature = "std")]
+/// [`drive`], with `initial` run on a finite `z0` before the first step (its error stops the
+/// trajectory at step 0 with no state kept).
+fn drive_checked<const S: usize>(
     mut one: impl OneStep<S>,
+    initial: impl FnOnce(&SVector<f64, S>) -> Result<(), Error>,
     z0: &SVector<f64, S>,
     h: f64,
     steps: usize,
@@ -477,6 +639,14 @@ pub fn drive<const S: usize>(
                 iteration: 0,
                 location: "initial state",
             },
+            crossing_time: None,
+        });
+    }
+    if let Err(error) = initial(z0) {
+        return Err(Interrupted {
+            trajectory,
+            step: 0,
+            error,
             crossing_time: None,
         });
     }

@@ -517,6 +517,11 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     ///
     /// # Errors
     /// A [`PlanError`] with the [`Failure`] and, after the first iteration, the last iterate.
+    /// Boundary jets that no guess can repair are refused before any iteration as
+    /// [`Failure::Invalid`]: a start or goal outside the domain of the Lagrangian
+    /// ([`Error::StartOutsideDomain`], [`Error::GoalOutsideDomain`]) or on the other side of
+    /// one of its singularities than the other end, e.g. inside an obstacle
+    /// ([`Error::BoundariesSeparated`]).
     pub fn solve<const S: usize, const M: usize>(
         &self,
         guess: PlanGuess<'_, N, X>,
@@ -536,6 +541,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }));
         }
         let iterate = self.initial(guess).map_err(invalid)?;
+        self.check_ends::<S, M>(&iterate).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {
             return Err(PlanError {
                 failure: Failure::GuessOutsideDomain { step, violation },
@@ -637,6 +643,30 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             return Err(wrong("the guess must be finite"));
         }
         Ok(iterate)
+    }
+
+    /// The boundary jets against the domain of the Lagrangian
+    /// ([`super::root_finder::check_boundary`], momenta zero as in [`Self::guard`], the
+    /// guess's top derivatives of the first and last steps).
+    fn check_ends<const S: usize, const M: usize>(
+        &self,
+        iterate: &Iterate<N, X>,
+    ) -> Result<(), Error>
+    where
+        Sys: LiftedSystem<S, M>,
+    {
+        let state =
+            |x: &SVector<f64, X>| SVector::<f64, S>::from_fn(|r, _| if r < X { x[r] } else { 0.0 });
+        let (Some(first), Some(last)) = (iterate.u.first(), iterate.u.last()) else {
+            return Ok(());
+        };
+        super::root_finder::check_boundary::<Sys, S, M>(
+            self.system,
+            &state(&self.start),
+            &state(&self.goal),
+            first.as_slice(),
+            last.as_slice(),
+        )
     }
 
     /// The singularity guard on every step ([`crate::step::check_step_domain`]): at its ends,

@@ -231,6 +231,57 @@ fn filled<T: Clone>(len: usize, value: T, name: &'static str) -> Result<Vec<T>, 
     Ok(out)
 }
 
+/// The boundary data against the domain of the Lagrangian, before any iteration: `start` and
+/// `goal` (states whose jets are the boundary jets) each alone
+/// ([`crate::step::check_point_domain`]: [`Error::StartOutsideDomain`],
+/// [`Error::GoalOutsideDomain`]), then against each other
+/// ([`crate::step::check_same_side`]: [`Error::BoundariesSeparated`], a guarded expression
+/// with opposite signs at the two ends, which every path between them must cross). No guess
+/// changes the boundary jets, so none can repair these. The guards are evaluated with the
+/// guess's top derivatives at the ends (`u_start`, `u_goal`) and a violation counts only if it
+/// persists with $u = 0$: a guard on the top derivative that a different guess could satisfy
+/// is left to the checks of the guess.
+///
+/// # Errors
+/// The first failure, start before goal.
+pub(super) fn check_boundary<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    start: &SVector<f64, S>,
+    goal: &SVector<f64, S>,
+    u_start: &[f64],
+    u_goal: &[f64],
+) -> Result<(), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    use crate::error::Given;
+    use crate::step::{check_point_domain, check_same_side};
+    let zero = [0.0; 0];
+    // the violation with the guess's u, if it persists with u = 0
+    let both = |check: &dyn Fn(&[f64]) -> Result<(), crate::DomainViolation>, u: &[f64]| match (
+        check(u),
+        check(&zero),
+    ) {
+        (Err(violation), Err(_)) => Err(violation),
+        _ => Ok(()),
+    };
+    both(
+        &|u| check_point_domain::<Sys, S, M>(system, start, u),
+        u_start,
+    )
+    .map_err(|violation| Error::given(Given::Start, violation))?;
+    both(
+        &|u| check_point_domain::<Sys, S, M>(system, goal, u),
+        u_goal,
+    )
+    .map_err(|violation| Error::given(Given::Goal, violation))?;
+    both(
+        &|u| check_same_side::<Sys, S, M>(system, start, goal, u),
+        u_start,
+    )
+    .map_err(|violation| Error::given(Given::Separated, violation))
+}
+
 fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -468,10 +519,15 @@ where
     /// Solves the problem from `guess`.
     ///
     /// # Errors
-    /// [`Error::InvalidArgument`] for inconsistent data; Newton failures
-    /// ([`Error::NonFinite`], [`Error::SingularJacobian`], [`Error::LineSearchFailed`],
-    /// [`Error::NoConvergence`]); [`Error::ThroughObstacle`] for a solution with negative
-    /// clearance.
+    /// [`Error::InvalidArgument`] for inconsistent data; boundary data no guess can repair,
+    /// before any iteration: a start or goal inside an obstacle of the clearance function
+    /// ([`Error::BoundaryInObstacle`]), outside the domain of the Lagrangian
+    /// ([`Error::StartOutsideDomain`], [`Error::GoalOutsideDomain`]) or on the other side of
+    /// one of its singularities than the other end ([`Error::BoundariesSeparated`]);
+    /// [`Error::GuessThroughObstacle`] for a first guess through an obstacle; Newton failures
+    /// ([`Error::NonFinite`], [`Error::SingularJacobian`],
+    /// [`Error::BoundaryValueLineSearchFailed`], [`Error::BoundaryValueNoConvergence`]);
+    /// [`Error::ThroughObstacle`] for a solution with negative clearance.
     pub fn solve(&self, guess: Guess<'_, S, M>) -> Result<BvpSolution<S, M>, Error> {
         let system = self.system;
         let (h, theta) = (self.h(), self.options.theta);
@@ -526,6 +582,7 @@ where
             Guess::Solution(previous) => self.guess_from_solution(previous)?,
             Guess::States(states) => self.guess_from_states(states)?,
         };
+        self.check_ends(&v, &mut buffer)?;
         if let Some((obstacle, step, clearance)) = self.first_collision(&v, &mut buffer) {
             return Err(Error::GuessThroughObstacle {
                 obstacle,
@@ -546,7 +603,7 @@ where
         let mut iterations = 0;
         while r_norm > options.residual_tolerance {
             if iterations == options.max_iterations {
-                return Err(Error::NoConvergence {
+                return Err(Error::BoundaryValueNoConvergence {
                     iterations,
                     residual_norm: r_norm,
                 });
@@ -569,7 +626,7 @@ where
                 accepted = self.line_search(&v, &r, &delta, &mut trial, &mut r_trial);
             }
             if !accepted {
-                return Err(Error::LineSearchFailed {
+                return Err(Error::BoundaryValueLineSearchFailed {
                     iteration: iterations,
                     residual_norm: r_norm,
                 });
@@ -631,6 +688,41 @@ where
             alpha *= 0.5;
         }
         false
+    }
+
+    /// The boundary data that no guess can repair: the guess's first and last states with
+    /// their jets set to `start` and `goal` (momenta and top derivatives of the guess), each
+    /// inside no obstacle of the clearance function ([`Error::BoundaryInObstacle`]), then
+    /// [`check_boundary`]. `buffer` holds one clearance per obstacle.
+    fn check_ends(&self, v: &[f64], buffer: &mut [f64]) -> Result<(), Error> {
+        let nk = S / 2;
+        let end = |i: usize, jet: &[f64]| {
+            let mut z = self.state(v, i);
+            for (e, &x) in z.iter_mut().zip(jet).take(nk) {
+                *e = x;
+            }
+            z
+        };
+        let (start, goal) = (end(0, self.start), end(self.steps, self.goal));
+        if let Some((_, f)) = self.clearance {
+            for (end, z) in [("start", &start), ("goal", &goal)] {
+                f(z, buffer);
+                if let Some((obstacle, &clearance)) = buffer
+                    .iter()
+                    .enumerate()
+                    .find(|(_, c)| c.is_nan() || **c < 0.0)
+                {
+                    return Err(Error::BoundaryInObstacle {
+                        end,
+                        obstacle,
+                        clearance,
+                    });
+                }
+            }
+        }
+        let layout = self.layout();
+        let u = |i: usize| &v[layout.u(i)..layout.u(i) + M - S];
+        check_boundary::<Sys, S, M>(self.system, &start, &goal, u(0), u(self.steps - 1))
     }
 
     /// The number of obstacles of the clearance function (0 without one).

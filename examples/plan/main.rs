@@ -3,7 +3,8 @@
 //! position and velocity given at both ends. The obstacles are a run-time list (a slice
 //! parameter of the generated Lagrangian), so one compiled planner serves every scene.
 //!
-//! Scene files (TOML):
+//! Scene files (TOML, parsed strictly and checked by `scene.rs`: an unknown key or a value
+//! out of range is an error naming the key, and the example exits with status 1):
 //!
 //! ```toml
 //! horizon = 4.0            # T
@@ -16,7 +17,7 @@
 //! [goal]                   # q(T) and q'(T)
 //! position = [2.0, 0.3, 1.57]
 //! velocity = [1.0, 0.0, 0.0]
-//! [[obstacles]]            # any number of discs
+//! [[obstacles]]            # any number of discs (`center` is accepted for `centre`)
 //! centre = [0.0, 0.0]
 //! radius = 1.0
 //! ```
@@ -29,16 +30,19 @@
 //! Run: `cargo run --release --example plan [scene.toml] [figure.svg]`
 //! (defaults: `examples/scenes/slalom.toml`, `docs/plan.svg`).
 
+#[path = "../common/mod.rs"]
 mod common;
+mod scene;
 
 use std::error::Error;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use retract::LiftedSystem;
 use retract::bvp::{BvpOptions, ClearanceFn, Guess, continuation};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{SVector, Vector2};
-use serde::Deserialize;
+use scene::Scene;
 
 /// The planner's Lagrangian: minimum acceleration plus a barrier per disc (cx, cy, r).
 #[higher_order_lagrangian(order = 2)]
@@ -48,38 +52,6 @@ fn planar_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, obstacles: &
         l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);
     }
     l
-}
-
-#[derive(Deserialize)]
-struct Scene {
-    horizon: f64,
-    steps: usize,
-    barrier: f64,
-    #[serde(default)]
-    continuation: Vec<f64>,
-    start: Boundary,
-    goal: Boundary,
-    #[serde(default)]
-    obstacles: Vec<Obstacle>,
-}
-
-#[derive(Deserialize)]
-struct Boundary {
-    position: [f64; 3],
-    velocity: [f64; 3],
-}
-
-#[derive(Deserialize)]
-struct Obstacle {
-    centre: [f64; 2],
-    radius: f64,
-}
-
-impl Boundary {
-    fn jet(&self) -> [f64; 6] {
-        let (p, v) = (self.position, self.velocity);
-        [p[0], p[1], p[2], v[0], v[1], v[2]]
-    }
 }
 
 /// Cubic Hermite interpolation of (position, velocity) at 0 and T, component `i`.
@@ -173,14 +145,15 @@ fn guess_states(scene: &Scene, system: &PlanarBody<'_>) -> Vec<SVector<f64, 12>>
 
 fn run() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
-    let scene_path = args.next().unwrap_or_else(|| {
-        concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/slalom.toml").into()
-    });
+    let scene_path: PathBuf = args.next().map_or_else(
+        || concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/slalom.toml").into(),
+        Into::into,
+    );
     let figure = args
         .next()
         .map(Into::into)
         .unwrap_or_else(|| common::docs_path("plan.svg"));
-    let scene: Scene = toml::from_str(&std::fs::read_to_string(&scene_path)?)?;
+    let scene = scene::load(&scene_path)?;
     let discs: Vec<[f64; 3]> = scene
         .obstacles
         .iter()
@@ -224,7 +197,7 @@ fn run() -> Result<(), Box<dyn Error>> {
     )?;
     let elapsed = started.elapsed();
 
-    println!("scene: {scene_path}");
+    println!("scene: {}", scene_path.display());
     println!(
         "T = {}, N = {}, barrier weights {:?}, {} obstacles",
         scene.horizon,
