@@ -42,8 +42,11 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     {
         scale = scale.max(gx.amax() / h).max(gu.amax() / h);
         // the gradient of the stage's Lagrangian h L - h z^T g_ineq + y^T g_eq
-        let gx = gx + stage.cx.transpose() * y;
-        let gu = gu + stage.cu.transpose() * y;
+        let (gx, gu) = if stage.constraints > 0 {
+            (gx + stage.cx.transpose() * y, gu + stage.cu.transpose() * y)
+        } else {
+            (*gx, *gu)
+        };
         let mu = -(wt * (lambda + gx * theta));
         let d = gx - shift_t(&mu) * h;
         for a in 0..N {

@@ -334,10 +334,18 @@ where
                 &models.r0,
                 &models.r_end,
             );
-            let mut gradients = models.cost_gradient.clone();
-            barrier.lagrangian_gradients(&mut gradients, &models.inequalities, h);
+            // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
+            let with_inequalities;
+            let gradients = if count > 0 {
+                let mut g = models.cost_gradient.clone();
+                barrier.lagrangian_gradients(&mut g, &models.inequalities, h);
+                with_inequalities = g;
+                &with_inequalities
+            } else {
+                &models.cost_gradient
+            };
             let (momenta, stationarity) =
-                kkt_residuals(&self.dynamics, &models.stages, &gradients, &direction);
+                kkt_residuals(&self.dynamics, &models.stages, gradients, &direction);
             let (complementarity, complementarity_error) = barrier.complementarity();
             let certificate = Certificate {
                 stationarity,
