@@ -11,6 +11,7 @@ use crate::graph::{Graph, Var};
 use crate::lower::{Guard, GuardKind, Lower};
 use crate::mechanics::{self, Degenerate, Mechanics};
 use crate::signature::{self, Attribute, Kind, Signature};
+use crate::util::{combine, tidy};
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
@@ -22,16 +23,6 @@ pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
             quote!(#item #errors)
         }
     }
-}
-
-/// Combines several errors into one that reports all of them.
-pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
-    let mut iter = errors.into_iter();
-    let mut first = iter.next()?;
-    for e in iter {
-        first.combine(e);
-    }
-    Some(first)
 }
 
 /// The expansion, or the errors of the input combined into one `syn::Error`.
@@ -277,27 +268,6 @@ fn domain_check(
                 #test
             }
         });
-    }
-    out
-}
-
-/// Token text with the spaces that `to_string` puts around `.`, `[` and calls removed.
-pub(crate) fn tidy(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let chars: Vec<char> = text.chars().collect();
-    for (i, &c) in chars.iter().enumerate() {
-        if c == ' ' {
-            let prev = if i > 0 { chars[i - 1] } else { ' ' };
-            let next = chars.get(i + 1).copied().unwrap_or(' ');
-            let glue = next == '.'
-                || prev == '.'
-                || next == '['
-                || (next == '(' && (prev.is_alphanumeric() || prev == '_'));
-            if glue {
-                continue;
-            }
-        }
-        out.push(c);
     }
     out
 }
@@ -1289,11 +1259,6 @@ mod tests {
         })?;
         let file: syn::File = syn::parse2(tokens).map_err(|e| e.to_string())?;
         Ok(prettyplease::unparse(&file))
-    }
-
-    #[test]
-    fn tidy_joins_calls_and_indexing() {
-        assert_eq!(tidy("q [0] . powi (2) + (a * b)"), "q[0].powi(2) + (a * b)");
     }
 
     #[test]

@@ -11,13 +11,13 @@ use quote::{ToTokens, quote};
 use syn::ItemFn;
 
 use crate::expand::{
-    ParamTokens, ScalarBodies, allow_generated, callable, combine, param_tokens, scalar_bodies,
-    tidy,
+    ParamTokens, ScalarBodies, allow_generated, callable, param_tokens, scalar_bodies,
 };
 use crate::graph::Graph;
 use crate::lower::Lower;
 use crate::mechanics;
 use crate::signature::{self, Attribute};
+use crate::util::{combine, tidy};
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
 /// so the rest of the crate still type-checks. Never panics.

@@ -19,6 +19,7 @@ mod jet_function;
 mod lower;
 mod mechanics;
 mod signature;
+mod util;
 
 pub mod samples;
 

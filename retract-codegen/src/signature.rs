@@ -13,6 +13,8 @@ use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
 use syn::{FnArg, Ident, ItemFn, Pat, ReturnType, Type};
 
+use crate::util::combine;
+
 /// Highest supported order.
 pub const MAX_ORDER: usize = 4;
 
@@ -405,7 +407,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             Ident::new("Lagrangian", sig.ident.span())
         }),
     };
-    if let Some(e) = crate::expand::combine(errors) {
+    if let Some(e) = combine(errors) {
         return Err(e);
     }
     Ok(Signature {
