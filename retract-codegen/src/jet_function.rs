@@ -10,9 +10,8 @@ use proc_macro2::TokenStream;
 use quote::{ToTokens, quote};
 use syn::ItemFn;
 
-use crate::expand::{
-    ParamTokens, ScalarBodies, allow_generated, callable, param_tokens, scalar_bodies,
-};
+use crate::emit::helpers::{ParamTokens, allow_generated, callable, param_tokens};
+use crate::emit::scalar::{ScalarBodies, scalar_bodies};
 use crate::graph::Graph;
 use crate::lower::Lower;
 use crate::mechanics;

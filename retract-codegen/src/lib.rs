@@ -13,6 +13,7 @@
 
 mod codegen;
 mod diff;
+mod emit;
 mod expand;
 mod graph;
 mod jet_function;
