@@ -65,7 +65,7 @@ impl Leaves for Names<'_> {
     }
 }
 
-/// q^(order)[i] inside a method taking `(x, u)`: `x[order][i]` below the top order k,
+/// `q^(order)[i]` inside a method taking `(x, u)`: `x[order][i]` below the top order k,
 /// `u[i]` at it.
 pub(crate) fn xu_leaf(k: usize, order: u8, i: u32) -> TokenStream {
     let i = index(i as usize);
