@@ -100,7 +100,7 @@ pub(crate) fn allow_generated() -> TokenStream {
 
 /// The annotated function as it is re-emitted: the generated code does not call it; it
 /// stays for users to call.
-pub(crate) fn callable(function: &ItemFn) -> ItemFn {
+fn callable(function: &ItemFn) -> ItemFn {
     let mut function = function.clone();
     function.block.stmts.insert(
         0,
@@ -113,6 +113,49 @@ pub(crate) fn callable(function: &ItemFn) -> ItemFn {
         .attrs
         .push(syn::parse_quote!(#[allow(dead_code, clippy::too_many_arguments)]));
     function
+}
+
+/// The annotated function, re-emitted (`callable`), the parameter struct of `sig` documented
+/// by `doc`, and its inherent impl: the constants `consts`, then the constructor `new`
+/// documented by `new_doc` (a doc comment). Shared by the Lagrangian (`emit::ty`) and
+/// `#[jet_function]`.
+pub(crate) fn function_and_type(
+    function: &ItemFn,
+    sig: &Signature,
+    params: &ParamTokens,
+    doc: &str,
+    consts: TokenStream,
+    new_doc: TokenStream,
+) -> TokenStream {
+    let ParamTokens {
+        generics,
+        ty_full,
+        fields,
+        ctor_args,
+        field_names,
+    } = params;
+    let (vis, ty) = (&function.vis, &sig.type_name);
+    let function = callable(function);
+    quote! {
+        #function
+
+        #[doc = #doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        #vis struct #ty #generics {
+            #(#fields,)*
+        }
+
+        #[automatically_derived]
+        impl #generics #ty_full {
+            #consts
+
+            #new_doc
+            #[allow(clippy::too_many_arguments)]
+            pub fn new(#(#ctor_args),*) -> Self {
+                Self { #(#field_names),* }
+            }
+        }
+    }
 }
 
 /// The pieces of the generated parameter struct.

@@ -8,7 +8,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Emission;
-use super::helpers::{Names, ParamTokens, index, xu_leaf};
+use super::helpers::{Names, index, xu_leaf};
 use super::scalar::{ScalarBodies, scalar_bodies};
 use crate::codegen::{constant, emit};
 use crate::mechanics::LegendreInverse;
@@ -26,12 +26,9 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
         vec_n,
         jet_blocks,
         float,
-        allow,
         ..
     } = e;
-    let ParamTokens {
-        generics, ty_full, ..
-    } = &e.params;
+    let header = e.impl_header(quote!(Lagrangian<#n_lit, #k_lit>));
     let ScalarBodies {
         value: l_body,
         gradient: g_body,
@@ -44,9 +41,7 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
         .map(|inv| top_derivative(e, inv));
 
     quote! {
-        #[automatically_derived]
-        #allow
-        impl #generics #core::Lagrangian<#n_lit, #k_lit> for #ty_full {
+        #header {
             /// L(x, u), straight-line code of the annotated function.
             fn lagrangian(&self, x: &#jet_blocks, u: &#vec_n) -> f64 {
                 #l_body

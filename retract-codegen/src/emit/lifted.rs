@@ -10,7 +10,7 @@ use quote::quote;
 
 use super::Emission;
 use super::domain::check_domain;
-use super::helpers::{ParamTokens, index};
+use super::helpers::index;
 use crate::codegen::emit;
 
 /// `impl LiftedSystem<s, m>`.
@@ -30,12 +30,9 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
         vec_m,
         vec_m_path,
         float,
-        allow,
         ..
     } = e;
-    let ParamTokens {
-        generics, ty_full, ..
-    } = &e.params;
+    let header = e.impl_header(quote!(LiftedSystem<#s_lit, #m_lit>));
     let residual = emit(g, &mech.residual, &e.scheme());
     let r_stmts = residual.stmts;
     let r_sets = mech.residual.iter().enumerate().filter_map(|(r, &id)| {
@@ -46,14 +43,12 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
         let r = index(r);
         Some(quote!(__out[#r] = #v;))
     });
-    let (j_stmts, j_sets) = e.matrix_sets(&mech.jacobian, *m);
-    let (ji_stmts, ji_sets) = e.matrix_sets(&mech.jacobian_initial, *s);
+    let jacobian = e.matrix_body(&mech.jacobian, *m);
+    let jacobian_initial = e.matrix_body(&mech.jacobian_initial, *s);
     let check_domain = check_domain(e);
 
     quote! {
-        #[automatically_derived]
-        #allow
-        impl #generics #core::LiftedSystem<#s_lit, #m_lit> for #ty_full {
+        #header {
             const DIMENSION: usize = #n_lit;
             const ORDER: usize = #k_lit;
 
@@ -89,11 +84,7 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
                 h: f64,
                 theta: f64,
             ) -> #na::SMatrix<f64, #m_lit, #m_lit> {
-                #float
-                #j_stmts
-                let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
-                #(#j_sets)*
-                __out
+                #jacobian
             }
 
             /// dF/dz0 of the lifted theta-scheme; structural zeros are not computed.
@@ -104,11 +95,7 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
                 h: f64,
                 theta: f64,
             ) -> #na::SMatrix<f64, #m_lit, #s_lit> {
-                #float
-                #ji_stmts
-                let mut __out = #na::SMatrix::<f64, #m_lit, #s_lit>::zeros();
-                #(#ji_sets)*
-                __out
+                #jacobian_initial
             }
 
             /// h L(x_theta, u), the cost of one step.

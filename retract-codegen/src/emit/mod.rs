@@ -132,6 +132,20 @@ impl<'a> Emission<'a> {
         }
     }
 
+    /// The head of the impl of `retract_core::#trait_` for the generated type:
+    /// `#[automatically_derived]`, the allowed lints and `impl<'a> ... for Type<'a>`.
+    pub fn impl_header(&self, trait_: TokenStream) -> TokenStream {
+        let (core, allow) = (&self.core, &self.allow);
+        let ParamTokens {
+            generics, ty_full, ..
+        } = &self.params;
+        quote! {
+            #[automatically_derived]
+            #allow
+            impl #generics #core::#trait_ for #ty_full
+        }
+    }
+
     /// The leaves inside the methods of the scheme, which read z0, w, h, theta and the
     /// parameters (never the jet, named NaN).
     pub fn scheme(&self) -> Names<'a> {
@@ -141,9 +155,10 @@ impl<'a> Emission<'a> {
         }
     }
 
-    /// The statements and the `__out[(r, c)] = ...;` assignments of a matrix with `cols`
-    /// columns, row-major `entries`, in the scheme's leaves; structural zeros are skipped.
-    pub fn matrix_sets(&self, entries: &[Id], cols: usize) -> (TokenStream, Vec<TokenStream>) {
+    /// The body of a method returning the m x `cols` matrix with the row-major `entries`, in
+    /// the scheme's leaves: straight-line code, then `__out[(r, c)] = ...;` for the structural
+    /// nonzeros only.
+    pub fn matrix_body(&self, entries: &[Id], cols: usize) -> TokenStream {
         let g = self.g;
         let code = emit(g, entries, &self.scheme());
         let sets: Vec<TokenStream> = entries
@@ -156,7 +171,26 @@ impl<'a> Emission<'a> {
                 quote!(__out[(#r, #c)] = #v;)
             })
             .collect();
-        (code.stmts, sets)
+        self.matrix_out(&code.stmts, &sets, &self.m_lit, &index(cols))
+    }
+
+    /// A method body: `stmts`, then `__out`, a `rows` x `cols` matrix of zeros with `sets`
+    /// assigned.
+    pub fn matrix_out(
+        &self,
+        stmts: &TokenStream,
+        sets: &[TokenStream],
+        rows: &Literal,
+        cols: &Literal,
+    ) -> TokenStream {
+        let (na, float) = (&self.na, &self.float);
+        quote! {
+            #float
+            #stmts
+            let mut __out = #na::SMatrix::<f64, #rows, #cols>::zeros();
+            #(#sets)*
+            __out
+        }
     }
 }
 

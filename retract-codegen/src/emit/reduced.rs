@@ -15,7 +15,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::Emission;
-use super::helpers::{ParamTokens, index, signed_sum, sum_tree};
+use super::helpers::{index, signed_sum, sum_tree};
 use crate::codegen::{Emitted, constant, emit};
 use crate::graph::Id;
 use crate::mechanics::{self, Reduced};
@@ -149,16 +149,8 @@ impl<'a> Reduction<'a> {
     /// The impl: the core, forced rows and blocks as constants, then its methods.
     fn scheme_impl(&self) -> TokenStream {
         let Emission {
-            core,
-            s_lit,
-            m_lit,
-            m,
-            allow,
-            ..
+            s_lit, m_lit, m, ..
         } = self.e;
-        let ParamTokens {
-            generics, ty_full, ..
-        } = &self.e.params;
         let (red, r, r_lit) = (self.red, self.r, &self.r_lit);
         let core_list = red.core.iter().map(|&c| index(c));
         let forced_list = red.rows.iter().map(|&q| index(q));
@@ -177,6 +169,9 @@ impl<'a> Reduction<'a> {
         );
         let residual_entries = self.residual_entries();
         let forcing_lets = self.forcing_lets();
+        let header = self
+            .e
+            .impl_header(quote!(ReducedScheme<#s_lit, #m_lit, #r_lit>));
         let linear_parts = self.linear_parts();
         let core_offset = self.core_offset();
         let core_system = self.core_system(&residual_entries);
@@ -187,9 +182,7 @@ impl<'a> Reduction<'a> {
         let recover = self.recover(&forcing_lets);
         quote! {
             #[doc = #doc]
-            #[automatically_derived]
-            #allow
-            impl #generics #core::ReducedScheme<#s_lit, #m_lit, #r_lit> for #ty_full {
+            #header {
                 const CORE: [usize; #r_lit] = [#(#core_list),*];
                 const FORCED: &'static [usize] = &[#(#forced_list),*];
                 const BLOCKS: &'static [(&'static [usize], &'static [usize])] = &[#(#block_list),*];
@@ -221,28 +214,19 @@ impl<'a> Reduction<'a> {
             m,
             s_lit,
             m_lit,
-            float,
             ..
         } = self.e;
-        let (a_stmts, a_sets) = self.e.matrix_sets(&self.red.linear, *m);
-        let (b_stmts, b_sets) = self.e.matrix_sets(&self.red.initial, *s);
+        let linear = self.e.matrix_body(&self.red.linear, *m);
+        let initial = self.e.matrix_body(&self.red.initial, *s);
         quote! {
             /// A = dF/dw at fixed y.
             fn linear_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #m_lit> {
-                #float
-                #a_stmts
-                let mut __out = #na::SMatrix::<f64, #m_lit, #m_lit>::zeros();
-                #(#a_sets)*
-                __out
+                #linear
             }
 
             /// B = dF/dz0 at fixed y.
             fn initial_part(&self, h: f64, theta: f64) -> #na::SMatrix<f64, #m_lit, #s_lit> {
-                #float
-                #b_stmts
-                let mut __out = #na::SMatrix::<f64, #m_lit, #s_lit>::zeros();
-                #(#b_sets)*
-                __out
+                #initial
             }
         }
     }
@@ -412,13 +396,7 @@ impl<'a> Reduction<'a> {
 
     /// The method `forcing_jacobian`: dn/dy, nonzero in the forced rows only.
     fn forcing_jacobian(&self) -> TokenStream {
-        let Emission {
-            g,
-            na,
-            m_lit,
-            float,
-            ..
-        } = self.e;
+        let Emission { g, na, m_lit, .. } = self.e;
         let (red, r, r_lit, vec_r) = (self.red, self.r, &self.r_lit, &self.vec_r);
         let forcing = emit(g, &red.nonlinear_jacobian, &self.e.scheme());
         let dn_stmts = forcing.stmts;
@@ -433,6 +411,7 @@ impl<'a> Reduction<'a> {
                 quote!(__out[(#q, #l)] = #value;)
             })
             .collect();
+        let body = self.e.matrix_out(&dn_stmts, &dn_sets, m_lit, r_lit);
         quote! {
             /// dn/dy, nonzero in the forced rows only.
             fn forcing_jacobian(
@@ -441,11 +420,7 @@ impl<'a> Reduction<'a> {
                 h: f64,
                 theta: f64,
             ) -> #na::SMatrix<f64, #m_lit, #r_lit> {
-                #float
-                #dn_stmts
-                let mut __out = #na::SMatrix::<f64, #m_lit, #r_lit>::zeros();
-                #(#dn_sets)*
-                __out
+                #body
             }
         }
     }

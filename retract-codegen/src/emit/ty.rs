@@ -7,7 +7,7 @@ use proc_macro2::TokenStream;
 use quote::{ToTokens, quote};
 
 use super::Emission;
-use super::helpers::{ParamTokens, callable, index};
+use super::helpers::{function_and_type, index};
 use crate::util::tidy;
 
 /// The function, the struct and its inherent impl.
@@ -25,16 +25,7 @@ pub(crate) fn type_and_constructor(e: &Emission<'_>) -> TokenStream {
         m_lit,
         ..
     } = e;
-    let ty = &sig.type_name;
-    let vis = &function.vis;
     let fn_name = &function.sig.ident;
-    let ParamTokens {
-        generics,
-        ty_full,
-        fields,
-        ctor_args,
-        field_names,
-    } = &e.params;
     let body_text = tidy(&function.block.to_token_stream().to_string());
     let struct_doc = format!(
         "The order-{k} Lagrangian [`{fn_name}`] on R^{n} with its parameters, as a system for \
@@ -43,36 +34,21 @@ pub(crate) fn type_and_constructor(e: &Emission<'_>) -> TokenStream {
          State z = (x, p) of size {s} = 2nk; Newton unknowns w = (z_1, u) of size {m}."
     );
     let reduced_unknowns = index(e.reduced.map_or(0, |r| r.core.len()));
-    let function = callable(function);
-
-    quote! {
-        #function
-
-        #[doc = #struct_doc]
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        #vis struct #ty #generics {
-            #(#fields,)*
-        }
-
-        #[automatically_derived]
-        impl #generics #ty_full {
-            /// Dimension n of the configuration space.
-            pub const DIMENSION: usize = #n_lit;
-            /// Order k of the Lagrangian.
-            pub const ORDER: usize = #k_lit;
-            /// Size 2nk of the Hamiltonian state z = (x, p).
-            pub const STATE: usize = #s_lit;
-            /// Number 2nk + n of Newton unknowns w = (z_1, u) of one step.
-            pub const UNKNOWNS: usize = #m_lit;
-            /// Unknowns of the reduced step (`retract::ReducedScheme`), or 0 where the
-            /// general step is kept.
-            pub const REDUCED_UNKNOWNS: usize = #reduced_unknowns;
-
-            /// The system with these parameters.
-            #[allow(clippy::too_many_arguments)]
-            pub fn new(#(#ctor_args),*) -> Self {
-                Self { #(#field_names),* }
-            }
-        }
-    }
+    let consts = quote! {
+        /// Dimension n of the configuration space.
+        pub const DIMENSION: usize = #n_lit;
+        /// Order k of the Lagrangian.
+        pub const ORDER: usize = #k_lit;
+        /// Size 2nk of the Hamiltonian state z = (x, p).
+        pub const STATE: usize = #s_lit;
+        /// Number 2nk + n of Newton unknowns w = (z_1, u) of one step.
+        pub const UNKNOWNS: usize = #m_lit;
+        /// Unknowns of the reduced step (`retract::ReducedScheme`), or 0 where the
+        /// general step is kept.
+        pub const REDUCED_UNKNOWNS: usize = #reduced_unknowns;
+    };
+    let new_doc = quote! {
+        /// The system with these parameters.
+    };
+    function_and_type(function, sig, &e.params, &struct_doc, consts, new_doc)
 }
