@@ -82,6 +82,47 @@ fn is_leaf(node: &Node) -> bool {
 /// Emits the roots.
 pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     let len = g.len();
+    let placement = placement(g, roots);
+    let inline = inlined(g, roots, &placement);
+    let reciprocal = reciprocals(g, &placement.top);
+    let mut emitter = Emitter {
+        g,
+        leaves,
+        inline,
+        reciprocal: &reciprocal,
+        latency: vec![0; len],
+        depth: vec![0; len],
+        pending: RefCell::new(TokenStream::new()),
+        cuts: Cell::new(0),
+    };
+    // the nodes emitted at function level or in a loop (the graph holds others)
+    let mut emitted = placement.top.clone();
+    for marks in placement.body_of.iter().filter(|m| !m.is_empty()) {
+        for (e, &m) in emitted.iter_mut().zip(marks) {
+            *e |= m;
+        }
+    }
+    emitter.plan(&emitted);
+    let emitter = emitter;
+    let mut stmts = emitter.statements(&placement);
+    let exprs = roots.iter().map(|&r| emitter.reference(r, false)).collect();
+    stmts.extend(emitter.take_pending());
+    Emitted { stmts, exprs }
+}
+
+/// Where the nodes needed by some roots are emitted.
+struct Placement {
+    /// At function level.
+    top: Vec<bool>,
+    /// For a sum, the nodes of its loop body that depend on the loop element, emitted inside
+    /// the loop (empty for other nodes).
+    body_of: Vec<Vec<bool>>,
+}
+
+/// The nodes needed by `roots`, each at function level or inside the loop of a sum (the
+/// nodes of a sum's body that depend on its element).
+fn placement(g: &Graph, roots: &[Id]) -> Placement {
+    let len = g.len();
     // depends on a loop element (a Sum binds its element, so it does not)
     let mut inner = vec![false; len];
     for i in 0..len {
@@ -126,7 +167,14 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
             n => stack.extend(children(n).into_iter().map(|c| (c, in_loop))),
         }
     }
+    Placement { top, body_of }
+}
 
+/// The function-level nodes inlined into their parent: a non-leaf used once, not a root and
+/// not used from inside a loop.
+fn inlined(g: &Graph, roots: &[Id], placement: &Placement) -> Vec<bool> {
+    let Placement { top, body_of } = placement;
+    let len = g.len();
     // use counts at function level: a node used once (and not from inside a loop) is inlined
     // into its parent instead of getting a `let`
     let mut uses = vec![0usize; len];
@@ -163,93 +211,21 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     for r in roots {
         uses[r.0 as usize] += 2; // roots are always bound
     }
-    let inline: Vec<bool> = (0..len)
+    (0..len)
         .map(|i| top[i] && uses[i] == 1 && !pinned[i] && !is_leaf(g.node(Id(i as u32))))
-        .collect();
-    // a denominator shared by several function-level divisions is inverted once:
-    // `let __rN = 1.0 / b;` and each `a / b` becomes `a * __rN`
-    let mut denominators = vec![0usize; len];
+        .collect()
+}
+
+/// The denominators shared by several function-level divisions: each is inverted once,
+/// `let __rN = 1.0 / b;`, and each `a / b` becomes `a * __rN`.
+fn reciprocals(g: &Graph, top: &[bool]) -> Vec<bool> {
+    let mut denominators = vec![0usize; g.len()];
     for (i, _) in top.iter().enumerate().filter(|(_, t)| **t) {
         if let Node::Div(_, b) = g.node(Id(i as u32)) {
             denominators[b.0 as usize] += 1;
         }
     }
-    let reciprocal: Vec<bool> = denominators.iter().map(|&n| n >= 2).collect();
-    let mut emitter = Emitter {
-        g,
-        leaves,
-        inline,
-        reciprocal: &reciprocal,
-        latency: vec![0; len],
-        depth: vec![0; len],
-        pending: RefCell::new(TokenStream::new()),
-        cuts: Cell::new(0),
-    };
-    // the nodes emitted at function level or in a loop (the graph holds others)
-    let mut emitted = top.clone();
-    for marks in body_of.iter().filter(|m| !m.is_empty()) {
-        for (e, &m) in emitted.iter_mut().zip(marks) {
-            *e |= m;
-        }
-    }
-    emitter.plan(&emitted);
-    let emitter = emitter;
-    let reference = |id: Id| emitter.reference(id, false);
-
-    let mut stmts = TokenStream::new();
-    let bind_reciprocal = |stmts: &mut TokenStream, id: Id| {
-        let (r, b) = (reciprocal_name(id), reference(id));
-        stmts.extend(emitter.take_pending());
-        stmts.extend(quote!(let #r: f64 = 1.0 / #b;));
-    };
-    for (i, _) in reciprocal.iter().enumerate().filter(|(_, r)| **r) {
-        let id = Id(i as u32);
-        if is_leaf(g.node(id)) {
-            bind_reciprocal(&mut stmts, id);
-        }
-    }
-    for i in 0..len {
-        let id = Id(i as u32);
-        let node = g.node(id);
-        if !top[i] || is_leaf(node) || emitter.inline[i] {
-            continue;
-        }
-        let t = temp(id);
-        if let Node::Sum { param, body } = *node {
-            let marks = &body_of[i];
-            let mut inside = TokenStream::new();
-            for (j, &m) in marks.iter().enumerate() {
-                let jd = Id(j as u32);
-                if m && !is_leaf(g.node(jd)) {
-                    let tj = temp(jd);
-                    let v = emitter.value(jd, true);
-                    inside.extend(emitter.take_pending());
-                    inside.extend(quote!(let #tj: f64 = #v;));
-                }
-            }
-            let slice = leaves.slice(param);
-            let element = leaves.element();
-            let b = emitter.reference(body, true);
-            inside.extend(emitter.take_pending());
-            stmts.extend(quote! {
-                let mut #t: f64 = 0.0;
-                for #element in #slice.iter() {
-                    #inside
-                    #t += #b;
-                }
-            });
-        } else {
-            let v = emitter.value(id, false);
-            stmts.extend(emitter.take_pending());
-            stmts.extend(quote!(let #t: f64 = #v;));
-        }
-        if reciprocal[i] {
-            bind_reciprocal(&mut stmts, id);
-        }
-    }
-    let exprs = roots.iter().map(|&r| reference(r)).collect();
-    stmts.extend(emitter.take_pending());
-    Emitted { stmts, exprs }
+    denominators.iter().map(|&n| n >= 2).collect()
 }
 
 /// The temporary holding `1.0 / node`.
@@ -568,6 +544,71 @@ impl Emitter<'_> {
             None => quote!(0.0),
             Some(((false, tokens, _), _)) => tokens,
             Some(((true, tokens, _), _)) => quote!(-#tokens),
+        }
+    }
+
+    /// The `let`s of the function-level nodes that are not inlined, in id order (children
+    /// first), a sum as a loop, and the bound reciprocals after their denominators.
+    fn statements(&self, placement: &Placement) -> TokenStream {
+        let g = self.g;
+        let mut stmts = TokenStream::new();
+        for (i, _) in self.reciprocal.iter().enumerate().filter(|(_, r)| **r) {
+            let id = Id(i as u32);
+            if is_leaf(g.node(id)) {
+                self.bind_reciprocal(&mut stmts, id);
+            }
+        }
+        for i in 0..g.len() {
+            let id = Id(i as u32);
+            let node = g.node(id);
+            if !placement.top[i] || is_leaf(node) || self.inline[i] {
+                continue;
+            }
+            let t = temp(id);
+            if let Node::Sum { param, body } = *node {
+                stmts.extend(self.sum_loop(&t, param, body, &placement.body_of[i]));
+            } else {
+                let v = self.value(id, false);
+                stmts.extend(self.take_pending());
+                stmts.extend(quote!(let #t: f64 = #v;));
+            }
+            if self.reciprocal[i] {
+                self.bind_reciprocal(&mut stmts, id);
+            }
+        }
+        stmts
+    }
+
+    /// `let __rN: f64 = 1.0 / b;` for the denominator `id`.
+    fn bind_reciprocal(&self, stmts: &mut TokenStream, id: Id) {
+        let (r, b) = (reciprocal_name(id), self.reference(id, false));
+        stmts.extend(self.take_pending());
+        stmts.extend(quote!(let #r: f64 = 1.0 / #b;));
+    }
+
+    /// The sum `t` of `body` over the elements of the slice parameter `param`, as a loop:
+    /// the nodes `marks` of its body that depend on the element are emitted inside it.
+    fn sum_loop(&self, t: &TokenStream, param: u32, body: Id, marks: &[bool]) -> TokenStream {
+        let mut inside = TokenStream::new();
+        for (j, &m) in marks.iter().enumerate() {
+            let jd = Id(j as u32);
+            if m && !is_leaf(self.g.node(jd)) {
+                let tj = temp(jd);
+                let v = self.value(jd, true);
+                inside.extend(self.take_pending());
+                inside.extend(quote!(let #tj: f64 = #v;));
+            }
+        }
+        let slice = self.leaves.slice(param);
+        let element = self.leaves.element();
+        let b = self.reference(body, true);
+        inside.extend(self.take_pending());
+        quote! {
+            let mut #t: f64 = 0.0;
+            for #element in #slice.iter() {
+                #inside
+                #t += #b;
+            }
         }
     }
 

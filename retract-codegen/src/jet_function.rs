@@ -10,14 +10,13 @@ use proc_macro2::TokenStream;
 use quote::{ToTokens, quote};
 use syn::ItemFn;
 
-use crate::expand::{
-    ParamTokens, ScalarBodies, allow_generated, callable, combine, param_tokens, scalar_bodies,
-    tidy,
-};
+use crate::emit::helpers::{ParamTokens, allow_generated, function_and_type, param_tokens};
+use crate::emit::scalar::{ScalarBodies, scalar_bodies};
 use crate::graph::Graph;
 use crate::lower::Lower;
 use crate::mechanics;
 use crate::signature::{self, Attribute};
+use crate::util::{combine, tidy};
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
 /// so the rest of the crate still type-checks. Never panics.
@@ -61,16 +60,8 @@ fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies)
     let na = quote!(::retract::__private::nalgebra);
     let vec_n = quote!(#na::SVector<f64, #n_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
-    let ty = &sig.type_name;
-    let vis = &function.vis;
     let fn_name = &function.sig.ident;
-    let ParamTokens {
-        generics,
-        ty_full,
-        fields,
-        ctor_args,
-        field_names,
-    } = param_tokens(sig, "g");
+    let params = param_tokens(sig, "g");
     let body_text = tidy(&function.block.to_token_stream().to_string());
     let struct_doc = format!(
         "The function [`{fn_name}`] of the order-{k} jet on R^{n} with its parameters, with \
@@ -79,37 +70,27 @@ fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies)
          g(q, ..., q^({k})) = `{body_text}`",
         k - 1
     );
+    let consts = quote! {
+        /// Dimension n of the configuration space.
+        pub const DIMENSION: usize = #n_lit;
+        /// Order k of the jet (q, ..., q^(k)).
+        pub const ORDER: usize = #k_lit;
+    };
+    let new_doc = quote! {
+        /// The function with these parameters.
+    };
+    let mut out = function_and_type(function, sig, &params, &struct_doc, consts, new_doc);
+    let ParamTokens {
+        generics, ty_full, ..
+    } = &params;
     let ScalarBodies {
         value,
         gradient,
         hessian,
     } = bodies;
     let allow = allow_generated();
-    let function = callable(function);
 
-    quote! {
-        #function
-
-        #[doc = #struct_doc]
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        #vis struct #ty #generics {
-            #(#fields,)*
-        }
-
-        #[automatically_derived]
-        impl #generics #ty_full {
-            /// Dimension n of the configuration space.
-            pub const DIMENSION: usize = #n_lit;
-            /// Order k of the jet (q, ..., q^(k)).
-            pub const ORDER: usize = #k_lit;
-
-            /// The function with these parameters.
-            #[allow(clippy::too_many_arguments)]
-            pub fn new(#(#ctor_args),*) -> Self {
-                Self { #(#field_names),* }
-            }
-        }
-
+    out.extend(quote! {
         #[automatically_derived]
         #allow
         impl #generics #core::JetFunction<#n_lit, #k_lit> for #ty_full {
@@ -128,7 +109,8 @@ fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies)
                 #hessian
             }
         }
-    }
+    });
+    out
 }
 
 #[cfg(test)]

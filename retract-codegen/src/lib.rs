@@ -5,20 +5,24 @@
 //! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically and
 //! emits straight-line code for the `retract_core` traits. The stages, one module each:
 //! `signature` (order, dimension, parameters) -> `lower` (body to a hash-consed expression
-//! graph) -> `mechanics` (gradient, Hessian, momenta, scheme) -> `codegen` (one `let` per
-//! shared node). `#[jet_function]` (module `jet_function`) reuses them for a scalar function
-//! of the jet, emitting only its value, gradient and Hessian.
+//! graph) -> `mechanics` (gradient, Hessian, momenta, scheme) -> `emit` (the generated items,
+//! one module each over a shared context, their code written by `codegen`: one `let` per
+//! shared node); `expand` runs them in order. `#[jet_function]` (module `jet_function`)
+//! reuses them for a scalar function of the jet, emitting only its value, gradient and
+//! Hessian. Helpers used by several stages (`util`) import none of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod codegen;
 mod diff;
+mod emit;
 mod expand;
 mod graph;
 mod jet_function;
 mod lower;
 mod mechanics;
 mod signature;
+mod util;
 
 pub mod samples;
 

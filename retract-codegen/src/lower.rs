@@ -22,6 +22,7 @@ use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
 use crate::graph::{Func, Graph, Id, Node, Var};
 use crate::signature::{Kind, Signature};
+use crate::util::tidy;
 
 /// The supported f64 methods.
 pub const METHODS: &str =
@@ -1067,7 +1068,7 @@ fn text_of(mut expr: &Expr) -> String {
     while let Expr::Paren(p) = expr {
         expr = &p.expr;
     }
-    crate::expand::tidy(&expr.to_token_stream().to_string())
+    tidy(&expr.to_token_stream().to_string())
 }
 
 /// `expr` as the receiver of a method call: parenthesised unless it is an atom.

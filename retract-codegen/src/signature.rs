@@ -13,6 +13,8 @@ use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
 use syn::{FnArg, Ident, ItemFn, Pat, ReturnType, Type};
 
+use crate::util::combine;
+
 /// Highest supported order.
 pub const MAX_ORDER: usize = 4;
 
@@ -205,73 +207,64 @@ fn camel(name: &Ident, attribute: Attribute) -> syn::Result<Ident> {
     }
 }
 
+/// The errors of a signature, collected so that the user sees all of them, with the
+/// messages written for a Lagrangian reworded for the attribute.
+struct Errors {
+    attribute: Attribute,
+    list: Vec<syn::Error>,
+}
+
+impl Errors {
+    fn fail(&mut self, span: Span, msg: String) {
+        self.list
+            .push(syn::Error::new(span, self.attribute.reword(msg)));
+    }
+}
+
 /// The function's qualifiers, generics and return type: errors for `const`, `async`,
 /// `unsafe`, generic parameters and a return type other than `f64`.
-fn check_qualifiers(sig: &syn::Signature, attribute: Attribute, errors: &mut Vec<syn::Error>) {
-    let fail = |errors: &mut Vec<syn::Error>, span: Span, msg: String| {
-        errors.push(syn::Error::new(span, attribute.reword(msg)))
-    };
+fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
     if let Some(c) = &sig.constness {
-        fail(
-            errors,
-            c.span(),
-            "a Lagrangian cannot be a `const fn`".into(),
-        );
+        errors.fail(c.span(), "a Lagrangian cannot be a `const fn`".into());
     }
     if let Some(a) = &sig.asyncness {
-        fail(errors, a.span(), "a Lagrangian cannot be `async`".into());
+        errors.fail(a.span(), "a Lagrangian cannot be `async`".into());
     }
     if let Some(u) = &sig.unsafety {
-        fail(errors, u.span(), "a Lagrangian cannot be `unsafe`".into());
+        errors.fail(u.span(), "a Lagrangian cannot be `unsafe`".into());
     }
     if !sig.generics.params.is_empty() || sig.generics.where_clause.is_some() {
-        fail(
-            errors,
+        errors.fail(
             sig.generics.span(),
             "a Lagrangian cannot be generic: write it for f64 and concrete array lengths".into(),
         );
     }
     match &sig.output {
         ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
-        ReturnType::Type(_, ty) => fail(
-            errors,
+        ReturnType::Type(_, ty) => errors.fail(
             ty.span(),
             "a Lagrangian returns a scalar: the return type must be `f64`".into(),
         ),
-        ReturnType::Default => fail(
-            errors,
+        ReturnType::Default => errors.fail(
             sig.ident.span(),
             "a Lagrangian returns a scalar: add `-> f64`".into(),
         ),
     }
 }
 
-/// Checks the attribute and the signature of `item` under `attribute`.
-pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
-    let options = parse_options(attr, attribute)?;
-    let sig = &item.sig;
-    let mut errors: Vec<syn::Error> = Vec::new();
-    let fail = |errors: &mut Vec<syn::Error>, span: Span, msg: String| {
-        errors.push(syn::Error::new(span, attribute.reword(msg)))
-    };
-
-    let Some((order, order_span)) = options.order else {
-        return Err(syn::Error::new(
-            Span::call_site(),
-            format!(
-                "missing the order: write #[{}(order = k)] with k in 1..=4",
-                attribute.name()
-            ),
-        ));
-    };
-    check_qualifiers(sig, attribute, &mut errors);
-
+/// The arguments of the function with their kinds, and the span of the type of the first
+/// (the configuration q); errors for `self`, patterns, mutable arguments, unsupported types
+/// and parameter arrays beyond [`MAX_LEN`].
+fn arguments(
+    sig: &syn::Signature,
+    order: usize,
+    errors: &mut Errors,
+) -> (Vec<(Ident, Kind)>, Span) {
     let mut args: Vec<(Ident, Kind)> = Vec::new();
     let mut jet_span = sig.ident.span();
     for input in &sig.inputs {
         let FnArg::Typed(arg) = input else {
-            fail(
-                &mut errors,
+            errors.fail(
                 input.span(),
                 "a Lagrangian is a free function: `self` is not supported".into(),
             );
@@ -280,8 +273,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         let name = match &*arg.pat {
             Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
                 if let Some(m) = &p.mutability {
-                    fail(
-                        &mut errors,
+                    errors.fail(
                         m.span(),
                         format!(
                             "parameter `{}` cannot be mutable: the arguments of a Lagrangian \
@@ -293,8 +285,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                 p.ident.clone()
             }
             other => {
-                fail(
-                    &mut errors,
+                errors.fail(
                     other.span(),
                     "unsupported argument pattern: use a plain name".into(),
                 );
@@ -304,8 +295,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         match kind_of(&arg.ty) {
             // a parameter (the jet's dimension is checked below)
             Some(Kind::Array(len) | Kind::Slice(len)) if len > MAX_LEN && args.len() > order => {
-                fail(
-                    &mut errors,
+                errors.fail(
                     arg.ty.span(),
                     format!("array length {len} exceeds the supported maximum of {MAX_LEN}"),
                 )
@@ -316,8 +306,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                 }
                 args.push((name, kind));
             }
-            None => fail(
-                &mut errors,
+            None => errors.fail(
                 arg.ty.span(),
                 "unsupported argument type; supported: `f64`, `[f64; N]` with a literal N, \
                  and `&[[f64; N]]` for a parameter list of any length"
@@ -325,46 +314,54 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             ),
         }
     }
+    (args, jet_span)
+}
 
-    let jet_kind = args.first().map(|(_, k)| *k);
-    let mut dim = 0;
-    let mut scalar_jet = false;
+/// The dimension n from the kind of the first argument, and whether the jet is scalar;
+/// errors for a slice and for n k beyond [`MAX_UNKNOWNS`] (at `jet_span`).
+fn dimension(
+    sig: &syn::Signature,
+    jet_kind: Option<Kind>,
+    jet_span: Span,
+    order: usize,
+    errors: &mut Errors,
+) -> (usize, bool) {
     match jet_kind {
-        Some(Kind::Scalar) => {
-            dim = 1;
-            scalar_jet = true;
+        Some(Kind::Scalar) => (1, true),
+        Some(Kind::Array(n)) if n > MAX_UNKNOWNS / order => {
+            errors.fail(
+                jet_span,
+                format!(
+                    "dimension too large: n = {n} at order {order} makes {} unknowns per step, \
+                     but at most n k = {MAX_UNKNOWNS} are supported (n <= {} at order {order}), \
+                     which keeps the expansion within seconds",
+                    n.saturating_mul(order),
+                    MAX_UNKNOWNS / order
+                ),
+            );
+            (0, false)
         }
-        Some(Kind::Array(n)) if n > MAX_UNKNOWNS / order => fail(
-            &mut errors,
-            jet_span,
-            format!(
-                "dimension too large: n = {n} at order {order} makes {} unknowns per step, but \
-                 at most n k = {MAX_UNKNOWNS} are supported (n <= {} at order {order}), which \
-                 keeps the expansion within seconds",
-                n.saturating_mul(order),
-                MAX_UNKNOWNS / order
-            ),
-        ),
-        Some(Kind::Array(n)) => dim = n,
-        Some(Kind::Slice(_)) => fail(
-            &mut errors,
-            sig.inputs.span(),
-            "the first argument is the configuration q: `f64` or `[f64; N]`, not a slice".into(),
-        ),
-        None => {}
+        Some(Kind::Array(n)) => (n, false),
+        Some(Kind::Slice(_)) => {
+            errors.fail(
+                sig.inputs.span(),
+                "the first argument is the configuration q: `f64` or `[f64; N]`, not a slice"
+                    .into(),
+            );
+            (0, false)
+        }
+        None => (0, false),
     }
-    if args.len() < order + 1 && errors.is_empty() {
-        fail(
-            &mut errors,
-            order_span,
-            format!(
-                "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
-                 the signature has {}",
-                order + 1,
-                args.len()
-            ),
-        );
-    }
+}
+
+/// The names of q, q', ..., q^(order): the first `order + 1` arguments; errors where one is
+/// not of the type of q.
+fn jet_names(
+    args: &[(Ident, Kind)],
+    order: usize,
+    jet_kind: Option<Kind>,
+    errors: &mut Errors,
+) -> Vec<Ident> {
     let mut jet = Vec::new();
     for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
         if Some(*kind) != jet_kind {
@@ -385,10 +382,47 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                     kind.describe()
                 )
             };
-            fail(&mut errors, name.span(), msg);
+            errors.fail(name.span(), msg);
         }
         jet.push(name.clone());
     }
+    jet
+}
+
+/// Checks the attribute and the signature of `item` under `attribute`.
+pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
+    let options = parse_options(attr, attribute)?;
+    let sig = &item.sig;
+    let mut errors = Errors {
+        attribute,
+        list: Vec::new(),
+    };
+
+    let Some((order, order_span)) = options.order else {
+        return Err(syn::Error::new(
+            Span::call_site(),
+            format!(
+                "missing the order: write #[{}(order = k)] with k in 1..=4",
+                attribute.name()
+            ),
+        ));
+    };
+    check_qualifiers(sig, &mut errors);
+    let (args, jet_span) = arguments(sig, order, &mut errors);
+    let jet_kind = args.first().map(|(_, k)| *k);
+    let (dim, scalar_jet) = dimension(sig, jet_kind, jet_span, order, &mut errors);
+    if args.len() < order + 1 && errors.list.is_empty() {
+        errors.fail(
+            order_span,
+            format!(
+                "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
+                 the signature has {}",
+                order + 1,
+                args.len()
+            ),
+        );
+    }
+    let jet = jet_names(&args, order, jet_kind, &mut errors);
     let params = args
         .iter()
         .skip(order + 1)
@@ -401,11 +435,11 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
     let type_name = match options.name {
         Some(name) => name,
         None => camel(&sig.ident, attribute).unwrap_or_else(|e| {
-            errors.push(e);
+            errors.list.push(e);
             Ident::new("Lagrangian", sig.ident.span())
         }),
     };
-    if let Some(e) = crate::expand::combine(errors) {
+    if let Some(e) = combine(errors.list) {
         return Err(e);
     }
     Ok(Signature {

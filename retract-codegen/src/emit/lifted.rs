@@ -1,0 +1,119 @@
+//! The `LiftedSystem` impl: the lifted theta-scheme of the Lagrangian on the Hamiltonian
+//! state z = (x, p) of size s = 2nk with the Newton unknowns w = (z_1, u) of size
+//! m = 2nk + n (formulas in `retract_core::LiftedSystem`). Its residual F(z0, w) and the
+//! Jacobians dF/dw and dF/dz0 are straight-line code over their structural nonzeros; the
+//! Hamiltonian, the vector field, the Legendre map, the step cost and the predictor call the
+//! generic implementations in `retract_core::lifted`; `check_domain` is emitted by `domain`.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::Emission;
+use super::domain::check_domain;
+use super::helpers::index;
+use crate::codegen::emit;
+
+/// `impl LiftedSystem<s, m>`.
+pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
+    let Emission {
+        g,
+        mech,
+        s,
+        m,
+        n_lit,
+        k_lit,
+        s_lit,
+        m_lit,
+        core,
+        na,
+        vec_s,
+        vec_m,
+        vec_m_path,
+        float,
+        ..
+    } = e;
+    let header = e.impl_header(quote!(LiftedSystem<#s_lit, #m_lit>));
+    let residual = emit(g, &mech.residual, &e.scheme());
+    let r_stmts = residual.stmts;
+    let r_sets = mech.residual.iter().enumerate().filter_map(|(r, &id)| {
+        if g.is_const(id, 0.0) {
+            return None;
+        }
+        let v = &residual.exprs[r];
+        let r = index(r);
+        Some(quote!(__out[#r] = #v;))
+    });
+    let jacobian = e.matrix_body(&mech.jacobian, *m);
+    let jacobian_initial = e.matrix_body(&mech.jacobian_initial, *s);
+    let check_domain = check_domain(e);
+
+    quote! {
+        #header {
+            const DIMENSION: usize = #n_lit;
+            const ORDER: usize = #k_lit;
+
+            /// The Ostrogradsky Hamiltonian H(x, p).
+            fn hamiltonian(&self, z: &#vec_s) -> ::core::result::Result<f64, #core::Error> {
+                #core::lifted::hamiltonian::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+            }
+
+            /// Hamilton's equations.
+            fn vector_field(&self, z: &#vec_s) -> ::core::result::Result<#vec_s, #core::Error> {
+                #core::lifted::vector_field::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+            }
+
+            /// The Legendre map (q, ..., q^(2k-1)) -> (x, p).
+            fn legendre(&self, jet: &#vec_s) -> #vec_s {
+                #core::lifted::legendre::<Self, #n_lit, #k_lit, #s_lit>(self, jet)
+            }
+
+            /// F(z0, w) of the lifted theta-scheme, straight-line.
+            fn residual(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> #vec_m {
+                #float
+                #r_stmts
+                let mut __out = #vec_m_path::zeros();
+                #(#r_sets)*
+                __out
+            }
+
+            /// dF/dw of the lifted theta-scheme; structural zeros are not computed.
+            fn jacobian(
+                &self,
+                z0: &#vec_s,
+                w: &#vec_m,
+                h: f64,
+                theta: f64,
+            ) -> #na::SMatrix<f64, #m_lit, #m_lit> {
+                #jacobian
+            }
+
+            /// dF/dz0 of the lifted theta-scheme; structural zeros are not computed.
+            fn jacobian_initial(
+                &self,
+                z0: &#vec_s,
+                w: &#vec_m,
+                h: f64,
+                theta: f64,
+            ) -> #na::SMatrix<f64, #m_lit, #s_lit> {
+                #jacobian_initial
+            }
+
+            /// h L(x_theta, u), the cost of one step.
+            fn step_cost(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> f64 {
+                #core::lifted::step_cost::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta)
+            }
+
+            #check_domain
+
+            /// Explicit Euler guess of w.
+            fn predictor(
+                &self,
+                z0: &#vec_s,
+                h: f64,
+                _theta: f64,
+            ) -> ::core::result::Result<#vec_m, #core::Error> {
+                #core::lifted::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
+            }
+        }
+    }
+}

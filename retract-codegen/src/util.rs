@@ -1,0 +1,45 @@
+//! Helpers shared by the stages that import nothing from them: error combining and the
+//! text of tokens as the user wrote them. This module uses no other module of the crate,
+//! so that `signature`, `lower`, the emission and the entry points can all use it without
+//! importing each other.
+
+/// Combines several errors into one that reports all of them.
+pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
+    let mut iter = errors.into_iter();
+    let mut first = iter.next()?;
+    for e in iter {
+        first.combine(e);
+    }
+    Some(first)
+}
+
+/// Token text with the spaces that `to_string` puts around `.`, `[` and calls removed.
+pub(crate) fn tidy(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let chars: Vec<char> = text.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        if c == ' ' {
+            let prev = if i > 0 { chars[i - 1] } else { ' ' };
+            let next = chars.get(i + 1).copied().unwrap_or(' ');
+            let glue = next == '.'
+                || prev == '.'
+                || next == '['
+                || (next == '(' && (prev.is_alphanumeric() || prev == '_'));
+            if glue {
+                continue;
+            }
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tidy_joins_calls_and_indexing() {
+        assert_eq!(tidy("q [0] . powi (2) + (a * b)"), "q[0].powi(2) + (a * b)");
+    }
+}
