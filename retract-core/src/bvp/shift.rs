@@ -21,6 +21,19 @@ pub(crate) struct BlockColumn<const N: usize, const X: usize> {
     b: [f64; X],
 }
 
+/// `dst += c src`, entry by entry.
+#[inline(always)]
+fn axpy(dst: &mut [f64], c: f64, src: &[f64]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        *d += c * s;
+    }
+}
+
+// The products work on the column-major storage slices: a column of an R x C matrix is
+// `R` consecutive entries, and a block of `N` rows within a column is `N` consecutive
+// entries, so every update is an `axpy` on contiguous runs (vectorised, bounds checked once
+// per run rather than per entry).
+
 impl<const N: usize, const X: usize> BlockPoly<N, X> {
     /// The coefficients of a matrix known to be a polynomial in $S$: its first block row.
     pub fn of(m: &SMatrix<f64, X, X>) -> Self {
@@ -33,15 +46,16 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, X> {
         let mut out = SMatrix::<f64, R, X>::zeros();
+        let (src, dst) = (m.as_slice(), out.as_mut_slice());
+        let block = R * N;
         for j in 0..X / N {
             for d in 0..=j {
-                let c = self.c[d];
-                for a in 0..N {
-                    let (to, from) = (j * N + a, (j - d) * N + a);
-                    for r in 0..R {
-                        out[(r, to)] += c * m[(r, from)];
-                    }
-                }
+                let from = (j - d) * block;
+                axpy(
+                    &mut dst[j * block..(j + 1) * block],
+                    self.c[d],
+                    &src[from..from + block],
+                );
             }
         }
         out
@@ -51,13 +65,14 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     #[inline(always)]
     pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
         let mut out = SMatrix::<f64, X, C>::zeros();
+        let (src, dst) = (m.as_slice(), out.as_mut_slice());
         for col in 0..C {
+            let base = col * X;
             for j in 0..X / N {
                 for d in 0..=j {
-                    let c = self.c[d];
-                    for a in 0..N {
-                        out[(j * N + a, col)] += c * m[((j - d) * N + a, col)];
-                    }
+                    let from = base + (j - d) * N;
+                    let to = base + j * N;
+                    axpy(&mut dst[to..to + N], self.c[d], &src[from..from + N]);
                 }
             }
         }
@@ -69,13 +84,14 @@ impl<const N: usize, const X: usize> BlockPoly<N, X> {
     pub fn left<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
         let k = X / N;
         let mut out = SMatrix::<f64, X, C>::zeros();
+        let (src, dst) = (m.as_slice(), out.as_mut_slice());
         for col in 0..C {
+            let base = col * X;
             for j in 0..k {
                 for d in 0..k - j {
-                    let c = self.c[d];
-                    for a in 0..N {
-                        out[(j * N + a, col)] += c * m[((j + d) * N + a, col)];
-                    }
+                    let from = base + (j + d) * N;
+                    let to = base + j * N;
+                    axpy(&mut dst[to..to + N], self.c[d], &src[from..from + N]);
                 }
             }
         }
@@ -95,13 +111,10 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, N> {
         let mut out = SMatrix::<f64, R, N>::zeros();
+        let (src, dst) = (m.as_slice(), out.as_mut_slice());
+        let block = R * N;
         for j in 0..X / N {
-            let b = self.b[j];
-            for a in 0..N {
-                for r in 0..R {
-                    out[(r, a)] += b * m[(r, j * N + a)];
-                }
-            }
+            axpy(dst, self.b[j], &src[j * block..(j + 1) * block]);
         }
         out
     }
@@ -110,12 +123,15 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     #[inline(always)]
     pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, N, C> {
         let mut out = SMatrix::<f64, N, C>::zeros();
+        let (src, dst) = (m.as_slice(), out.as_mut_slice());
         for col in 0..C {
             for j in 0..X / N {
-                let b = self.b[j];
-                for a in 0..N {
-                    out[(a, col)] += b * m[(j * N + a, col)];
-                }
+                let from = col * X + j * N;
+                axpy(
+                    &mut dst[col * N..(col + 1) * N],
+                    self.b[j],
+                    &src[from..from + N],
+                );
             }
         }
         out
