@@ -214,3 +214,30 @@ fn item_7_non_finite_constants_are_folded_as_f64_does() {
         );
     }
 }
+
+/// Item 6: a recurrence unrolled to the documented limit (10 000 iterations, each a few nodes
+/// deeper) is differentiated and substituted without deep recursion, so the expansion fits a
+/// 1 MiB stack even unoptimised (the compiler's own stack overflowed on it before). The
+/// emitted code of this case compiles too (about 80 s and 0.8 GB in a release build, so it is
+/// not compiled here; `tests/item_6_deep_nesting.rs` compiles the 1000-iteration case).
+#[test]
+fn item_6_a_recurrence_unrolled_to_the_limit_expands_on_a_small_stack() {
+    let run = std::thread::Builder::new()
+        .stack_size(1 << 20)
+        .spawn(|| {
+            expand(
+                "order = 1",
+                "fn recurrence(q: f64, dq: f64) -> f64 {
+                    let mut x = q;
+                    for _ in 0..10000 {
+                        x = x * 0.999 + 0.001 * q.sin();
+                    }
+                    0.5 * dq * dq - x * x
+                }",
+            )
+            .map(|e| e.len())
+        })
+        .expect("a thread");
+    let length = run.join().expect("no stack overflow").expect("expands");
+    assert!(length > 1_000_000, "{length} bytes");
+}
