@@ -444,3 +444,25 @@ fn real_time_iterations_track_a_receding_horizon() {
     assert!(!capped.converged);
     assert_eq!(capped.plan.iterations, 1);
 }
+
+/// Problems, plans and solutions can cross threads when their parts can (issue 16, item 8):
+/// the constraint and clearance references are `Sync`.
+#[test]
+fn public_problem_and_solution_types_are_send_and_sync() {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<OptimalControlProblem<'_, OneDisc, 2, 2, 4>>();
+    send_sync::<Plan<2, 4>>();
+    send_sync::<retract::bvp::PlanError<2, 4>>();
+    send_sync::<BoundaryValueProblem<'_, OneDisc, 8, 10>>();
+    send_sync::<retract::BvpSolution<8, 10>>();
+    send_sync::<retract::Trajectory<8>>();
+    send_sync::<retract::Interrupted<8>>();
+    // a Lagrangian without parameters is a unit struct, a value by its name alone
+    let _: DoublePendulumUnit = DoublePendulumUnit;
+}
+
+/// The double pendulum with g = 9.81 written in: no parameters.
+#[higher_order_lagrangian(order = 2)]
+fn double_pendulum_unit(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + 9.81 * q[0].cos()
+}

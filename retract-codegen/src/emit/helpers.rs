@@ -136,14 +136,18 @@ pub(crate) fn function_and_type(
     } = params;
     let (vis, ty) = (&function.vis, &sig.type_name);
     let function = callable(function);
+    // without parameters a unit struct, usable as a value by its name alone
+    let body = if fields.is_empty() {
+        quote!(;)
+    } else {
+        quote!({ #(#fields,)* })
+    };
     quote! {
         #function
 
         #[doc = #doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
-        #vis struct #ty #generics {
-            #(#fields,)*
-        }
+        #vis struct #ty #generics #body
 
         #[automatically_derived]
         impl #generics #ty_full {

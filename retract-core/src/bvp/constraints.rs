@@ -21,7 +21,7 @@ pub enum Variable {
 #[derive(Clone, Copy)]
 pub(super) enum StageConstraint<'a, const N: usize, const K: usize> {
     /// $g(x_\theta, u)$.
-    Function(&'a dyn JetFunction<N, K>),
+    Function(&'a (dyn JetFunction<N, K> + Sync)),
     /// $\pm(v - \text{value})$: the variable above (sign +1) or below (sign -1) a value.
     Bound {
         variable: Variable,

@@ -343,7 +343,7 @@ impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 /// `M` are those of the system's [`LiftedSystem`] (used for its singularity guard).
 pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize> {
     pub(super) system: &'a Sys,
-    pub(super) equalities: Vec<&'a dyn JetFunction<N, K>>,
+    pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
     pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
     pub(super) start: SVector<f64, X>,
     pub(super) goal: SVector<f64, X>,
@@ -399,7 +399,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// Adds the equality constraint $g(x_{\theta,i}, u_i) = 0$ at every step (e.g. a passive
     /// joint's torque, written under `#[jet_function]`). At most $n$ constraints, jointly of
     /// full rank in the top derivative $u$ (so that each step can satisfy them).
-    pub fn with_equality(mut self, constraint: &'a dyn JetFunction<N, K>) -> Self {
+    pub fn with_equality(mut self, constraint: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
         self.equalities.push(constraint);
         self
     }
@@ -408,7 +408,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// (obstacle clearance, a keep-out cone, a torque limit $\tau_{\max} - \tau \ge 0$),
     /// handled by the interior-point iteration with slacks (see the module docs): the first
     /// guess need not satisfy it.
-    pub fn with_inequality(mut self, constraint: &'a dyn JetFunction<N, K>) -> Self {
+    pub fn with_inequality(mut self, constraint: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
         self.inequalities
             .push(StageConstraint::Function(constraint));
         self

@@ -164,7 +164,7 @@ impl<const S: usize, const M: usize> BvpSolution<S, M> {
 
 /// Per-obstacle clearance of a state: writes one signed distance per obstacle into `out`
 /// (negative inside).
-pub type ClearanceFn<'a, const S: usize> = &'a dyn Fn(&SVector<f64, S>, &mut [f64]);
+pub type ClearanceFn<'a, const S: usize> = &'a (dyn Fn(&SVector<f64, S>, &mut [f64]) + Sync);
 
 /// A boundary-value problem: a system, the boundary jets, the horizon and the step count.
 pub struct BoundaryValueProblem<'a, Sys: ?Sized, const S: usize, const M: usize> {
