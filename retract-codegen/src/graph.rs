@@ -31,6 +31,9 @@ pub enum Var {
     /// Core variable m of the reduced step: the value at the evaluation point of a jet
     /// component on which the Hessian of L depends.
     Core(u32),
+    /// Component `index` of block `block` of the covector w1 (`side` 0) or w2 (`side` 1)
+    /// that contracts a discretization map's points (`#[discretization_map]`).
+    Covector { side: u8, block: u8, index: u32 },
 }
 
 /// A unary function.
@@ -63,7 +66,7 @@ impl Func {
         }
     }
 
-    fn eval(self, x: f64) -> f64 {
+    pub(crate) fn eval(self, x: f64) -> f64 {
         match self {
             Func::Sqrt => x.sqrt(),
             Func::Exp => x.exp(),
@@ -125,6 +128,34 @@ impl Graph {
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.nodes.len()
+    }
+
+    /// The values of the nodes up to `root` (children before parents), with the symbols and
+    /// named constants given by `leaf`; `None` where a leaf has no value (and above it). Not
+    /// for sums over slices (`None`).
+    pub fn evaluate(&self, root: Id, leaf: &dyn Fn(&Node) -> Option<f64>) -> Vec<Option<f64>> {
+        let mut values: Vec<Option<f64>> = Vec::with_capacity(root.0 as usize + 1);
+        for i in 0..=root.0 as usize {
+            let node = &self.nodes[i];
+            let at = |id: Id| values[id.0 as usize];
+            let value = match *node {
+                Node::Const(bits) => Some(f64::from_bits(bits)),
+                Node::Var(_) | Node::Named(_) => leaf(node),
+                Node::Sum { .. } => None,
+                Node::Neg(a) => at(a).map(|a| -a),
+                Node::Powi(a, n) => at(a).map(|a| a.powi(n)),
+                Node::Unary(f, a) => at(a).map(|a| f.eval(a)),
+                Node::Add(a, b) => at(a).zip(at(b)).map(|(a, b)| a + b),
+                Node::Sub(a, b) => at(a).zip(at(b)).map(|(a, b)| a - b),
+                Node::Mul(a, b) => at(a).zip(at(b)).map(|(a, b)| a * b),
+                Node::Div(a, b) => at(a).zip(at(b)).map(|(a, b)| a / b),
+                Node::Powf(a, b) => at(a).zip(at(b)).map(|(a, b)| a.powf(b)),
+                Node::Atan2(a, b) => at(a).zip(at(b)).map(|(a, b)| a.atan2(b)),
+                Node::Hypot(a, b) => at(a).zip(at(b)).map(|(a, b)| a.hypot(b)),
+            };
+            values.push(value);
+        }
+        values
     }
 
     fn add(&mut self, node: Node) -> Id {

@@ -118,16 +118,7 @@ mod tests {
     use super::*;
 
     fn expand_str(attr: &str, item: &str) -> Result<String, String> {
-        let attr: TokenStream = attr.parse().map_err(|e| format!("{e}"))?;
-        let item: TokenStream = item.parse().map_err(|e| format!("{e}"))?;
-        let tokens = try_expand_jet_function(attr, item).map_err(|e| {
-            e.into_iter()
-                .map(|e| e.to_string())
-                .collect::<Vec<_>>()
-                .join("\n")
-        })?;
-        let file: syn::File = syn::parse2(tokens).map_err(|e| e.to_string())?;
-        Ok(prettyplease::unparse(&file))
+        crate::util::pretty_expansion(try_expand_jet_function, attr, item)
     }
 
     #[test]

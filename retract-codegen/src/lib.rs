@@ -1,6 +1,6 @@
-//! The expansions behind `#[higher_order_lagrangian]` and `#[jet_function]`, as ordinary
-//! functions over `proc_macro2` tokens so that they can be unit-tested, fuzzed and
-//! benchmarked.
+//! The expansions behind `#[higher_order_lagrangian]`, `#[jet_function]` and
+//! `#[discretization_map]`, as ordinary functions over `proc_macro2` tokens so that they can be
+//! unit-tested, fuzzed and benchmarked.
 //!
 //! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically and
 //! emits straight-line code for the `retract_core` traits. The stages, one module each:
@@ -9,7 +9,9 @@
 //! one module each over a shared context, their code written by `codegen`: one `let` per
 //! shared node); `expand` runs them in order. `#[jet_function]` (module `jet_function`)
 //! reuses them for a scalar function of the jet, emitting only its value, gradient and
-//! Hessian. Helpers used by several stages (`util`) import none of them.
+//! Hessian. `#[discretization_map]` (module `map`) lowers a map (q, v) -> (R1, R2) the same
+//! way, checks its conditions (`map_check`), lifts it by total derivatives and differentiates
+//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). Helpers used by several stages (`util`) import none of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -20,6 +22,9 @@ mod expand;
 mod graph;
 mod jet_function;
 mod lower;
+mod map;
+mod map_check;
+mod map_lift;
 mod mechanics;
 mod signature;
 mod util;
@@ -28,3 +33,4 @@ pub mod samples;
 
 pub use expand::{ExpansionStats, expand, expansion_stats, try_expand};
 pub use jet_function::{expand_jet_function, try_expand_jet_function};
+pub use map::{expand_discretization_map, try_expand_discretization_map};

@@ -21,7 +21,7 @@ use syn::spanned::Spanned;
 use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
 use crate::graph::{Func, Graph, Id, Node, Var};
-use crate::signature::{Kind, Signature};
+use crate::signature::{Attribute, Kind, Signature};
 use crate::util::tidy;
 
 /// The supported f64 methods.
@@ -38,7 +38,12 @@ enum Binding {
         mutable: bool,
     },
     Int(i64),
-    Jet(u8),
+    /// A jet argument: component i is `Var::Jet { order, index: offset + i }` (the offset
+    /// places v after q in the 2n-dimensional jet of a discretization map).
+    Jet {
+        order: u8,
+        offset: u32,
+    },
     Param {
         param: u32,
         kind: Kind,
@@ -130,8 +135,19 @@ impl<'a> Lower<'a> {
     /// A lowering context with the arguments of `sig` in scope.
     pub fn new(g: &'a mut Graph, sig: &'a Signature) -> Self {
         let mut top = HashMap::new();
-        for (order, name) in sig.jet.iter().enumerate() {
-            top.insert(name.to_string(), Binding::Jet(order as u8));
+        for (position, name) in sig.jet.iter().enumerate() {
+            // a map's (q, v) is the 2n-dimensional point (q, v) of order 0
+            let binding = match sig.attribute {
+                Attribute::Map => Binding::Jet {
+                    order: 0,
+                    offset: (position * sig.dim) as u32,
+                },
+                _ => Binding::Jet {
+                    order: position as u8,
+                    offset: 0,
+                },
+            };
+            top.insert(name.to_string(), binding);
         }
         for (i, p) in sig.params.iter().enumerate() {
             top.insert(
@@ -199,6 +215,14 @@ impl<'a> Lower<'a> {
                     "the body must end with the value of the Lagrangian (an expression without `;`)",
                 )
             }
+        }
+    }
+
+    /// Statements before the tail expression of a body (for a body whose tail is not one
+    /// value: the points of a discretization map).
+    pub fn statements(&mut self, stmts: &[Stmt]) {
+        for stmt in stmts {
+            self.stmt(stmt);
         }
     }
 
@@ -710,9 +734,12 @@ impl<'a> Lower<'a> {
             }
             Some((_, Binding::Int(v))) => self.g.constant(v as f64),
             Some((_, Binding::Poisoned)) => self.g.constant(0.0),
-            Some((_, Binding::Jet(order))) => {
+            Some((_, Binding::Jet { order, offset })) => {
                 if self.sig.scalar_jet {
-                    self.g.var(Var::Jet { order, index: 0 })
+                    self.g.var(Var::Jet {
+                        order,
+                        index: offset,
+                    })
                 } else {
                     self.error(
                         ident.span(),
@@ -754,9 +781,13 @@ impl<'a> Lower<'a> {
             return self.g.constant(0.0);
         };
         let (len, var) = match self.lookup(&name) {
-            Some((_, Binding::Jet(order))) if !self.sig.scalar_jet => {
-                (self.sig.dim, Var::Jet { order, index: 0 })
-            }
+            Some((_, Binding::Jet { order, offset })) if !self.sig.scalar_jet => (
+                self.sig.dim,
+                Var::Jet {
+                    order,
+                    index: offset,
+                },
+            ),
             Some((
                 _,
                 Binding::Param {
@@ -789,7 +820,13 @@ impl<'a> Lower<'a> {
             );
         };
         let var = match var {
-            Var::Jet { order, .. } => Var::Jet { order, index },
+            Var::Jet {
+                order,
+                index: offset,
+            } => Var::Jet {
+                order,
+                index: offset + index,
+            },
             Var::Param { param, .. } => Var::Param { param, index },
             Var::Elem { param, .. } => Var::Elem { param, index },
             other => other,

@@ -53,6 +53,8 @@ pub enum Attribute {
     Lagrangian,
     /// `#[jet_function]`: a scalar function of the jet with its gradient and Hessian.
     JetFunction,
+    /// `#[discretization_map]`: a map (q, v) -> (R1, R2), lifted to T^(k-1)Q.
+    Map,
 }
 
 impl Attribute {
@@ -61,6 +63,7 @@ impl Attribute {
         match self {
             Attribute::Lagrangian => "higher_order_lagrangian",
             Attribute::JetFunction => "jet_function",
+            Attribute::Map => "discretization_map",
         }
     }
 
@@ -69,6 +72,15 @@ impl Attribute {
         match self {
             Attribute::Lagrangian => msg,
             Attribute::JetFunction => msg.replace("Lagrangian", "jet function"),
+            Attribute::Map => msg.replace("Lagrangian", "discretization map"),
+        }
+    }
+
+    /// How many arguments come before the parameters: the jet q, ..., q^(k), or (q, v).
+    fn jet_count(self, order: usize) -> usize {
+        match self {
+            Attribute::Map => 2,
+            _ => order + 1,
         }
     }
 }
@@ -97,6 +109,8 @@ pub struct Signature {
     pub type_name: Ident,
     /// Whether the domain check (singularity guard) is emitted.
     pub guard: bool,
+    /// Whether a discretization map's conditions are checked at compile time (`check`).
+    pub check: bool,
     /// The attribute that is expanded.
     pub attribute: Attribute,
 }
@@ -106,6 +120,7 @@ struct Options {
     order: Option<(usize, Span)>,
     name: Option<Ident>,
     guard: bool,
+    check: bool,
 }
 
 fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options> {
@@ -113,6 +128,7 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         order: None,
         name: None,
         guard: true,
+        check: true,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("order") {
@@ -133,6 +149,15 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
+        } else if meta.path.is_ident("check") && attribute == Attribute::Map {
+            let lit: syn::LitBool = meta.value()?.parse()?;
+            options.check = lit.value;
+            Ok(())
+        } else if attribute == Attribute::Map {
+            Err(meta.error(
+                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
+                 `check = false`",
+            ))
         } else {
             Err(meta.error("unsupported option; supported: `order = k` (1..=4), `name = TypeName`"))
         }
@@ -221,8 +246,9 @@ impl Errors {
     }
 }
 
-/// The function's qualifiers, generics and return type: errors for `const`, `async`,
-/// `unsafe`, generic parameters and a return type other than `f64`.
+/// The function's qualifiers, generics and (except for a map: [`check_map_return`]) return
+/// type: errors for `const`, `async`, `unsafe`, generic parameters and a return type other
+/// than `f64`.
 fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
     if let Some(c) = &sig.constness {
         errors.fail(c.span(), "a Lagrangian cannot be a `const fn`".into());
@@ -240,6 +266,7 @@ fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
         );
     }
     match &sig.output {
+        _ if errors.attribute == Attribute::Map => {}
         ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
         ReturnType::Type(_, ty) => errors.fail(
             ty.span(),
@@ -252,12 +279,31 @@ fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
     }
 }
 
+/// The return type of a map: the pair `(T, T)` of points, T the type of q.
+fn check_map_return(sig: &syn::Signature, jet_kind: Option<Kind>, errors: &mut Errors) {
+    let expected = jet_kind
+        .map(Kind::describe)
+        .unwrap_or_else(|| "[f64; N]".into());
+    let msg = format!(
+        "a discretization map returns the pair of points (R1, R2): the return type must be \
+         `({expected}, {expected})`, the type of q twice"
+    );
+    match &sig.output {
+        ReturnType::Type(_, ty) => match &**ty {
+            Type::Tuple(t)
+                if t.elems.len() == 2 && t.elems.iter().all(|e| kind_of(e) == jet_kind) => {}
+            _ => errors.fail(ty.span(), msg),
+        },
+        ReturnType::Default => errors.fail(sig.ident.span(), msg),
+    }
+}
+
 /// The arguments of the function with their kinds, and the span of the type of the first
-/// (the configuration q); errors for `self`, patterns, mutable arguments, unsupported types
-/// and parameter arrays beyond [`MAX_LEN`].
+/// (the configuration q); errors for `self`, patterns, mutable arguments, unsupported types,
+/// parameter arrays beyond [`MAX_LEN`] and parameter lists of a map.
 fn arguments(
     sig: &syn::Signature,
-    order: usize,
+    jet_count: usize,
     errors: &mut Errors,
 ) -> (Vec<(Ident, Kind)>, Span) {
     let mut args: Vec<(Ident, Kind)> = Vec::new();
@@ -294,10 +340,22 @@ fn arguments(
         };
         match kind_of(&arg.ty) {
             // a parameter (the jet's dimension is checked below)
-            Some(Kind::Array(len) | Kind::Slice(len)) if len > MAX_LEN && args.len() > order => {
+            Some(Kind::Array(len) | Kind::Slice(len))
+                if len > MAX_LEN && args.len() >= jet_count =>
+            {
                 errors.fail(
                     arg.ty.span(),
                     format!("array length {len} exceeds the supported maximum of {MAX_LEN}"),
+                )
+            }
+            Some(Kind::Slice(_))
+                if errors.attribute == Attribute::Map && args.len() >= jet_count =>
+            {
+                errors.fail(
+                    arg.ty.span(),
+                    "unsupported parameter type for a discretization map; supported: `f64` and \
+                     `[f64; N]`"
+                        .into(),
                 )
             }
             Some(kind) => {
@@ -354,8 +412,8 @@ fn dimension(
     }
 }
 
-/// The names of q, q', ..., q^(order): the first `order + 1` arguments; errors where one is
-/// not of the type of q.
+/// The names of q, q', ..., q^(order) (the first `order + 1` arguments), or of q and v for
+/// a map; errors where one is not of the type of q.
 fn jet_names(
     args: &[(Ident, Kind)],
     order: usize,
@@ -363,11 +421,20 @@ fn jet_names(
     errors: &mut Errors,
 ) -> Vec<Ident> {
     let mut jet = Vec::new();
-    for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
+    for (i, (name, kind)) in args
+        .iter()
+        .take(errors.attribute.jet_count(order))
+        .enumerate()
+    {
         if Some(*kind) != jet_kind {
             let expected = jet_kind.map(Kind::describe).unwrap_or_default();
-            let msg = if matches!(kind, Kind::Array(_)) && matches!(jet_kind, Some(Kind::Array(_)))
-            {
+            let msg = if errors.attribute == Attribute::Map {
+                format!(
+                    "argument 2 (`{name}`) is the tangent vector v: it must have the type of q \
+                     ({expected}), not {}",
+                    kind.describe()
+                )
+            } else if matches!(kind, Kind::Array(_)) && matches!(jet_kind, Some(Kind::Array(_))) {
                 format!(
                     "inconsistent dimensions across jet arguments: `{name}` is {} but `{}` is \
                      {expected}",
@@ -408,24 +475,34 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         ));
     };
     check_qualifiers(sig, &mut errors);
-    let (args, jet_span) = arguments(sig, order, &mut errors);
+    let jet_count = attribute.jet_count(order);
+    let (args, jet_span) = arguments(sig, jet_count, &mut errors);
     let jet_kind = args.first().map(|(_, k)| *k);
     let (dim, scalar_jet) = dimension(sig, jet_kind, jet_span, order, &mut errors);
-    if args.len() < order + 1 && errors.list.is_empty() {
-        errors.fail(
-            order_span,
+    if attribute == Attribute::Map {
+        check_map_return(sig, jet_kind, &mut errors);
+    }
+    if args.len() < jet_count && errors.list.is_empty() {
+        let msg = if attribute == Attribute::Map {
+            format!(
+                "a discretization map takes the point q and the tangent vector v (two arguments \
+                 of one type) before its parameters; the signature has {}",
+                args.len()
+            )
+        } else {
             format!(
                 "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
                  the signature has {}",
                 order + 1,
                 args.len()
-            ),
-        );
+            )
+        };
+        errors.fail(order_span, msg);
     }
     let jet = jet_names(&args, order, jet_kind, &mut errors);
     let params = args
         .iter()
-        .skip(order + 1)
+        .skip(jet_count)
         .map(|(name, kind)| Param {
             name: name.clone(),
             kind: *kind,
@@ -450,6 +527,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         params,
         type_name,
         guard: options.guard,
+        check: options.check,
         attribute,
     })
 }

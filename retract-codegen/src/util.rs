@@ -1,5 +1,5 @@
-//! Helpers shared by the stages that import nothing from them: error combining and the
-//! text of tokens as the user wrote them. This module uses no other module of the crate,
+//! Helpers shared by the stages that import nothing from them: error combining, the text
+//! of tokens as the user wrote them and, for unit tests, an expansion formatted. This module uses no other module of the crate,
 //! so that `signature`, `lower`, the emission and the entry points can all use it without
 //! importing each other.
 
@@ -32,6 +32,29 @@ pub(crate) fn tidy(text: &str) -> String {
         out.push(c);
     }
     out
+}
+
+/// For unit tests of an expansion: `expand(attr, item)` from text, formatted, or its error
+/// messages joined by newlines.
+#[cfg(test)]
+pub(crate) fn pretty_expansion(
+    expand: fn(
+        proc_macro2::TokenStream,
+        proc_macro2::TokenStream,
+    ) -> syn::Result<proc_macro2::TokenStream>,
+    attr: &str,
+    item: &str,
+) -> Result<String, String> {
+    let attr: proc_macro2::TokenStream = attr.parse().map_err(|e| format!("{e}"))?;
+    let item: proc_macro2::TokenStream = item.parse().map_err(|e| format!("{e}"))?;
+    let tokens = expand(attr, item).map_err(|e| {
+        e.into_iter()
+            .map(|e| e.to_string())
+            .collect::<Vec<_>>()
+            .join("\n")
+    })?;
+    let file: syn::File = syn::parse2(tokens).map_err(|e| e.to_string())?;
+    Ok(prettyplease::unparse(&file))
 }
 
 #[cfg(test)]

@@ -54,6 +54,11 @@ impl Leaves for Names<'_> {
                 let m = self::index(m as usize);
                 quote!(y[#m])
             }
+            Var::Covector { side, block, index } => {
+                let w = if side == 0 { quote!(w1) } else { quote!(w2) };
+                let (b, i) = (self::index(block as usize), self::index(index as usize));
+                quote!(#w[#b][#i])
+            }
             Var::Step => quote!(h),
             Var::Theta => quote!(theta),
         }

@@ -9,6 +9,9 @@
 //! - `reduced`: the `ReducedScheme` impl, where the Hessian of L depends on a few jet
 //!   components only.
 //!
+//! `map` emits the items of `#[discretization_map]` (its own type and `DiscretizationMap`
+//! impl, from the stages `map_lift` and `map_check`).
+//!
 //! Shared by them (and by `#[jet_function]`): the token helpers (`helpers`) and the
 //! straight-line bodies of a scalar function of the jet (`scalar`). The items are
 //! concatenated by `expand`, in the order above.
@@ -28,6 +31,7 @@ pub(crate) mod domain;
 pub(crate) mod helpers;
 pub(crate) mod lagrangian;
 pub(crate) mod lifted;
+pub(crate) mod map;
 pub(crate) mod reduced;
 pub(crate) mod scalar;
 pub(crate) mod ty;
