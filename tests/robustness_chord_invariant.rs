@@ -128,20 +128,22 @@ fn angular_momentum(z: &SVector<f64, 8>) -> f64 {
 }
 
 #[test]
-#[ignore = "item 13 is open: the reduced step drifts 6.5e-10 over 1e7 steps (see the comment)"]
 fn item_13_the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
     // The midpoint rule conserves the angular momentum of a rotation-invariant Lagrangian
     // exactly; solved by the general step it stays within 9e-13 (relative) over 1e7 steps, a
-    // random walk of rounding errors. The reduced step drifts linearly, 6.5e-17 per step:
-    // its cached propagator T = -A^{-1} B is rounded once, so every step applies the same
-    // slightly non-symplectic linear map. Measured (h = 0.1, 1e6 steps, relative drift):
-    // 6.5e-11 with the cached factors (closed form or LU alike, any Newton tolerance, the core
-    // solved to 1e-17); 1.3e-13 when w = (T + T_lo) z0 - A^{-1} n is summed exactly with the
-    // correction T_lo = -A^{-1} (A T + B) (the rounding error of T); unchanged (6.5e-11) when
-    // T_lo z0 is added after the rounded recovery (a sub-ulp addition to a rounded value is
-    // lost). The fix needs the correction inside the emitted recovery, before its last
-    // rounding. Bound: 1e-11, ten times the general step's 9e-13 at 1e7 and 65 times below
-    // the drift today; 1e7 reduced steps take about a second in the test profile.
+    // random walk of rounding errors. The reduced step drifted linearly, 6.5e-17 per step
+    // (6.5e-11 at 1e6 steps, 6.5e-10 at 1e7; any Newton tolerance, closed form or LU alike):
+    // its cached propagator T = -A^{-1} B (and the forced columns of A^{-1}) are rounded once,
+    // so every step applied the same slightly non-symplectic linear map. The factors now carry
+    // their rounding errors, T_lo = -A^{-1}(A T + B) and A^{-1}(E - A a_inv) (residuals summed
+    // compensated), and the recovery adds T_lo z0 - a_inv_lo n to the exact error of its last
+    // addition, inside the one rounding of each entry of w (added after that rounding, a
+    // correction below the last bit is lost: the drift stayed 6.5e-11 at 1e6). Measured
+    // (h = 0.1, relative, worst over the run): 4.2e-13 at 1e6 steps and 2.1e-12 at 1e7;
+    // 3.5e-12 at 1e7 without the A^{-1} correction; 1.6e-13 and 6.3e-13 with each row summed
+    // fully compensated (Dot2), which made the step 3x slower. Bound: 1e-11, five times the
+    // measured 2.1e-12 and 65 times below the drift before; 1e7 reduced steps take about a
+    // second in the test profile.
     let (system, z0) = common::models::bounded_pais_uhlenbeck();
     let j0 = angular_momentum(&z0);
     let options = StepOptions::default();

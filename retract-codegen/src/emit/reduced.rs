@@ -6,16 +6,18 @@
 //! With E the selection of the core rows, the factors of a step size are T = -A^{-1} B, the
 //! forced columns of A^{-1}, K = theta E A^{-1} and G = (1 - theta) E + theta E T; the core
 //! system is r(y) = y - G z0 + K n(y) with Jacobian I + K dn/dy, and the unknowns are
-//! recovered as w = T z0 - A^{-1} n(y). Every product is emitted over the structural
-//! nonzeros of its factor; where T and A^{-1} are known in closed form (a symbolic
-//! elimination of the blocks of A at compile time, `closed_form_factors`), its zeros refine
-//! the patterns and its constants are written in place of cached values.
+//! recovered as w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y), the corrections (the cached
+//! factors' rounding errors, `retract_core::reduced`) added inside the last rounding of each
+//! entry. Every product is emitted over the structural nonzeros of its factor; where T and
+//! A^{-1} are known in closed form (a symbolic elimination of the blocks of A at compile time,
+//! `closed_form_factors`), its zeros refine the patterns and its constants are written in
+//! place of cached values (a constant +-1 is exact: no correction).
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::Emission;
-use super::helpers::{index, signed_sum, sum_tree};
+use super::helpers::{index, signed_sum};
 use crate::codegen::{Emitted, constant, emit};
 use crate::graph::Id;
 use crate::mechanics::{self, Reduced};
@@ -125,25 +127,6 @@ impl<'a> Reduction<'a> {
         red.closed_form
             .as_ref()
             .map(|(_, a_inv, _)| a_inv[row * forced_count + f])
-    }
-
-    /// A cached factor entry times a value, or the known constant times it, as
-    /// `(negative, tokens)`.
-    fn coefficient(
-        &self,
-        cached: TokenStream,
-        known: Option<Id>,
-        value: TokenStream,
-    ) -> (bool, TokenStream) {
-        match known.and_then(|id| self.e.g.as_const(id)) {
-            Some(1.0) => (false, value),
-            Some(-1.0) => (true, value),
-            Some(v) => {
-                let v = constant(v);
-                (false, quote!(#v * #value))
-            }
-            None => (false, quote!(#cached * #value)),
-        }
     }
 
     /// The impl: the core, forced rows and blocks as constants, then its methods.
@@ -504,48 +487,108 @@ impl<'a> Reduction<'a> {
         }
     }
 
-    /// The method `recover`: w = T z0 - A^{-1} n(y) over the structural nonzeros.
+    /// A term `factor * value` of a row of w: the cached factor entry, or its constant where
+    /// the closed form knows one (times `sign`).
+    fn term(&self, cached: TokenStream, known: Option<Id>, value: TokenStream, sign: f64) -> Term {
+        match known.and_then(|id| self.e.g.as_const(id)).map(|v| sign * v) {
+            Some(1.0) => Term::Exact(value),
+            Some(-1.0) => Term::Exact(quote!(-#value)),
+            Some(v) => {
+                let v = constant(v);
+                Term::Product(quote!(#v), value)
+            }
+            None if sign < 0.0 => Term::Product(quote!(-#cached), value),
+            None => Term::Product(cached, value),
+        }
+    }
+
+    /// Row `row` of w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y): the terms of T and A^{-1}
+    /// summed as a balanced tree, the last addition exact (`two_sum`), and the corrections
+    /// (T_lo z0 and A^{-1}_lo n, of the size of the rounding errors) added to its error, so
+    /// that they enter the one rounding of the result instead of being lost below the last
+    /// bit. A row of exact terms (factors +-1) has no correction and is a plain sum.
+    fn recover_row(&self, row: usize) -> TokenStream {
+        let (core, s, red) = (&self.e.core, self.e.s, self.red);
+        let rl = index(row);
+        let mut terms: Vec<Term> = Vec::new();
+        let mut corrections: Vec<(bool, TokenStream)> = Vec::new();
+        for c in (0..s).filter(|&c| self.t_pattern[row][c]) {
+            let (cl, z) = (index(c), z0_entry(c));
+            let term = self.term(
+                quote!(factors.t[(#rl, #cl)]),
+                self.closed_t(row, c),
+                z.clone(),
+                1.0,
+            );
+            // T_lo is the rounding error of the T the step multiplies (the cached one, which
+            // holds the closed form's values): none where that is +-1, exact
+            if matches!(term, Term::Product(..)) {
+                corrections.push((false, quote!(factors.t_lo[(#rl, #cl)] * #z)));
+            }
+            terms.push(term);
+        }
+        // the forcing is known last: its terms join the sum of the others at the end
+        let forced_start = terms.len();
+        for &q in red.rows.iter().filter(|&&q| self.inverse_pattern[row][q]) {
+            let (ql, name) = (index(q), n_name(q));
+            let term = self.term(
+                quote!(factors.a_inv[(#rl, #ql)]),
+                self.closed_a_inv(row, q),
+                quote!(#name),
+                -1.0,
+            );
+            if matches!(term, Term::Product(..)) {
+                corrections.push((true, quote!(factors.a_inv_lo[(#rl, #ql)] * #name)));
+            }
+            terms.push(term);
+        }
+        let signed: Vec<(bool, TokenStream)> = terms
+            .iter()
+            .map(|term| match term {
+                Term::Exact(v) => (false, v.clone()),
+                Term::Product(a, b) => (false, quote!(#a * #b)),
+            })
+            .collect();
+        if corrections.is_empty() {
+            return signed_sum(&signed);
+        }
+        let small = signed_sum(&corrections);
+        if let [Term::Product(a, b)] = terms.as_slice() {
+            // one product: its own rounding error, exact, carries the correction
+            return quote!({
+                let (__p, __e) = #core::reduced::two_product(#a, #b);
+                __p + (__e + #small)
+            });
+        }
+        let split = if forced_start > 0 && forced_start < terms.len() {
+            forced_start
+        } else {
+            terms.len() / 2
+        };
+        let (left, right) = signed.split_at(split);
+        let (left, right) = (signed_sum(left), signed_sum(right));
+        quote!({
+            let (__s, __e) = #core::reduced::two_sum(#left, #right);
+            __s + (__e + #small)
+        })
+    }
+
+    /// The method `recover`: w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the
+    /// structural nonzeros, each row with its corrections inside its last rounding
+    /// ([`Self::recover_row`]).
     fn recover(&self, forcing_lets: &[TokenStream]) -> TokenStream {
         let Emission {
-            s,
             m,
             vec_s,
             vec_m,
             vec_m_path,
             ..
         } = self.e;
-        let (red, factors_ty) = (self.red, &self.factors_ty);
-        let recover_sets = (0..*m).map(|row| {
-            let terms: Vec<(bool, TokenStream)> = (0..*s)
-                .filter(|&c| self.t_pattern[row][c])
-                .map(|c| {
-                    let (rl, cl, z) = (index(row), index(c), z0_entry(c));
-                    self.coefficient(quote!(factors.t[(#rl, #cl)]), self.closed_t(row, c), z)
-                })
-                .collect();
-            let forced: Vec<(bool, TokenStream)> = red
-                .rows
-                .iter()
-                .filter(|&&q| self.inverse_pattern[row][q])
-                .map(|&q| {
-                    let (rl, ql, name) = (index(row), index(q), n_name(q));
-                    let (negative, term) = self.coefficient(
-                        quote!(factors.a_inv[(#rl, #ql)]),
-                        self.closed_a_inv(row, q),
-                        quote!(#name),
-                    );
-                    (!negative, term)
-                })
-                .collect();
-            // the forcing is known last: its terms join the sum of the others at the end
-            let parts: Vec<(bool, TokenStream)> = [sum_tree(&terms), sum_tree(&forced)]
-                .into_iter()
-                .flatten()
-                .collect();
-            signed_sum(&parts)
-        });
+        let factors_ty = &self.factors_ty;
+        let recover_sets = (0..*m).map(|row| self.recover_row(row));
         quote! {
-            /// w = T z0 - A^{-1} n(y) over the structural nonzeros.
+            /// w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the structural nonzeros,
+            /// the corrections inside each row's last rounding.
             #[inline]
             fn recover(
                 &self,
@@ -558,6 +601,14 @@ impl<'a> Reduction<'a> {
             }
         }
     }
+}
+
+/// A term of a row of w.
+enum Term {
+    /// An exact value (a value times +-1).
+    Exact(TokenStream),
+    /// A product `a * b`.
+    Product(TokenStream, TokenStream),
 }
 
 /// The name `__n<q>` of n_q(y) in the generated code.
