@@ -1,6 +1,6 @@
 //! Issue 14, the macro: hostile but valid inputs compile to code that computes what the
 //! annotated function computes, with the right derivatives. (Inputs that must be rejected are
-//! in `tests/ui/fail/item_*.rs`; the expansion itself is tested in
+//! in `validation/tests/ui/fail/item_*.rs`; the expansion itself is tested in
 //! `retract-codegen/tests/robustness_items.rs`.)
 
 use retract::Lagrangian;

@@ -1,7 +1,7 @@
 //! Regression tests of the macro items of issue 14 at the level of the expansion: each
 //! input ends in correct code or in an error at its span, never in a panic, a hang or a
 //! silently wrong derivative. (The compiled behaviour is checked in the workspace's
-//! `tests/macro_robustness.rs`, `tests/derivatives.rs` and `tests/ui`.)
+//! `tests/macro_robustness.rs`, `validation/tests/derivatives.rs` and `validation/tests/ui`.)
 
 use proc_macro2::TokenStream;
 use retract_codegen::{try_expand, try_expand_jet_function};

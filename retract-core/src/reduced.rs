@@ -25,7 +25,7 @@
 //! cached factors as straight-line code over their nonzeros, with the factors' constant
 //! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
 //! obstacle system a step without the domain check takes about 1.6x the time of one written by
-//! hand for $h$ and $\theta$ fixed at compile time (`cargo bench --bench step`; 1.2x without
+//! hand for $h$ and $\theta$ fixed at compile time (`cargo bench -p retract-validation --bench step`; 1.2x without
 //! the corrections below).
 //!
 //! Cached, $T$ and $A^{-1}$ are rounded once, so every step would apply the same slightly

@@ -11,8 +11,9 @@
 //!    run.
 //!
 //! Writes docs/work_precision.svg and docs/energy_long_run.svg and prints the tables.
-//! Run: `cargo run --release --example work_precision`
+//! Run: `cargo run --release -p retract-validation --example work_precision`
 
+#[path = "../../examples/common/mod.rs"]
 mod common;
 
 use std::time::Instant;

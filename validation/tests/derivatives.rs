@@ -6,6 +6,7 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+#[path = "../../tests/common/mod.rs"]
 mod common;
 
 use common::{grad_entry, hess_entry};

@@ -9,7 +9,7 @@
 //! alternate round by round, best of `ROUNDS` each, so a change of machine speed hits both):
 //! the one-disc scene of `../shared/BENCHMARKS.md` from its bump guess and the SE(2) scene
 //! from the spline guess, cold and warm (after a shift by one step), with the iteration counts
-//! and the costs both reach. Then criterion. Run: `cargo bench --bench bvp`.
+//! and the costs both reach. Then criterion. Run: `cargo bench -p retract-validation --bench bvp`.
 
 use std::time::Instant;
 

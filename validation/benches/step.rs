@@ -10,7 +10,7 @@
 //! - the dense 12x12 residual with a central finite-difference Jacobian.
 //!
 //! Criterion times each; a ratio table, timed in the same run (best of repeated batches),
-//! is printed first. Run: `cargo bench --bench step`.
+//! is printed first. Run: `cargo bench -p retract-validation --bench step`.
 
 use std::hint::black_box;
 use std::time::Instant;

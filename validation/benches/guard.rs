@@ -3,7 +3,7 @@
 //! paper's closest approach: the three points, the step's check with the chord rule (a step of
 //! h = 0.01 is shorter than the default spacing 0.02: no pieces), and the chord of a long step
 //! (h = 0.1, 16 pieces at a spacing of 0.005).
-//! Run: `cargo bench --bench guard`.
+//! Run: `cargo bench -p retract-validation --bench guard`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use retract::higher_order_lagrangian;
