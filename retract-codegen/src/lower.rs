@@ -117,6 +117,32 @@ struct SliceLoop {
     contributions: Vec<(String, Id)>,
 }
 
+/// The optimal string alignment distance: insertions, deletions, substitutions and swaps of
+/// neighbouring characters, one each.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut best = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = best;
+        }
+    }
+    d[a.len()][b.len()]
+}
+
 /// Lowers statements into the graph.
 pub struct Lower<'a> {
     pub g: &'a mut Graph,
@@ -175,6 +201,19 @@ impl<'a> Lower<'a> {
         let msg = self.sig.attribute.reword(msg.into());
         self.errors.push(syn::Error::new(span, msg));
         self.g.constant(0.0)
+    }
+
+    /// ` (did you mean `x`?)` for the name in scope closest to `name` (at most two edits, a
+    /// swap of neighbours counting one, and fewer than its length), else nothing.
+    fn suggestion(&self, name: &str) -> String {
+        self.scopes
+            .iter()
+            .flat_map(|scope| scope.keys())
+            .map(|candidate| (edit_distance(name, candidate), candidate))
+            .filter(|&(d, _)| d <= 2 && d < name.chars().count())
+            .min()
+            .map(|(_, candidate)| format!(" (did you mean `{candidate}`?)"))
+            .unwrap_or_default()
     }
 
     fn lookup(&self, name: &str) -> Option<(usize, Binding)> {
@@ -759,13 +798,16 @@ impl<'a> Lower<'a> {
                 format!("`{name}` is an array: use its components `{name}[i]`"),
             ),
             None if is_const_name(&name) => self.g.named(name),
-            None => self.error(
-                ident.span(),
-                format!(
-                    "cannot find `{name}`: a Lagrangian may use its arguments, `let` bindings, \
-                     loop variables and consts (SCREAMING_CASE or by path)"
-                ),
-            ),
+            None => {
+                let hint = self.suggestion(&name);
+                self.error(
+                    ident.span(),
+                    format!(
+                        "cannot find `{name}`{hint}: a Lagrangian may use its arguments, `let` \
+                         bindings, loop variables and consts (SCREAMING_CASE or by path)"
+                    ),
+                )
+            }
         }
     }
 
@@ -796,6 +838,13 @@ impl<'a> Lower<'a> {
                 },
             )) => (len, Var::Param { param, index: 0 }),
             Some((_, Binding::Element { param, len })) => (len, Var::Elem { param, index: 0 }),
+            None => {
+                let hint = self.suggestion(&name);
+                return self.error(
+                    ident.span(),
+                    format!("cannot find `{name}`{hint}; only array arguments can be indexed"),
+                );
+            }
             _ => {
                 return self.error(
                     ident.span(),

@@ -420,12 +420,31 @@ fn jet_names(
     jet_kind: Option<Kind>,
     errors: &mut Errors,
 ) -> Vec<Ident> {
+    let count = errors.attribute.jet_count(order);
+    if let Some(first) = parameters_first(args, count) {
+        let moved: Vec<String> = args[..first]
+            .iter()
+            .map(|(n, _)| format!("`{n}`"))
+            .collect();
+        let jet: Vec<String> = args[first..first + count]
+            .iter()
+            .map(|(n, _)| n.to_string())
+            .collect();
+        errors.fail(
+            args[0].0.span(),
+            format!(
+                "parameters go after the jet: {} {} before `{}`; write ({}, then the \
+                 parameters)",
+                moved.join(", "),
+                if moved.len() == 1 { "comes" } else { "come" },
+                args[first].0,
+                jet.join(", ")
+            ),
+        );
+        return args.iter().take(count).map(|(n, _)| n.clone()).collect();
+    }
     let mut jet = Vec::new();
-    for (i, (name, kind)) in args
-        .iter()
-        .take(errors.attribute.jet_count(order))
-        .enumerate()
-    {
+    for (i, (name, kind)) in args.iter().take(count).enumerate() {
         if Some(*kind) != jet_kind {
             let expected = jet_kind.map(Kind::describe).unwrap_or_default();
             let msg = if errors.attribute == Attribute::Map {
@@ -454,6 +473,21 @@ fn jet_names(
         jet.push(name.clone());
     }
     jet
+}
+
+/// Where the jet starts when parameters were written before it: the first position `s > 0`
+/// from which `count` arguments share one array or scalar type that the first argument does
+/// not have; `None` when the first argument starts such a run (or none exists).
+fn parameters_first(args: &[(Ident, Kind)], count: usize) -> Option<usize> {
+    let run = |s: usize| {
+        args.get(s..s + count).is_some_and(|jet| {
+            !matches!(jet[0].1, Kind::Slice(_)) && jet.iter().all(|(_, k)| *k == jet[0].1)
+        })
+    };
+    if count < 2 || run(0) {
+        return None;
+    }
+    (1..args.len()).find(|&s| run(s) && args[0].1 != args[s].1)
 }
 
 /// Checks the attribute and the signature of `item` under `attribute`.
