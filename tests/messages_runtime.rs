@@ -424,3 +424,76 @@ fn debug_of_an_interrupted_trajectory_is_a_summary() {
     // the pretty form is a summary too
     assert!(format!("{stop:#?}").lines().count() < 60);
 }
+
+/// A planar body among discs given as a parameter list.
+#[higher_order_lagrangian(order = 2)]
+fn disc_list(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64, discs: &[[f64; 3]]) -> f64 {
+    let mut l = 0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1]);
+    for d in discs {
+        l += tau / ((q[0] - d[0]).powi(2) + (q[1] - d[1]).powi(2) - d[2] * d[2]);
+    }
+    l
+}
+
+/// A NaN parameter is named (issue 16, item 7) by steps, the reduced step and solves, not
+/// reported as a non-finite residual.
+#[test]
+fn a_nan_parameter_is_named() {
+    let system = OneDisc { tau: f64::NAN };
+    let z0 = state(&OneDisc { tau: 1e-2 }, [-2.0, 0.2, 1.0, 0.0]);
+    let options = StepOptions::default();
+    let general = retract::step(&system, &z0, 0.01, &options).unwrap_err();
+    assert!(
+        matches!(
+            general,
+            Error::NonFiniteParameter {
+                name: "tau",
+                element: None,
+                index: None
+            }
+        ),
+        "{general}"
+    );
+    contains_all(&general.to_string(), &["parameter `tau`", "not finite"]);
+    let reduced = ReducedStepper::new(&system)
+        .step(&z0, 0.01, &options)
+        .unwrap_err();
+    assert!(
+        matches!(reduced, Error::NonFiniteParameter { name: "tau", .. }),
+        "{reduced}"
+    );
+    let (x, u) = disc_bump_guess(40);
+    let plan = OptimalControlProblem::new(&system, &DISC_START, &DISC_GOAL, 4.0, 40)
+        .solve(PlanGuess::Path { x: &x, u: &u })
+        .unwrap_err();
+    contains_all(&plan.to_string(), &["parameter `tau`"]);
+    let bvp = BoundaryValueProblem::new(&system, &DISC_START, &DISC_GOAL, 4.0, 40)
+        .solve(Guess::Spline)
+        .unwrap_err();
+    assert!(
+        matches!(bvp, Error::NonFiniteParameter { name: "tau", .. }),
+        "{bvp}"
+    );
+    // an element of a parameter list: its index and component
+    let discs = [[0.0, -5.0, 1.0], [0.0, f64::INFINITY, 1.0]];
+    let listed = DiscList {
+        tau: 1e-2,
+        discs: &discs,
+    };
+    let z0 = state(&listed, [-2.0, 0.2, 1.0, 0.0]);
+    let error = retract::step(&listed, &z0, 0.01, &options).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            Error::NonFiniteParameter {
+                name: "discs",
+                element: Some(1),
+                index: Some(1)
+            }
+        ),
+        "{error}"
+    );
+    contains_all(&error.to_string(), &["`discs` element 1 component 1"]);
+    // finite parameters pass
+    assert!(OneDisc { tau: 1e-2 }.check_parameters().is_ok());
+}

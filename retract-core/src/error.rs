@@ -104,6 +104,17 @@ pub enum Error {
         /// The quantity that was not finite.
         location: &'static str,
     },
+    /// A parameter of the system is NaN or infinite (reported by
+    /// [`LiftedSystem::check_parameters`](crate::LiftedSystem::check_parameters) when a step or
+    /// solve meets a non-finite value, or before a solve starts).
+    NonFiniteParameter {
+        /// The parameter's name, as written in the Lagrangian.
+        name: &'static str,
+        /// For a parameter list (`&[[f64; M]]`): the element (saturated at `u32::MAX`).
+        element: Option<u32>,
+        /// For an array: the component.
+        index: Option<u32>,
+    },
     /// The Newton matrix had a zero pivot (or its solve overflowed) at `iteration`.
     SingularJacobian {
         /// Newton iteration at which the factorisation failed.
@@ -324,6 +335,23 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
+            Error::NonFiniteParameter {
+                name,
+                element,
+                index,
+            } => {
+                write!(f, "parameter `{name}`")?;
+                if let Some(k) = element {
+                    write!(f, " element {k}")?;
+                }
+                if let Some(i) = index {
+                    write!(f, " component {i}")?;
+                }
+                write!(
+                    f,
+                    " is not finite (NaN or infinite): set it to a finite value"
+                )
+            }
             Error::NonFinite {
                 iteration,
                 location,

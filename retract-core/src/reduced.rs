@@ -762,6 +762,18 @@ where
         h: f64,
         options: &StepOptions,
     ) -> Result<(SVector<f64, S>, StepReport), Error> {
+        let system = self.system;
+        self.step_unnamed(z0, h, options)
+            .map_err(|e| crate::step::name_parameter(system, e))
+    }
+
+    /// [`Self::step`] before a non-finite value is traced to a parameter.
+    fn step_unnamed(
+        &mut self,
+        z0: &SVector<f64, S>,
+        h: f64,
+        options: &StepOptions,
+    ) -> Result<(SVector<f64, S>, StepReport), Error> {
         options.newton.validate()?;
         let theta = options.theta;
         let system = self.system;

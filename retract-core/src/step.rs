@@ -404,9 +404,24 @@ where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     options.validate(h)?;
-    let guess = system.predictor(z0, h, options.theta)?;
-    let (w, report) = solve_validated(system, z0, guess, h, options)?;
+    let solved = system
+        .predictor(z0, h, options.theta)
+        .and_then(|guess| solve_validated(system, z0, guess, h, options));
+    let (w, report) = solved.map_err(|e| name_parameter(system, e))?;
     Ok((system.state(&w), report))
+}
+
+/// A non-finite value met by a step, reported as the parameter that causes it when one is
+/// not finite ([`LiftedSystem::check_parameters`], run only on this failure path); any other
+/// error unchanged.
+pub(crate) fn name_parameter<Sys, const S: usize, const M: usize>(system: &Sys, e: Error) -> Error
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    match e {
+        Error::NonFinite { .. } => system.check_parameters().err().unwrap_or(e),
+        _ => e,
+    }
 }
 
 #[cfg(feature = "std")]

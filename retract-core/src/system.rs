@@ -225,6 +225,17 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
     fn predictor(&self, z0: &SVector<f64, S>, h: f64, theta: f64)
     -> Result<SVector<f64, M>, Error>;
 
+    /// Whether every parameter of the system is finite: the first that is not, as
+    /// [`Error::NonFiniteParameter`] naming it. Steps call it when they meet a non-finite
+    /// value, and solves before they start, so a NaN parameter is reported by name rather than
+    /// as a non-finite residual. The default (no parameters) is `Ok`.
+    ///
+    /// # Errors
+    /// The first non-finite parameter (component).
+    fn check_parameters(&self) -> Result<(), Error> {
+        Ok(())
+    }
+
     /// The domain check of a step: every guarded expression of $L$ (denominators, arguments
     /// of `sqrt`, `ln`, `powf`) evaluated at the start $x_0$, the end $x_1$ and the
     /// evaluation point $x_\theta$ of the step from `z0` to the unknowns `w`. A denominator

@@ -12,6 +12,7 @@ use super::Emission;
 use super::domain::check_domain;
 use super::helpers::index;
 use crate::codegen::emit;
+use crate::signature::Kind;
 
 /// `impl LiftedSystem<s, m>`.
 pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
@@ -46,6 +47,7 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
     let jacobian = e.matrix_body(&mech.jacobian, *m);
     let jacobian_initial = e.matrix_body(&mech.jacobian_initial, *s);
     let check_domain = check_domain(e);
+    let check_parameters = check_parameters(e);
 
     quote! {
         #header {
@@ -105,6 +107,8 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
 
             #check_domain
 
+            #check_parameters
+
             /// Explicit Euler guess of w.
             fn predictor(
                 &self,
@@ -114,6 +118,63 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
             ) -> ::core::result::Result<#vec_m, #core::Error> {
                 #core::lifted::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
             }
+        }
+    }
+}
+
+/// `check_parameters`: every scalar, array component and list element component of the
+/// parameters is finite, else `Error::NonFiniteParameter` naming the first that is not
+/// (nothing emitted without parameters: the trait's default is `Ok`).
+fn check_parameters(e: &Emission<'_>) -> TokenStream {
+    let core = &e.core;
+    if e.sig.params.is_empty() {
+        return quote!();
+    }
+    let saturate = quote!(|i: usize| u32::try_from(i).unwrap_or(u32::MAX));
+    let checks = e.sig.params.iter().map(|p| {
+        let field = &p.name;
+        let name = p.name.to_string();
+        let fail = |element: TokenStream, index: TokenStream| {
+            quote! {
+                return ::core::result::Result::Err(#core::Error::NonFiniteParameter {
+                    name: #name,
+                    element: #element,
+                    index: #index,
+                });
+            }
+        };
+        match p.kind {
+            Kind::Scalar => {
+                let fail = fail(quote!(None), quote!(None));
+                quote!(if !self.#field.is_finite() { #fail })
+            }
+            Kind::Array(_) => {
+                let fail = fail(quote!(None), quote!(Some(__u32(__i))));
+                quote! {
+                    for (__i, __v) in self.#field.iter().enumerate() {
+                        if !__v.is_finite() { #fail }
+                    }
+                }
+            }
+            Kind::Slice(_) => {
+                let fail = fail(quote!(Some(__u32(__k))), quote!(Some(__u32(__i))));
+                quote! {
+                    for (__k, __e) in self.#field.iter().enumerate() {
+                        for (__i, __v) in __e.iter().enumerate() {
+                            if !__v.is_finite() { #fail }
+                        }
+                    }
+                }
+            }
+        }
+    });
+    quote! {
+        /// Whether every parameter is finite; the first that is not, by name.
+        #[allow(clippy::redundant_closure_call, unused_variables)]
+        fn check_parameters(&self) -> ::core::result::Result<(), #core::Error> {
+            let __u32 = #saturate;
+            #(#checks)*
+            ::core::result::Result::Ok(())
         }
     }
 }

@@ -540,6 +540,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 requirement: "the optimizer needs the general unknowns w = (z_1, u)",
             }));
         }
+        self.system.check_parameters().map_err(invalid)?;
         let iterate = self.initial(guess).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {

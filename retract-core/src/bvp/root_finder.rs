@@ -340,6 +340,7 @@ where
     }
 
     fn validate(&self) -> Result<(), Error> {
+        self.system.check_parameters()?;
         let nk = S / 2;
         let invalid = |name, requirement| Err(Error::InvalidArgument { name, requirement });
         if M != S + Sys::DIMENSION {
