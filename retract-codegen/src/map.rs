@@ -189,7 +189,10 @@ mod tests {
             ["q[0] + 0.5 * v[0] + s * v[0] * v[0]", "q[1] + 0.5 * v[1]"],
         )
         .unwrap();
-        assert!(out.contains("struct M {"), "{out}");
+        assert!(
+            out.contains("struct M") && out.contains("pub c: f64"),
+            "{out}"
+        );
         assert!(out.contains("DiscretizationMap<2, 2> for M"), "{out}");
         assert!(out.contains("pub fn new(c: f64)"), "{out}");
         assert!(

@@ -237,6 +237,7 @@ fn interleaved_best_ns(rounds: usize, n: usize, fs: &mut [&mut dyn FnMut()]) -> 
     best
 }
 
+/// Checks that every variant computes the same step, then prints the tables.
 fn print_ratios(system: &RigidBody, z: &Z) {
     let options = StepOptions::default();
     let mut reduced = ReducedStepper::new(system);
@@ -254,7 +255,14 @@ fn print_ratios(system: &RigidBody, z: &Z) {
         &hand_guarded_step(z).expect("outside the disc"),
     );
     same("dual", &dense_step(z, Jacobian::Dual));
+    print_newton_systems(system, z);
+    print_steps(system, z);
+    print_interleaved(system, z);
+    print_runs();
+}
 
+/// The Newton system (residual and Jacobian) of one step, per variant.
+fn print_newton_systems(system: &RigidBody, z: &Z) {
     let w = system.predictor(z, H, 0.5).expect("regular");
     let factors = ReducedFactors::new(system, H, 0.5).expect("regular");
     let offset = system.core_offset(&factors, z);
@@ -320,7 +328,12 @@ fn print_ratios(system: &RigidBody, z: &Z) {
     for (name, ns) in systems {
         println!("  {name:<40} {ns:>9.1} ns");
     }
+}
 
+/// One step per variant, as ratios to the generated reduced step.
+fn print_steps(system: &RigidBody, z: &Z) {
+    let options = StepOptions::default();
+    let mut reduced = ReducedStepper::new(system);
     let unguarded = options.with_domain_check(false);
     let steps: [(&str, f64); 7] = [
         (
@@ -376,6 +389,13 @@ fn print_ratios(system: &RigidBody, z: &Z) {
     for (name, ns) in steps {
         println!("  {name:<40} {ns:>9.1} ns   {:>6.2}x", ns / reduced_ns);
     }
+}
+
+/// The generated and hand-written reduced steps, with and without the domain check, timed
+/// interleaved.
+fn print_interleaved(system: &RigidBody, z: &Z) {
+    let options = StepOptions::default();
+    let unguarded = options.with_domain_check(false);
     let (mut guarded, mut unguarded_stepper) =
         (ReducedStepper::new(system), ReducedStepper::new(system));
     let best = interleaved_best_ns(
@@ -414,6 +434,12 @@ fn print_ratios(system: &RigidBody, z: &Z) {
         best[0] / best[3],
         best[0] / best[2],
     );
+}
+
+/// The paper's 400-step run, generated (general and reduced) and hand-written, interleaved.
+fn print_runs() {
+    let options = StepOptions::default();
+    let unguarded = options.with_domain_check(false);
     let (system0, z0) = {
         let s = RigidBody { tau: TAU, r: 1.0 };
         let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
