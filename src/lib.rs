@@ -4,6 +4,11 @@
 #![warn(missing_docs)]
 
 pub use retract_core::*;
+
+// the generated items name `::retract`, also inside this crate (`sphere`)
+extern crate self as retract;
+
+pub mod sphere;
 pub use retract_macros::{higher_order_lagrangian, jet_function};
 
 /// A runnable example: the symmetric "bent midpoint" map lifted to order 2, stepping the

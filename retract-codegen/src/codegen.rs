@@ -21,7 +21,8 @@
 //! an inlined node that would nest deeper is bound to its `let` instead, and a chain whose
 //! balanced tree would is cut into `let __cN` temporaries (which changes no operation), so
 //! that 1000 chained `let`s or a recurrence unrolled 10 000 times compile (rustc's parser
-//! overflows its stack on a few thousand nested parentheses).
+//! overflows its stack on a few thousand nested parentheses). Long code is grouped into
+//! blocks (`scopes`) so that the `let`s do not nest thousands of scopes deep either.
 
 use std::cell::{Cell, RefCell};
 use std::cmp::Reverse;
@@ -31,6 +32,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::graph::{Func, Graph, Id, Node, Var, children};
+use crate::scopes::bounded_scopes;
 
 /// How a function names the leaves: symbol -> expression tokens.
 pub trait Leaves {
@@ -107,7 +109,10 @@ pub fn emit(g: &Graph, roots: &[Id], leaves: &dyn Leaves) -> Emitted {
     let mut stmts = emitter.statements(&placement);
     let exprs = roots.iter().map(|&r| emitter.reference(r, false)).collect();
     stmts.extend(emitter.take_pending());
-    Emitted { stmts, exprs }
+    Emitted {
+        stmts: bounded_scopes(stmts),
+        exprs,
+    }
 }
 
 /// Where the nodes needed by some roots are emitted.
@@ -809,25 +814,41 @@ mod tests {
         }
     }
 
+    /// Runs `let`s into `env`: typed ones, and the blocks of long code (`scopes`), whose
+    /// inner names are unique, so they are run into `env` directly.
+    fn run(stmts: &[syn::Stmt], env: &mut HashMap<String, f64>) {
+        for stmt in stmts {
+            let syn::Stmt::Local(local) = stmt else {
+                panic!("not a let: {stmt:?}")
+            };
+            let init = &local.init.as_ref().expect("initialiser").expr;
+            match &local.pat {
+                syn::Pat::Type(typed) => {
+                    let syn::Pat::Ident(name) = &*typed.pat else {
+                        panic!("pattern")
+                    };
+                    let value = evaluate(init, env);
+                    env.insert(name.ident.to_string(), value);
+                }
+                syn::Pat::Tuple(_) => {
+                    let syn::Expr::Block(block) = &**init else {
+                        panic!("a tuple from a block")
+                    };
+                    let inner = &block.block.stmts;
+                    run(&inner[..inner.len() - 1], env);
+                }
+                _ => panic!("untyped let"),
+            }
+        }
+    }
+
     /// The roots as emitted, evaluated at `x`.
     fn emitted(g: &Graph, roots: &[Id], x: &[f64]) -> Vec<f64> {
         let code = emit(g, roots, &Names);
         let stmts = &code.stmts;
         let block: syn::Block = syn::parse2(quote!({ #stmts })).expect("statements");
         let mut env: HashMap<String, f64> = (0..x.len()).map(|i| (format!("x{i}"), x[i])).collect();
-        for stmt in &block.stmts {
-            let syn::Stmt::Local(local) = stmt else {
-                panic!("not a let: {stmt:?}")
-            };
-            let syn::Pat::Type(typed) = &local.pat else {
-                panic!("untyped let")
-            };
-            let syn::Pat::Ident(name) = &*typed.pat else {
-                panic!("pattern")
-            };
-            let init = &local.init.as_ref().expect("initialiser").expr;
-            env.insert(name.ident.to_string(), evaluate(init, &env));
-        }
+        run(&block.stmts, &mut env);
         code.exprs
             .iter()
             .map(|e| evaluate(&syn::parse2(e.clone()).expect("expression"), &env))

@@ -14,7 +14,8 @@ use crate::emit::ty::type_and_constructor;
 use crate::graph::{Graph, Id};
 use crate::lower::{Guard, Lower};
 use crate::mechanics::{self, Degenerate};
-use crate::signature::{self, Attribute};
+use crate::signature::{self, Attribute, Signature};
+use crate::sphere;
 use crate::util::combine;
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
@@ -75,6 +76,11 @@ fn expand_counted(
         }
         (root, std::mem::take(&mut lower.guards))
     };
+    let (sig, root, guards) = if sig.sphere {
+        on_sphere(&mut graph, &sig, root, guards)
+    } else {
+        (sig, root, guards)
+    };
     let mech = mechanics::build(&mut graph, root, sig.dim, sig.order);
     stats.graph_nodes = graph.len();
     let mech = mech.map_err(|reason| {
@@ -114,6 +120,26 @@ fn expand_counted(
     stats.graph_nodes = graph.len();
     let emission = Emission::new(&function, &sig, &graph, &mech, &guards, reduced.as_ref());
     Ok(generate(&emission))
+}
+
+/// L and its guards composed with the gnomonic chart of the sphere (`sphere`), with the
+/// signature of the composed Lagrangian.
+fn on_sphere(
+    graph: &mut Graph,
+    sig: &Signature,
+    root: Id,
+    guards: Vec<Guard>,
+) -> (Signature, Id, Vec<Guard>) {
+    let roots: Vec<Id> = core::iter::once(root)
+        .chain(guards.iter().map(|g| g.node))
+        .collect();
+    let composed = sphere::compose(graph, sig, &roots);
+    let guards = guards
+        .into_iter()
+        .zip(&composed[1..])
+        .map(|(guard, &node)| Guard { node, ..guard })
+        .collect();
+    (sphere::chart_signature(sig), composed[0], guards)
 }
 
 /// The generated items, in order: the function and its type (`emit::ty`), the `Lagrangian`

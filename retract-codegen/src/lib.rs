@@ -11,7 +11,8 @@
 //! reuses them for a scalar function of the jet, emitting only its value, gradient and
 //! Hessian. `#[discretization_map]` (module `map`) lowers a map (q, v) -> (R1, R2) the same
 //! way, checks its conditions (`map_check`), lifts it by total derivatives and differentiates
-//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). Helpers used by several stages (`util`) import none of them.
+//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). With `sphere`, the stage `sphere` composes an
+//! ambient Lagrangian on S^2 with a gnomonic chart between `lower` and `mechanics`. Helpers used by several stages (`util`) import none of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -26,7 +27,9 @@ mod map;
 mod map_check;
 mod map_lift;
 mod mechanics;
+mod scopes;
 mod signature;
+mod sphere;
 mod util;
 
 pub mod samples;

@@ -111,6 +111,9 @@ pub struct Signature {
     pub guard: bool,
     /// Whether a discretization map's conditions are checked at compile time (`check`).
     pub check: bool,
+    /// Whether the Lagrangian lives on the unit sphere S^2 (`sphere`): the jet is ambient
+    /// (`[f64; 3]`) and the generated system works in a gnomonic chart (`crate::sphere`).
+    pub sphere: bool,
     /// The attribute that is expanded.
     pub attribute: Attribute,
 }
@@ -121,6 +124,7 @@ struct Options {
     name: Option<Ident>,
     guard: bool,
     check: bool,
+    sphere: Option<Span>,
 }
 
 fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options> {
@@ -129,6 +133,7 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         name: None,
         guard: true,
         check: true,
+        sphere: None,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("order") {
@@ -149,6 +154,9 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
+        } else if meta.path.is_ident("sphere") && attribute != Attribute::Map {
+            options.sphere = Some(meta.path.span());
+            Ok(())
         } else if meta.path.is_ident("check") && attribute == Attribute::Map {
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.check = lit.value;
@@ -158,8 +166,15 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
                  `check = false`",
             ))
+        } else if attribute == Attribute::Lagrangian {
+            Err(meta.error(
+                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
+                 `guard = false`, `sphere`",
+            ))
         } else {
-            Err(meta.error("unsupported option; supported: `order = k` (1..=4), `name = TypeName`"))
+            Err(meta.error(
+                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, `sphere`",
+            ))
         }
     });
     syn::parse::Parser::parse2(parser, attr)?;
@@ -412,6 +427,41 @@ fn dimension(
     }
 }
 
+/// The conditions of `sphere`: the jet is ambient, `[f64; 3]`, and no parameter takes the
+/// name of the chart's (`SPHERE_CHART`).
+fn check_sphere(
+    args: &[(Ident, Kind)],
+    jet_kind: Option<Kind>,
+    jet_count: usize,
+    span: Span,
+    errors: &mut Errors,
+) {
+    if jet_kind.is_some() && jet_kind != Some(Kind::Array(3)) {
+        errors.fail(
+            args.first().map_or(span, |(name, _)| name.span()),
+            format!(
+                "a Lagrangian on the sphere (`sphere`) is written in ambient coordinates: its \
+                 jet q, q', ... must be `[f64; 3]`, not {}",
+                jet_kind.map(Kind::describe).unwrap_or_default()
+            ),
+        );
+    }
+    for (name, _) in args.iter().skip(jet_count) {
+        if name == SPHERE_CHART {
+            errors.fail(
+                name.span(),
+                format!(
+                    "`{SPHERE_CHART}` is the name of the chart that `sphere` adds to the \
+                     parameters; rename this parameter"
+                ),
+            );
+        }
+    }
+}
+
+/// The name of the chart parameter `[c, e1, e2]` (9 numbers) that `sphere` appends.
+pub const SPHERE_CHART: &str = "sphere_chart";
+
 /// The names of q, q', ..., q^(order) (the first `order + 1` arguments), or of q and v for
 /// a map; errors where one is not of the type of q.
 fn jet_names(
@@ -516,6 +566,9 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
     if attribute == Attribute::Map {
         check_map_return(sig, jet_kind, &mut errors);
     }
+    if let Some(span) = options.sphere {
+        check_sphere(&args, jet_kind, jet_count, span, &mut errors);
+    }
     if args.len() < jet_count && errors.list.is_empty() {
         let msg = if attribute == Attribute::Map {
             format!(
@@ -562,6 +615,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         type_name,
         guard: options.guard,
         check: options.check,
+        sphere: options.sphere.is_some(),
         attribute,
     })
 }

@@ -19,6 +19,8 @@
 //!   [`diagnostics`]: energy, symplecticity, drift, RK4.
 //! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
 //!   among them.
+//! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
+//!   discretization map of $S^2$.
 //! - [`models`]: a system written by hand.
 //!
 //! # References
@@ -47,6 +49,7 @@ pub mod map;
 pub mod models;
 pub mod newton;
 pub mod reduced;
+pub mod sphere;
 pub mod step;
 pub mod system;
 

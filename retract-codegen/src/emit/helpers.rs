@@ -9,7 +9,7 @@ use syn::ItemFn;
 
 use crate::codegen::{Leaves, signed_add};
 use crate::graph::Var;
-use crate::signature::{Kind, Signature};
+use crate::signature::{Kind, SPHERE_CHART, Signature};
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -167,6 +167,27 @@ pub(crate) fn function_and_type(
     }
 }
 
+/// For a function on the sphere (`sphere`), `SphereSystem`: the chart parameter, read and
+/// replaced.
+pub(crate) fn sphere_system_impl(params: &ParamTokens) -> TokenStream {
+    let (generics, ty) = (&params.generics, &params.ty_full);
+    let allow = allow_generated();
+    let chart = syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site());
+    quote! {
+        #[automatically_derived]
+        #allow
+        impl #generics ::retract::__private::retract_core::sphere::SphereSystem for #ty {
+            fn chart(&self) -> [f64; 9] {
+                self.#chart
+            }
+
+            fn with_chart(&self, chart: [f64; 9]) -> Self {
+                Self { #chart: chart, ..*self }
+            }
+        }
+    }
+}
+
 /// The pieces of the generated parameter struct.
 pub(crate) struct ParamTokens {
     /// `<'a>` when a parameter is a slice, else nothing.
@@ -177,8 +198,9 @@ pub(crate) struct ParamTokens {
     pub fields: Vec<TokenStream>,
     /// The arguments of `new`.
     pub ctor_args: Vec<TokenStream>,
-    /// The field names, in order.
-    pub field_names: Vec<syn::Ident>,
+    /// The field initialisers of `new`, in order: the arguments by name, and for a system on
+    /// the sphere the chart at the north pole.
+    pub field_names: Vec<TokenStream>,
 }
 
 /// The parameter struct of `sig`; `symbol` names the function in the docs (`L`, `g`).
@@ -209,11 +231,19 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
                     )
                 }
             };
+            let doc = if sig.sphere && name == SPHERE_CHART {
+                "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set \
+                 by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`."
+                    .to_string()
+            } else {
+                doc
+            };
             quote!(#[doc = #doc] pub #name: #t)
         })
         .collect();
-    let ctor_args = sig
-        .params
+    // the chart of a system on the sphere is set by the stepper, not by the user
+    let user_params = &sig.params[..sig.params.len() - usize::from(sig.sphere)];
+    let ctor_args = user_params
         .iter()
         .map(|p| {
             let name = &p.name;
@@ -230,7 +260,17 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
             }
         })
         .collect();
-    let field_names = sig.params.iter().map(|p| p.name.clone()).collect();
+    let mut field_names: Vec<TokenStream> = user_params
+        .iter()
+        .map(|p| {
+            let name = &p.name;
+            quote!(#name)
+        })
+        .collect();
+    if sig.sphere {
+        let chart = syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site());
+        field_names.push(quote!(#chart: [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]));
+    }
     ParamTokens {
         generics,
         ty_full,

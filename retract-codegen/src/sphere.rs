@@ -1,0 +1,125 @@
+//! The stage behind `#[higher_order_lagrangian(order = k, sphere)]`: a Lagrangian written in
+//! ambient coordinates of the unit sphere S^2 (q, q', ..., q^(k) in R^3), composed with a
+//! gnomonic chart so that the rest of the pipeline sees an order-k Lagrangian on R^2.
+//!
+//! The chart is a run-time parameter `sphere_chart = [c, e1, e2]` (a point c of S^2 and an
+//! orthonormal basis of its tangent plane):
+//!
+//! phi(y) = s / |s|,  s = c + y_0 e1 + y_1 e2,
+//!
+//! and the ambient jet is its lift, q^(j) = D^j phi(y), with D the total derivative of the
+//! chart jet (D y^(i) = y^(i+1)). Every ambient jet variable of L (and of its guards) is
+//! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
+
+use std::collections::HashMap;
+
+use crate::diff::{Differentiator, substitute, total_derivative};
+use crate::graph::{Func, Graph, Id, Var};
+use crate::signature::{Kind, Param, SPHERE_CHART, Signature};
+
+/// The signature of the composed Lagrangian: dimension 2, the parameters of `sig` followed
+/// by the chart `sphere_chart: [f64; 9]`.
+pub fn chart_signature(sig: &Signature) -> Signature {
+    let mut chart = sig.clone();
+    chart.dim = 2;
+    chart.params.push(Param {
+        name: syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site()),
+        kind: Kind::Array(9),
+    });
+    chart
+}
+
+/// The ambient jet q^(j)_a = D^j phi_a(y), j = 0..=k, as nodes in the chart jet
+/// (`Var::Jet` with index 0, 1) and the chart parameter (`Var::Param { param: chart }`).
+fn ambient_jet(g: &mut Graph, chart: u32, k: usize) -> Vec<[Id; 3]> {
+    let p = |g: &mut Graph, i: u32| {
+        g.var(Var::Param {
+            param: chart,
+            index: i,
+        })
+    };
+    let y: [Id; 2] = [0, 1].map(|a| g.var(Var::Jet { order: 0, index: a }));
+    let s: [Id; 3] = core::array::from_fn(|i| {
+        let c = p(g, i as u32);
+        let e1 = p(g, 3 + i as u32);
+        let e2 = p(g, 6 + i as u32);
+        let t1 = g.mul(y[0], e1);
+        let t2 = g.mul(y[1], e2);
+        let t = g.add_op(t1, t2);
+        g.add_op(c, t)
+    });
+    let mut r2 = g.constant(0.0);
+    for &si in &s {
+        let sq = g.powi(si, 2);
+        r2 = g.add_op(r2, sq);
+    }
+    let r = g.unary(Func::Sqrt, r2);
+    let q0: [Id; 3] = s.map(|si| g.div(si, r));
+    let mut d = Differentiator::default();
+    let mut jet = vec![q0];
+    for j in 1..=k {
+        let previous = jet[j - 1];
+        jet.push(previous.map(|f| total_derivative(g, &mut d, f, 2, j)));
+    }
+    jet
+}
+
+/// `roots` (L and its guarded expressions, in the ambient jet of `sig`) rewritten in the
+/// chart jet: each ambient `Var::Jet { order: j, index: a }` becomes D^j phi_a(y). The chart
+/// parameter is number `sig.params.len()`.
+pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+    let chart = sig.params.len() as u32;
+    let jet = ambient_jet(g, chart, sig.order);
+    let map = move |_: &mut Graph, v: Var| match v {
+        Var::Jet { order, index } => Some(jet[order as usize][index as usize]),
+        _ => None,
+    };
+    let mut memo = HashMap::new();
+    roots
+        .iter()
+        .map(|&root| substitute(g, root, &map, &mut memo))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Evaluates `node` at the chart jet `y[order][a]` and chart `[c, e1, e2]`.
+    fn eval(g: &Graph, node: Id, y: &[[f64; 2]], chart: &[f64; 9]) -> f64 {
+        let values = g.evaluate(node, &|n| match n {
+            crate::graph::Node::Var(Var::Jet { order, index }) => {
+                Some(y[*order as usize][*index as usize])
+            }
+            crate::graph::Node::Var(Var::Param { index, .. }) => Some(chart[*index as usize]),
+            _ => None,
+        });
+        values[node.0 as usize].expect("evaluable")
+    }
+
+    #[test]
+    fn the_ambient_jet_is_the_lift_of_the_chart() {
+        // a chart at c = (0, 0, 1) with e1 = x, e2 = y, and the curve y(t) = (t + t^2, 2t):
+        // q(t) = (t + t^2, 2t, 1) / sqrt(1 + (t + t^2)^2 + 4 t^2); compare q, q' and q'' at
+        // t = 0.3 with central differences of q(t).
+        let chart = [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let mut g = Graph::default();
+        let jet = ambient_jet(&mut g, 0, 2);
+        let curve = |t: f64| {
+            let s = [t + t * t, 2.0 * t, 1.0];
+            let r = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+            s.map(|v| v / r)
+        };
+        let t = 0.3;
+        let y = [[t + t * t, 2.0 * t], [1.0 + 2.0 * t, 2.0], [2.0, 0.0]];
+        let e = 1e-4;
+        for (a, [q, dq, ddq]) in (0..3).map(|a| (a, [jet[0][a], jet[1][a], jet[2][a]])) {
+            let f = |t: f64| curve(t)[a];
+            let d1 = (f(t + e) - f(t - e)) / (2.0 * e);
+            let d2 = (f(t + e) - 2.0 * f(t) + f(t - e)) / (e * e);
+            assert!((eval(&g, q, &y, &chart) - f(t)).abs() < 1e-15);
+            assert!((eval(&g, dq, &y, &chart) - d1).abs() < 1e-7, "{a}");
+            assert!((eval(&g, ddq, &y, &chart) - d2).abs() < 1e-6, "{a}");
+        }
+    }
+}
