@@ -47,11 +47,13 @@ pub(crate) struct Dynamics<const N: usize, const X: usize> {
     pub b: SMatrix<f64, X, N>,
     /// $E = (1 - \theta) I + \theta \bar A$: $x_\theta$ as a function of $x_i$ (given $u$).
     pub e: SMatrix<f64, X, X>,
-    /// $W = (I - h\theta A)^{-1}$.
+    /// $W = (I - h\theta A)^{-1}$ (dense, for the tests; the solver uses `poly_w`).
+    #[cfg(test)]
     pub w: SMatrix<f64, X, X>,
-    /// $\bar A$, $E$ and $\bar B$ as polynomials in the block shift ([`super::shift`]).
+    /// $\bar A$, $E$, $W$ and $\bar B$ as polynomials in the block shift ([`super::shift`]).
     pub poly_a: BlockPoly<N, X>,
     pub poly_e: BlockPoly<N, X>,
+    pub poly_w: BlockPoly<N, X>,
     pub poly_b: BlockColumn<N, X>,
 }
 
@@ -77,9 +79,11 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
             a,
             b,
             e,
+            #[cfg(test)]
             w,
             poly_a: BlockPoly::of(&a),
             poly_e: BlockPoly::of(&e),
+            poly_w: BlockPoly::of(&w),
             poly_b: BlockColumn::of(&b),
         }
     }
@@ -335,8 +339,13 @@ fn stage_factor<const N: usize, const X: usize>(
 ) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
     let (a, b, e) = (&dynamics.poly_a, &dynamics.poly_b, &dynamics.poly_e);
     let theta = dynamics.theta;
-    let hxx = stage.hxx + SMatrix::<f64, X, X>::identity() * rho;
-    let huu = stage.huu + SMatrix::<f64, N, N>::identity() * rho;
+    let (mut hxx, mut huu) = (stage.hxx, stage.huu);
+    for r in 0..X {
+        hxx[(r, r)] += rho;
+    }
+    for a in 0..N {
+        huu[(a, a)] += rho;
+    }
     // fu = theta B: the evaluation point's dependence on the control
     let hxx_e = e.right(&hxx);
     let pa = a.right(p);
@@ -511,7 +520,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let linear = |i: usize| {
             let stage = &stages[i];
             let offset = stage.defect * theta;
-            let gx = stage.gx + (stage.hxx + SMatrix::<f64, X, X>::identity() * rho) * offset;
+            let gx = stage.gx + stage.hxx * offset + offset * rho;
             let gu = stage.gu + stage.hux * offset;
             StageLinear {
                 lx: dynamics.poly_e.left_t(&gx),
