@@ -112,6 +112,7 @@ where
     /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h z^T g^{\ge}$,
     /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
     /// own terms are added by [`Barrier::add_to_stage`]).
+    #[inline(always)]
     fn stage(
         &self,
         iterate: &Iterate<N, X>,
@@ -182,9 +183,11 @@ where
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
-            let mut stage = self.stage(iterate, i, &y[i], barrier);
+            // (built in place: a stage model is a few hundred bytes)
+            stages.push(self.stage(iterate, i, &y[i], barrier));
+            let stage = stages.last_mut()?;
             cost_gradient.push((stage.gx, stage.gu));
-            barrier.add_to_stage(&mut stage, i, own, h);
+            barrier.add_to_stage(stage, i, own, h);
             // a NaN or an infinity anywhere makes the sum non-finite
             let finite = (stage.hxx.sum()
                 + stage.hux.sum()
@@ -198,7 +201,6 @@ where
             if !finite {
                 return None;
             }
-            stages.push(stage);
         }
         let r0 = self.problem.start - iterate.x[0];
         let r_end = self.problem.goal - iterate.x[iterate.x.len() - 1];
