@@ -25,7 +25,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     direction: &Direction<N, X>,
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
-    let wt = dynamics.w.transpose();
+    let wt = &dynamics.poly_w;
     // (A^T mu)_j = mu_{j-1}; B^T mu = the last block
     let shift_t = |mu: &SVector<f64, X>| {
         SVector::<f64, X>::from_fn(|r, _| if r >= N { mu[r - N] } else { 0.0 })
@@ -47,7 +47,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         } else {
             (*gx, *gu)
         };
-        let mu = -(wt * (lambda + gx * theta));
+        let mu = -wt.left_t(&(lambda + gx * theta));
         let d = gx - shift_t(&mu) * h;
         for a in 0..N {
             worst = worst.max((gu[a] - h * mu[X - N + a]).abs());

@@ -13,15 +13,20 @@
 //! $h\,L(x_{\theta,i}, u_i)$ and $c_i$ the dynamics defect. The terminal constraint enters
 //! through its multiplier $\nu$: the cost-to-go is
 //! $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$ with
-//! $P_N = 0$, $s_N = 0$, $S_N = I$, and a forward sweep of $\partial \delta x_i/\partial \nu$
-//! gives the $nk \times nk$ system $D_N \nu = r_N - e_N$.
+//! $P_N = 0$, $s_N = 0$, $S_N = I$, over the last steps only (the tail, from step $b$): with
+//! $D = \partial \delta x_N / \partial \nu$ of the tail, $\nu = D^{-1}(r_N - S_b^T \delta
+//! x_b - e)$ is eliminated at $x_b$ (constraint-to-go) and the steps before are plain Riccati
+//! steps. $D$ is invertible from $k$ steps on (the controllability index of the chain of
+//! integrators); the tail is the shortest of at least $k$ steps with $D$ well conditioned, the
+//! whole horizon if none is.
 //!
 //! Inertia (Sylvester, Haynsworth): the Riccati recursion is a block $LDL^T$ factorisation
-//! of the Hessian $W$ reduced by the dynamics alone, so $W$ has
-//! $\sum_i \mathrm{neg}(Q_{uu,i})$ negative eigenvalues, and with the terminal constraint the
-//! reduced Hessian has $\mathrm{neg}(W) + \mathrm{neg}(D_N) - nk$ of them ($D_N = -G W^{-1}
-//! G^T$ for the terminal map $G$). It is positive definite exactly when that count is 0 and
-//! nothing is singular.
+//! of the KKT matrix, eliminating $\delta u_{N-1}, \dots, \delta u_b$, then $\nu$ (pivot
+//! $D$), then $\delta u_{b-1}, \dots, \delta u_0$; the pivots' negative eigenvalues add up
+//! to those of the KKT matrix, which has $nk$ (one per row of the terminal constraint) more
+//! than the reduced Hessian. So the reduced Hessian has
+//! $\sum_i \mathrm{neg}(Q_{uu,i}) + \mathrm{neg}(D) - nk$ negative eigenvalues, and it is
+//! positive definite exactly when that count is 0 and nothing is singular.
 
 use nalgebra::{DMatrix, SMatrix, SVector, SymmetricEigen};
 
@@ -42,11 +47,13 @@ pub(crate) struct Dynamics<const N: usize, const X: usize> {
     pub b: SMatrix<f64, X, N>,
     /// $E = (1 - \theta) I + \theta \bar A$: $x_\theta$ as a function of $x_i$ (given $u$).
     pub e: SMatrix<f64, X, X>,
-    /// $W = (I - h\theta A)^{-1}$.
+    /// $W = (I - h\theta A)^{-1}$ (dense, for the tests; the solver uses `poly_w`).
+    #[cfg(test)]
     pub w: SMatrix<f64, X, X>,
-    /// $\bar A$, $E$ and $\bar B$ as polynomials in the block shift ([`super::shift`]).
+    /// $\bar A$, $E$, $W$ and $\bar B$ as polynomials in the block shift ([`super::shift`]).
     pub poly_a: BlockPoly<N, X>,
     pub poly_e: BlockPoly<N, X>,
+    pub poly_w: BlockPoly<N, X>,
     pub poly_b: BlockColumn<N, X>,
 }
 
@@ -72,9 +79,11 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
             a,
             b,
             e,
+            #[cfg(test)]
             w,
             poly_a: BlockPoly::of(&a),
             poly_e: BlockPoly::of(&e),
+            poly_w: BlockPoly::of(&w),
             poly_b: BlockColumn::of(&b),
         }
     }
@@ -162,20 +171,50 @@ struct StageFactor<const N: usize, const X: usize> {
     projector: SMatrix<f64, N, N>,
     pinv: SMatrix<f64, N, N>,
     constrained: bool,
-    /// $\delta u = K \delta x + k + K_\nu \nu$ ($k$ depends on the linear terms).
+    /// $\delta u = K \delta x + k$ (plus $K_\nu \nu$ in the tail; $k$ depends on the linear
+    /// terms).
     gain: SMatrix<f64, N, X>,
-    gain_nu: SMatrix<f64, N, X>,
-    /// $P_{i+1}$ and $S_{i+1}$ of the next stage (for the costates).
+    /// $P_{i+1}$ of the next stage (for the costates).
     p_next: SMatrix<f64, X, X>,
+}
+
+impl<const N: usize, const X: usize> StageFactor<N, X> {
+    /// The map $v \mapsto \delta u$ of the stage's minimisation over $\delta u$ for the
+    /// linear term $v$, up to sign: $Q_{uu}^{-1}$, with constraints
+    /// $\Pi \tilde Q^{-1} \Pi$.
+    fn solve_map(&self) -> SMatrix<f64, N, N> {
+        if self.constrained {
+            self.projector * self.quu_inv * self.projector
+        } else {
+            self.quu_inv
+        }
+    }
+}
+
+/// What the backward pass keeps of a step of the tail, the steps where the terminal
+/// multiplier $\nu$ is still a parameter.
+#[derive(Clone, Copy, Debug)]
+struct TailFactor<const N: usize, const X: usize> {
+    /// $K_\nu$ of $\delta u = K \delta x + k + K_\nu \nu$.
+    gain_nu: SMatrix<f64, N, X>,
+    /// $S_{i+1}$ of the next stage.
     sens_next: SMatrix<f64, X, X>,
 }
 
-/// The factorised KKT system of one iteration.
+/// The factorised KKT system of one iteration. The terminal multiplier $\nu$ is a parameter
+/// of the cost-to-go over the last steps only (the tail, at least $k$ steps: enough for
+/// $D$ to be invertible); at the tail's first state $x_b$ it is eliminated,
+/// $\nu = D^{-1}(r_N - S_b^T \delta x_b - e)$, and the steps before see the plain
+/// cost-to-go $P_b - S_b D^{-1} S_b^T$ (constraint-to-go, as Laine and Tomlin 2019).
 pub(crate) struct Riccati<const N: usize, const X: usize> {
     /// The stages' factors, last step first.
     stages: Vec<StageFactor<N, X>>,
-    /// $D_N^{-1}$.
-    d_end_inv: SMatrix<f64, X, X>,
+    /// The tail's factors, last step first.
+    tail: Vec<TailFactor<N, X>>,
+    /// $S_b$ at the tail's first state.
+    sens_boundary: SMatrix<f64, X, X>,
+    /// $D^{-1}$ of the tail.
+    d_inv: SMatrix<f64, X, X>,
     /// Negative eigenvalues of the reduced Hessian.
     pub negative: usize,
     /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
@@ -288,21 +327,25 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
 /// $K = -Q_{uu}^{-1} Q_{ux}$ and $K_\nu = -Q_{uu}^{-1} \bar B^T S$; with them
 /// $\delta u = M \delta x + m_0 + \Pi v$ ($M = -C_u^+ C_x$) and $v$ minimises over the null
 /// space: $K = M - \Pi \tilde Q^{-1} \Pi (Q_{ux} + Q_{uu} M)$, $K_\nu = -\Pi \tilde Q^{-1}
-/// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + I - \Pi$. Returns the factor, $Q_{xx}$
-/// and the negative eigenvalues of $\tilde Q$ on the null space (`None`: singular).
+/// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + I - \Pi$ ($K_\nu$ by the caller, for the
+/// tail). Returns the factor, $Q_{xx}$ and the negative eigenvalues of $\tilde Q$ on the null
+/// space (`None`: singular).
 #[inline(always)]
 fn stage_factor<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stage: &StageModel<N, X>,
     rho: f64,
     p: &SMatrix<f64, X, X>,
-    sens: &SMatrix<f64, X, X>,
-    bts: &SMatrix<f64, N, X>,
 ) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
     let (a, b, e) = (&dynamics.poly_a, &dynamics.poly_b, &dynamics.poly_e);
     let theta = dynamics.theta;
-    let hxx = stage.hxx + SMatrix::<f64, X, X>::identity() * rho;
-    let huu = stage.huu + SMatrix::<f64, N, N>::identity() * rho;
+    let (mut hxx, mut huu) = (stage.hxx, stage.huu);
+    for r in 0..X {
+        hxx[(r, r)] += rho;
+    }
+    for a in 0..N {
+        huu[(a, a)] += rho;
+    }
     // fu = theta B: the evaluation point's dependence on the control
     let hxx_e = e.right(&hxx);
     let pa = a.right(p);
@@ -323,9 +366,7 @@ fn stage_factor<const N: usize, const X: usize>(
         pinv: SMatrix::zeros(),
         constrained: stage.constraints > 0,
         gain: SMatrix::zeros(),
-        gain_nu: SMatrix::zeros(),
         p_next: *p,
-        sens_next: *sens,
     };
     if !factor.constrained {
         let Some((quu_inv, neg)) = invert_counting(quu) else {
@@ -333,7 +374,6 @@ fn stage_factor<const N: usize, const X: usize>(
         };
         factor.quu_inv = quu_inv;
         factor.gain = -(quu_inv * qux);
-        factor.gain_nu = -(quu_inv * bts);
         return (factor, qxx, Some(neg));
     }
     let Some((projector, pinv, cx)) = constraint_projection(dynamics, stage) else {
@@ -347,30 +387,47 @@ fn stage_factor<const N: usize, const X: usize>(
     let m = -(pinv * cx);
     let solve = projector * quu_inv * projector;
     factor.gain = m - solve * (qux + quu * m);
-    factor.gain_nu = -(solve * bts);
     factor.quu_inv = quu_inv;
     factor.projector = projector;
     factor.pinv = pinv;
     (factor, qxx, Some(neg))
 }
 
+/// $D^{-1}$ (by LU with partial pivoting: nalgebra's closed-form 4x4 inverse loses digits
+/// here) and the negative eigenvalues of the symmetric part $(D + D^T)/2$ (for the inertia);
+/// `None` if either is singular.
+fn terminal_inverse<const X: usize>(d: &SMatrix<f64, X, X>) -> Option<(SMatrix<f64, X, X>, usize)> {
+    let (_, negative) = invert_counting((d + d.transpose()) * 0.5)?;
+    let inv = crate::linalg::solve(d, &SMatrix::identity())?;
+    Some((inv, negative))
+}
+
+/// The largest condition number $\|D\|_{\max} \|D^{-1}\|_{\max}$ at which a tail's terminal
+/// system is eliminated before the first step (a longer tail is better conditioned).
+const TAIL_CONDITION: f64 = 1e6;
+
 impl<const N: usize, const X: usize> Riccati<N, X> {
     /// The backward pass over `stages` with $\rho$ added to the diagonal of every $H_i$
-    /// (inertia correction), then the terminal system.
+    /// (inertia correction). Over the tail the cost-to-go carries $\nu$:
+    /// $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$,
+    /// $S_N = I$, $S_i = (\bar A + \bar B K_i)^T S_{i+1}$, and
+    /// $D = \partial \delta x_N / \partial \nu = \sum_i (\bar B^T S_{i+1})^T K_{\nu,i}$. The tail
+    /// ends at the first $b \le N - k$ where $D$ is well conditioned (else at 0); there
+    /// $P_b \leftarrow P_b - S_b D^{-1} S_b^T$ (the maximum over $\nu$ of the parametric
+    /// cost-to-go), and the steps before are plain Riccati steps.
     pub fn factor(dynamics: &Dynamics<N, X>, stages: &[StageModel<N, X>], rho: f64) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
+        let steps = stages.len();
         let mut p = SMatrix::<f64, X, X>::zeros();
         let mut sens = SMatrix::<f64, X, X>::identity();
-        let mut factors = Vec::with_capacity(stages.len());
+        let mut factors = Vec::with_capacity(steps);
+        let mut tail = Vec::with_capacity(X / N);
         let mut negative = 0;
         let mut singular = false;
-        // D_N = d delta x_N / d nu = sum_i Phi(N, i+1) B K_nu,i with the closed-loop transition
-        // Phi(N, i+1) = S_{i+1}^T, so D_N = sum_i (B^T S_{i+1})^T K_nu,i: accumulated here,
-        // symmetric (K_nu,i = -Qtilde^-1 B^T S_{i+1}) up to rounding
         let mut d = SMatrix::<f64, X, X>::zeros();
-        for stage in stages.iter().rev() {
-            let bts = b.left_t(&sens);
-            let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p, &sens, &bts);
+        let mut eliminated: Option<SMatrix<f64, X, X>> = None;
+        for (j, stage) in stages.iter().rev().enumerate() {
+            let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p);
             singular |= neg.is_none();
             negative += neg.unwrap_or(0);
             // V_i(dx) = Q(dx, K dx + k + K_nu nu): the general form (K need not minimise Q
@@ -383,31 +440,48 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 qxx + qux.transpose() * k
             };
             p = (p_new + p_new.transpose()) * 0.5;
-            d += bts.transpose() * factor.gain_nu;
-            // S_i = (A + B K)^T S_{i+1} (with constraints the term (Q_ux + Q_uu K)^T K_nu
-            // vanishes: Pi (Q_ux + Q_uu K) = 0)
-            sens = a.left_t(&sens) + k.transpose() * bts;
+            if eliminated.is_none() {
+                let bts = b.left_t(&sens);
+                let gain_nu = -(factor.solve_map() * bts);
+                // D accumulates Phi(N, i+1) B K_nu,i with Phi(N, i+1) = S_{i+1}^T: symmetric
+                // (K_nu,i = -Qtilde^-1 B^T S_{i+1}) up to rounding
+                d += bts.transpose() * gain_nu;
+                tail.push(TailFactor {
+                    gain_nu,
+                    sens_next: sens,
+                });
+                // S_i = (A + B K)^T S_{i+1} (with constraints the term (Q_ux + Q_uu K)^T K_nu
+                // vanishes: Pi (Q_ux + Q_uu K) = 0)
+                sens = a.left_t(&sens) + k.transpose() * bts;
+                if j + 1 >= X / N && j + 1 < steps {
+                    let conditioned = terminal_inverse(&d)
+                        .filter(|(inv, _)| d.amax() * inv.amax() <= TAIL_CONDITION);
+                    if let Some((d_inv, neg_d)) = conditioned {
+                        negative += neg_d;
+                        let p_new = p - sens * d_inv * sens.transpose();
+                        p = (p_new + p_new.transpose()) * 0.5;
+                        eliminated = Some(d_inv);
+                    }
+                }
+            }
             factors.push(factor);
         }
-        // (kept in the order of the backward pass: `step_factor(i)` reads step i)
-        let d_sym = (d + d.transpose()) * 0.5;
-        // the symmetric part for the inertia, the matrix itself for the solve
-        let neg_d = invert_counting(d_sym).map_or_else(
-            || {
+        let d_inv = eliminated.unwrap_or_else(|| match terminal_inverse(&d) {
+            Some((d_inv, neg_d)) => {
+                negative += neg_d;
+                d_inv
+            }
+            None => {
                 singular = true;
-                0
-            },
-            |(_, neg)| neg,
-        );
-        // by LU with partial pivoting (nalgebra's closed-form 4x4 inverse loses digits here)
-        let d_end_inv = crate::linalg::solve(&d, &SMatrix::identity()).unwrap_or_else(|| {
-            singular = true;
-            SMatrix::zeros()
+                SMatrix::zeros()
+            }
         });
         Self {
             stages: factors,
-            d_end_inv,
-            negative: (negative + neg_d).saturating_sub(X),
+            tail,
+            sens_boundary: sens,
+            d_inv,
+            negative: negative.saturating_sub(X),
             singular,
         }
     }
@@ -415,6 +489,16 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     /// The factor of step `i`.
     fn step_factor(&self, i: usize) -> &StageFactor<N, X> {
         &self.stages[self.stages.len() - 1 - i]
+    }
+
+    /// The first step of the tail, $b$.
+    fn boundary(&self) -> usize {
+        self.stages.len() - self.tail.len()
+    }
+
+    /// The tail factor of step `i` $\ge b$.
+    fn tail_factor(&self, i: usize) -> &TailFactor<N, X> {
+        &self.tail[self.stages.len() - 1 - i]
     }
 
     /// True when the reduced Hessian is positive definite.
@@ -436,7 +520,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let linear = |i: usize| {
             let stage = &stages[i];
             let offset = stage.defect * theta;
-            let gx = stage.gx + (stage.hxx + SMatrix::<f64, X, X>::identity() * rho) * offset;
+            let gx = stage.gx + stage.hxx * offset + offset * rho;
             let gu = stage.gu + stage.hux * offset;
             StageLinear {
                 lx: dynamics.poly_e.left_t(&gx),
@@ -449,10 +533,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// The subproblem's solution for the stage linear terms, defects and constraint offsets
-    /// given by `linear(i)`: a backward pass for the feed-forward terms, the terminal
-    /// multiplier $\nu$ from $D_N \nu = r_N - \delta x_N(0)$ (with one refinement when the
+    /// given by `linear(i)`: a backward pass for the feed-forward terms, then one forward pass
+    /// for the direction, which at the tail's first state $\delta x_b$ sets the terminal
+    /// multiplier from $D \nu = r_N - \delta x_N(\nu = 0)$ (with one refinement when the
     /// terminal condition is missed by more than rounding; both by the cheap forward pass of
-    /// [`Self::terminal`]), then one forward pass for the direction.
+    /// [`Self::terminal`] over the tail).
     pub fn solve_linear(
         &self,
         dynamics: &Dynamics<N, X>,
@@ -462,13 +547,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
-        let backward = self.backward(dynamics, linear);
-        let mut nu = self.d_end_inv * (r_end - self.terminal(dynamics, &backward, r0, None));
-        let x_end = self.terminal(dynamics, &backward, r0, Some(&nu));
-        let miss = r_end - x_end;
-        if miss.amax() > 1e-12 * (1.0 + r_end.amax() + x_end.amax()) {
-            nu += self.d_end_inv * miss;
-        }
+        let boundary = self.boundary();
+        let backward = self.backward(dynamics, linear, r_end);
         let mut d = Direction {
             dx: Vec::with_capacity(steps + 1),
             du: Vec::with_capacity(steps),
@@ -476,17 +556,37 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             multipliers: Vec::with_capacity(steps),
         };
         let mut x = *r0;
+        let mut nu = SVector::<f64, X>::zeros();
         d.dx.push(x);
-        for (f, l) in self.stages.iter().rev().zip(&backward) {
-            let u = f.gain * x + l.feedforward + f.gain_nu * nu;
+        for (i, (f, l)) in self.stages.iter().rev().zip(&backward).enumerate() {
+            let tail = (i >= boundary).then(|| self.tail_factor(i));
+            if i == boundary {
+                nu = self.d_inv * (r_end - self.terminal(dynamics, &backward, &x, None));
+                let x_end = self.terminal(dynamics, &backward, &x, Some(&nu));
+                let miss = r_end - x_end;
+                if miss.amax() > 1e-12 * (1.0 + r_end.amax() + x_end.amax()) {
+                    nu += self.d_inv * miss;
+                }
+            }
+            let mut u = f.gain * x + l.feedforward;
+            if let Some(t) = tail {
+                u += t.gain_nu * nu;
+            }
             if f.constrained {
-                let dq = f.qux * x + f.quu * u + l.qu + b.left_t(&(f.sens_next * nu));
+                let mut dq = f.qux * x + f.quu * u + l.qu;
+                if let Some(t) = tail {
+                    dq += b.left_t(&(t.sens_next * nu));
+                }
                 d.multipliers.push(-(f.pinv.transpose() * dq));
             } else {
                 d.multipliers.push(SVector::zeros());
             }
             x = a.left(&x) + b.left(&u) + l.defect;
-            d.costate.push(f.p_next * x + l.s_next + f.sens_next * nu);
+            let mut costate = f.p_next * x + l.s_next;
+            if let Some(t) = tail {
+                costate += t.sens_next * nu;
+            }
+            d.costate.push(costate);
             d.du.push(u);
             d.dx.push(x);
         }
@@ -494,14 +594,18 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// The backward pass of a solve: per step (first step first) the feed-forward term, $q_u$,
-    /// $s_{i+1}$ and the defect for the linear terms `linear(i)`.
+    /// $s_{i+1}$ and the defect for the linear terms `linear(i)`. At the tail's first state
+    /// (if not step 0) $\nu$ is eliminated: $s_b \leftarrow s_b + S_b D^{-1} (r_N - e)$ with
+    /// $e = \delta x_N$ of the tail from $\delta x_b = 0$, $\nu = 0$.
     fn backward(
         &self,
         dynamics: &Dynamics<N, X>,
         linear: &impl Fn(usize) -> StageLinear<N, X>,
+        r_end: &SVector<f64, X>,
     ) -> Vec<Backward<N, X>> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
+        let boundary = self.boundary();
         let mut out = Vec::with_capacity(steps);
         let mut s = SVector::<f64, X>::zeros();
         for i in (0..steps).rev() {
@@ -527,26 +631,52 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 s_next,
                 defect: l.defect,
             });
+            if i == boundary && i > 0 {
+                // the tail's entries are the last ones pushed, last step first
+                let x_end = self.tail_terminal(dynamics, out.iter().rev(), i);
+                s += self.sens_boundary * (self.d_inv * (r_end - x_end));
+            }
         }
         out.reverse();
         out
     }
 
-    /// $\delta x_N$ of the closed loop from $\delta x_0 = $ `r0` with the terminal multiplier
-    /// `nu` (none: 0).
+    /// $\delta x_N$ of the closed tail loop from $\delta x_b = 0$ with $\nu = 0$, for the
+    /// backward pass entries `tail` of steps $b, \dots, N-1$.
+    fn tail_terminal<'b>(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        tail: impl Iterator<Item = &'b Backward<N, X>>,
+        boundary: usize,
+    ) -> SVector<f64, X>
+    where
+        Backward<N, X>: 'b,
+    {
+        let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
+        let mut x = SVector::<f64, X>::zeros();
+        for (i, l) in (boundary..).zip(tail) {
+            let du = self.step_factor(i).gain * x + l.feedforward;
+            x = a.left(&x) + b.left(&du) + l.defect;
+        }
+        x
+    }
+
+    /// $\delta x_N$ of the closed loop over the tail from its first state $\delta x_b = $ `xb`
+    /// with the terminal multiplier `nu` (none: 0).
     fn terminal(
         &self,
         dynamics: &Dynamics<N, X>,
         backward: &[Backward<N, X>],
-        r0: &SVector<f64, X>,
+        xb: &SVector<f64, X>,
         nu: Option<&SVector<f64, X>>,
     ) -> SVector<f64, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
-        let mut x = *r0;
-        for (f, l) in self.stages.iter().rev().zip(backward) {
-            let mut du = f.gain * x + l.feedforward;
+        let boundary = self.boundary();
+        let mut x = *xb;
+        for (i, l) in backward.iter().enumerate().skip(boundary) {
+            let mut du = self.step_factor(i).gain * x + l.feedforward;
             if let Some(nu) = nu {
-                du += f.gain_nu * nu;
+                du += self.tail_factor(i).gain_nu * nu;
             }
             x = a.left(&x) + b.left(&du) + l.defect;
         }
@@ -575,98 +705,122 @@ mod tests {
     }
 
     /// The Riccati solve equals a dense solve of the same equality-constrained quadratic
-    /// program, including an indefinite stage Hessian whose reduced Hessian stays definite.
+    /// program, with the terminal multiplier eliminated before the first step or not.
     #[test]
     fn riccati_equals_the_dense_kkt_solve() {
         const N: usize = 2;
         const X: usize = 4;
-        let steps = 7;
-        let dynamics = Dynamics::<N, X>::new(0.3, 0.5);
-        let mut seed = 7;
-        let stages: Vec<StageModel<N, X>> = (0..steps)
-            .map(|_| {
-                let m = SMatrix::<f64, 6, 6>::from_fn(|_, _| noise(&mut seed));
-                let h = m * m.transpose() + SMatrix::<f64, 6, 6>::identity() * 0.5;
-                StageModel {
-                    hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
-                    hux: h.fixed_view::<2, 4>(4, 0).into_owned(),
-                    huu: h.fixed_view::<2, 2>(4, 4).into_owned(),
-                    gx: SVector::from_fn(|_, _| noise(&mut seed)),
-                    gu: SVector::from_fn(|_, _| noise(&mut seed)),
-                    defect: SVector::from_fn(|_, _| 0.1 * noise(&mut seed)),
-                    constraints: 0,
-                    cx: SMatrix::zeros(),
-                    cu: SMatrix::zeros(),
-                    value: SVector::zeros(),
-                }
-            })
-            .collect();
-        let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-        let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-        let riccati = Riccati::factor(&dynamics, &stages, 0.0);
-        assert!(riccati.positive_definite());
-        let d = riccati.solve(&dynamics, &stages, 0.0, &r0, &r_end);
-        // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
-        let nv = (steps + 1) * X + steps * N;
-        let nc = (steps + 2) * X;
-        let xc = |i: usize| i * X;
-        let uc = |i: usize| (steps + 1) * X + i * N;
-        let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
-        let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
-        let theta = dynamics.theta;
-        for (i, s) in stages.iter().enumerate() {
-            let mut t = DMatrix::<f64>::zeros(6, nv);
-            for r in 0..X {
-                t[(r, xc(i) + r)] = 1.0 - theta;
-                t[(r, xc(i + 1) + r)] = theta;
-            }
-            for a in 0..N {
-                t[(4 + a, uc(i) + a)] = 1.0;
-            }
-            let mut h = DMatrix::<f64>::zeros(6, 6);
-            h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
-            h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
-            h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
-            h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
-            let g = nalgebra::DVector::from_iterator(6, s.gx.iter().chain(s.gu.iter()).copied());
-            let block = t.transpose() * h * &t;
-            let mut view = kkt.view_mut((0, 0), (nv, nv));
-            view += block;
-            let mut top = rhs.rows_mut(0, nv);
-            top -= t.transpose() * g;
-            // x_{i+1} - A x_i - B u_i = c_i
-            let row = nv + (i + 1) * X;
-            for r in 0..X {
-                kkt[(row + r, xc(i + 1) + r)] = 1.0;
-                for c in 0..X {
-                    kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+        // 2 steps: the tail is the whole horizon; 3 and 7: the terminal constraint is
+        // eliminated after the tail of k = 2 steps. A shift of -1 makes stage Hessians
+        // indefinite.
+        for (steps, shift) in [
+            (2, 0.5),
+            (3, 0.5),
+            (7, 0.5),
+            (2, -1.0),
+            (3, -1.0),
+            (7, -1.0),
+        ] {
+            let dynamics = Dynamics::<N, X>::new(0.3, 0.5);
+            let mut seed = 7;
+            let stages: Vec<StageModel<N, X>> = (0..steps)
+                .map(|_| {
+                    let m = SMatrix::<f64, 6, 6>::from_fn(|_, _| noise(&mut seed));
+                    let h = m * m.transpose() + SMatrix::<f64, 6, 6>::identity() * shift;
+                    StageModel {
+                        hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
+                        hux: h.fixed_view::<2, 4>(4, 0).into_owned(),
+                        huu: h.fixed_view::<2, 2>(4, 4).into_owned(),
+                        gx: SVector::from_fn(|_, _| noise(&mut seed)),
+                        gu: SVector::from_fn(|_, _| noise(&mut seed)),
+                        defect: SVector::from_fn(|_, _| 0.1 * noise(&mut seed)),
+                        constraints: 0,
+                        cx: SMatrix::zeros(),
+                        cu: SMatrix::zeros(),
+                        value: SVector::zeros(),
+                    }
+                })
+                .collect();
+            let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+            let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+            let riccati = Riccati::factor(&dynamics, &stages, 0.0);
+            assert!(!riccati.singular);
+            assert_eq!(riccati.boundary() > 0, steps > 2);
+            let d = riccati.solve(&dynamics, &stages, 0.0, &r0, &r_end);
+            // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
+            let nv = (steps + 1) * X + steps * N;
+            let nc = (steps + 2) * X;
+            let xc = |i: usize| i * X;
+            let uc = |i: usize| (steps + 1) * X + i * N;
+            let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
+            let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
+            let theta = dynamics.theta;
+            for (i, s) in stages.iter().enumerate() {
+                let mut t = DMatrix::<f64>::zeros(6, nv);
+                for r in 0..X {
+                    t[(r, xc(i) + r)] = 1.0 - theta;
+                    t[(r, xc(i + 1) + r)] = theta;
                 }
                 for a in 0..N {
-                    kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                    t[(4 + a, uc(i) + a)] = 1.0;
                 }
-                rhs[row + r] = s.defect[r];
+                let mut h = DMatrix::<f64>::zeros(6, 6);
+                h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
+                h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
+                h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
+                h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
+                let g =
+                    nalgebra::DVector::from_iterator(6, s.gx.iter().chain(s.gu.iter()).copied());
+                let block = t.transpose() * h * &t;
+                let mut view = kkt.view_mut((0, 0), (nv, nv));
+                view += block;
+                let mut top = rhs.rows_mut(0, nv);
+                top -= t.transpose() * g;
+                // x_{i+1} - A x_i - B u_i = c_i
+                let row = nv + (i + 1) * X;
+                for r in 0..X {
+                    kkt[(row + r, xc(i + 1) + r)] = 1.0;
+                    for c in 0..X {
+                        kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+                    }
+                    for a in 0..N {
+                        kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                    }
+                    rhs[row + r] = s.defect[r];
+                }
             }
-        }
-        for r in 0..X {
-            kkt[(nv + r, xc(0) + r)] = 1.0;
-            rhs[nv + r] = r0[r];
-            kkt[(nv + (steps + 1) * X + r, xc(steps) + r)] = 1.0;
-            rhs[nv + (steps + 1) * X + r] = r_end[r];
-        }
-        for r in nv..nv + nc {
-            for c in 0..nv {
-                kkt[(c, r)] = kkt[(r, c)];
-            }
-        }
-        let sol = kkt.lu().solve(&rhs).unwrap();
-        for i in 0..=steps {
             for r in 0..X {
-                assert!((d.dx[i][r] - sol[xc(i) + r]).abs() < 1e-9, "dx[{i}][{r}]");
+                kkt[(nv + r, xc(0) + r)] = 1.0;
+                rhs[nv + r] = r0[r];
+                kkt[(nv + (steps + 1) * X + r, xc(steps) + r)] = 1.0;
+                rhs[nv + (steps + 1) * X + r] = r_end[r];
             }
-        }
-        for i in 0..steps {
-            for a in 0..N {
-                assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
+            for r in nv..nv + nc {
+                for c in 0..nv {
+                    kkt[(c, r)] = kkt[(r, c)];
+                }
+            }
+            // the KKT matrix has nc + neg(Z^T H Z) negative eigenvalues
+            let eigenvalues = SymmetricEigen::new(kkt.clone()).eigenvalues;
+            let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
+            assert_eq!(
+                riccati.negative,
+                negative - nc,
+                "{steps} steps, shift {shift}"
+            );
+            if shift > 0.0 {
+                assert!(riccati.positive_definite());
+            }
+            let sol = kkt.lu().solve(&rhs).unwrap();
+            for i in 0..=steps {
+                for r in 0..X {
+                    assert!((d.dx[i][r] - sol[xc(i) + r]).abs() < 1e-9, "dx[{i}][{r}]");
+                }
+            }
+            for i in 0..steps {
+                for a in 0..N {
+                    assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
+                }
             }
         }
     }

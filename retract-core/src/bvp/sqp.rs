@@ -112,6 +112,7 @@ where
     /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h z^T g^{\ge}$,
     /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
     /// own terms are added by [`Barrier::add_to_stage`]).
+    #[inline(always)]
     fn stage(
         &self,
         iterate: &Iterate<N, X>,
@@ -182,9 +183,11 @@ where
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
-            let mut stage = self.stage(iterate, i, &y[i], barrier);
+            // (built in place: a stage model is a few hundred bytes)
+            stages.push(self.stage(iterate, i, &y[i], barrier));
+            let stage = stages.last_mut()?;
             cost_gradient.push((stage.gx, stage.gu));
-            barrier.add_to_stage(&mut stage, i, own, h);
+            barrier.add_to_stage(stage, i, own, h);
             // a NaN or an infinity anywhere makes the sum non-finite
             let finite = (stage.hxx.sum()
                 + stage.hux.sum()
@@ -198,7 +201,6 @@ where
             if !finite {
                 return None;
             }
-            stages.push(stage);
         }
         let r0 = self.problem.start - iterate.x[0];
         let r_end = self.problem.goal - iterate.x[iterate.x.len() - 1];
@@ -256,6 +258,39 @@ where
         None
     }
 
+    /// The certificate's residuals at the iterate of `models` with the multipliers of the
+    /// subproblem solution `direction` ([`kkt_residuals`] with the gradients of $h L - h z^T
+    /// g^{\ge}$, the constraint violation, $\max z g$), its negative directions those of
+    /// `riccati`; and the momenta.
+    fn residuals(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        riccati: &Riccati<N, X>,
+        direction: &Direction<N, X>,
+    ) -> (Vec<SVector<f64, X>>, Certificate) {
+        // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
+        let with_inequalities;
+        let gradients = if barrier.count > 0 {
+            let mut g = models.cost_gradient.clone();
+            barrier.lagrangian_gradients(&mut g, &models.inequalities, self.dynamics.h);
+            with_inequalities = g;
+            &with_inequalities
+        } else {
+            &models.cost_gradient
+        };
+        let (momenta, stationarity) =
+            kkt_residuals(&self.dynamics, &models.stages, gradients, direction);
+        let certificate = Certificate {
+            stationarity,
+            feasibility: models.violation_max(),
+            complementarity: barrier.complementarity().0,
+            negative_directions: riccati.negative,
+            min_reduced_hessian_eig: f64::NAN,
+        };
+        (momenta, certificate)
+    }
+
     fn plan(
         &self,
         iterate: &Iterate<N, X>,
@@ -278,7 +313,11 @@ where
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
     /// definite reduced Hessian (and, with inequalities, the barrier parameter at its floor
-    /// $\varepsilon / 10$), or a budget or the line search fails.
+    /// $\varepsilon / 10$), or a budget or the line search fails. After a full step from an
+    /// error below $\sqrt{\varepsilon}$ the residuals at the new point are first evaluated
+    /// with the last subproblem's multipliers (the Newton estimates there): if they and the
+    /// inertia of the factorisation at the point certify it, it is returned without solving
+    /// its own subproblem.
     pub fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
         let options = &self.problem.options;
         let (h, theta) = (self.dynamics.h, self.dynamics.theta);
@@ -303,6 +342,7 @@ where
         let floor = options.tolerance / 10.0;
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
+        let mut full_step: Option<Direction<N, X>> = None;
         loop {
             let done = iterations;
             let fail = |failure, iterate: &Iterate<N, X>, cost, certificate, momenta| PlanError {
@@ -327,6 +367,23 @@ where
                 return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
             };
             rho_last = rho;
+            // after a full step the last subproblem's multipliers are the Newton estimates
+            // here: if they already certify this point, no subproblem is solved at it
+            if let Some(last) = full_step
+                .take()
+                .filter(|_| rho == 0.0 && barrier.mu <= floor)
+            {
+                let (momenta, certificate) = self.residuals(&models, &barrier, &riccati, &last);
+                if certificate.stationarity.max(certificate.feasibility) <= options.tolerance {
+                    let state = (&iterate, &y[..], &barrier);
+                    if let Ok(certificate) =
+                        self.certify(state, &models, &riccati, rho, certificate)
+                    {
+                        let cost = models.cost;
+                        return Ok(self.plan(&iterate, cost, iterations, momenta, certificate));
+                    }
+                }
+            }
             let direction = riccati.solve(
                 &self.dynamics,
                 &models.stages,
@@ -334,27 +391,9 @@ where
                 &models.r0,
                 &models.r_end,
             );
-            // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
-            let with_inequalities;
-            let gradients = if count > 0 {
-                let mut g = models.cost_gradient.clone();
-                barrier.lagrangian_gradients(&mut g, &models.inequalities, h);
-                with_inequalities = g;
-                &with_inequalities
-            } else {
-                &models.cost_gradient
-            };
-            let (momenta, stationarity) =
-                kkt_residuals(&self.dynamics, &models.stages, gradients, &direction);
+            let (momenta, certificate) = self.residuals(&models, &barrier, &riccati, &direction);
             let (complementarity, complementarity_error) = barrier.complementarity();
-            let certificate = Certificate {
-                stationarity,
-                feasibility: models.violation_max(),
-                complementarity,
-                negative_directions: riccati.negative,
-                min_reduced_hessian_eig: f64::NAN,
-            };
-            let error = stationarity.max(certificate.feasibility);
+            let error = certificate.stationarity.max(certificate.feasibility);
             if barrier.mu > floor && error.max(complementarity_error) <= 10.0 * barrier.mu {
                 barrier.decrease(floor);
                 continue;
@@ -363,7 +402,13 @@ where
             let acceptable = stalled >= 3 && error.max(complementarity) <= options.acceptable;
             if (error <= options.tolerance || acceptable) && barrier.mu <= floor {
                 return self
-                    .certify((&iterate, &y, &barrier), &models, riccati, rho, certificate)
+                    .certify(
+                        (&iterate, &y, &barrier),
+                        &models,
+                        &riccati,
+                        rho,
+                        certificate,
+                    )
                     .map(|certificate| {
                         self.plan(
                             &iterate,
@@ -403,6 +448,9 @@ where
             for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
                 *yi += (target - *yi) * alpha;
             }
+            // (worth trying when Newton's quadratic convergence will take the error from here
+            // to below the tolerance)
+            full_step = (alpha == 1.0 && error <= options.tolerance.sqrt()).then_some(direction);
         }
     }
 
@@ -416,20 +464,23 @@ where
         &self,
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         models: &Models<N, X>,
-        riccati: Riccati<N, X>,
+        riccati: &Riccati<N, X>,
         rho: f64,
         mut certificate: Certificate,
     ) -> Result<Certificate, (Failure, Certificate)> {
         let (iterate, y, barrier) = state;
+        let refactored;
         let exact = if barrier.count > 0 {
             let stages = self.active_set_models(iterate, y, barrier, &models.inequalities);
-            Riccati::factor(
+            refactored = Riccati::factor(
                 &self.dynamics,
                 stages.as_deref().unwrap_or(&models.stages),
                 0.0,
-            )
+            );
+            &refactored
         } else if rho > 0.0 {
-            Riccati::factor(&self.dynamics, &models.stages, 0.0)
+            refactored = Riccati::factor(&self.dynamics, &models.stages, 0.0);
+            &refactored
         } else {
             riccati
         };
@@ -442,7 +493,7 @@ where
         }
         if self.problem.options.min_eigenvalue {
             certificate.min_reduced_hessian_eig =
-                min_reduced_eigenvalue(&exact, &self.dynamics, self.problem.steps);
+                min_reduced_eigenvalue(exact, &self.dynamics, self.problem.steps);
         }
         Ok(certificate)
     }
