@@ -27,14 +27,14 @@ pub struct StepOptions {
     /// $x_0, \dots, x_{k-1}$, in the units of the state); $0.02$ by default, `f64::INFINITY`
     /// checks only the three points of [`LiftedSystem::check_domain`]. With
     /// [`Self::check_domain`] on, a step whose chord has max-norm length
-    /// $\ell = |x_1 - x_0|_\infty$ above the spacing is cut into
-    /// $m = \min(\lceil \ell / \text{spacing} \rceil,$ [`Self::max_chord_pieces`]$)$ equal
-    /// pieces, and each piece is checked like a step of its own (at its two ends and its
-    /// midpoint, with the top derivative $u$ of the step), after the step itself.
+    /// $\ell = \Vert x_1 - x_0\Vert_\infty$ above the spacing $d$ is cut into
+    /// $m = \min(\lceil \ell / d \rceil, m_{\max})$ equal pieces ($m_{\max}$ =
+    /// [`Self::max_chord_pieces`]), and each piece is checked like a step of its own (at its two
+    /// ends and its midpoint, with the top derivative $u$ of the step), after the step itself.
     ///
     /// What this guarantees, and what not: the checked points are at most
     /// $\ell / (2m)$ apart along the chord (max-norm): at most half the spacing, or
-    /// $\ell / (2\,\text{max\_chord\_pieces})$ when the cap binds. A guarded expression
+    /// $\ell / (2 m_{\max})$ when the cap binds. A guarded expression
     /// that leaves its domain on a piece of the chord longer than that is reported. A
     /// violation on a shorter piece (an obstacle thinner than that, or a chord grazing a
     /// region) can still be missed: sampling is not a proof. The chord is the straight segment

@@ -4,7 +4,7 @@
 //! $N$ steps of $h = T/N$, the discrete necessary conditions of the lifted scheme are the
 //! KKT system of the direct transcription
 //!
-//! $$\min \sum_{i<N} h\,L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad x_{i+1} - x_i = h A
+//! $$\min \sum_{i<N} h\thinspace L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad x_{i+1} - x_i = h A
 //!   x_{\theta,i} + h B u_i, \quad x_0 = a, \quad x_N = b,$$
 //!
 //! whose multipliers are the momenta.
