@@ -3,7 +3,7 @@
 //! A has `kl` sub- and `ku` superdiagonals; row interchanges widen U to `kl + ku`
 //! superdiagonals. Storage is column-major with `2 kl + ku + 1` entries per column:
 //! $A_{ij}$ lives at row `kl + ku + i - j` of column `j`. Factorisation costs
-//! $O(n\,k_l\,(k_l + k_u))$ and solves $O(n\,(2k_l + k_u))$: linear in $n$.
+//! $O(n\thinspace k_l\thinspace(k_l + k_u))$ and solves $O(n\thinspace(2k_l + k_u))$: linear in $n$.
 
 /// A square banded matrix and, after [`BandMatrix::factor`], its LU factors.
 #[derive(Clone, Debug)]

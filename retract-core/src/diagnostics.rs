@@ -44,7 +44,7 @@ pub fn component_drift<const S: usize>(states: &[SVector<f64, S>], c: usize) -> 
         .fold(0.0, f64::max)
 }
 
-/// The canonical structure matrix $J = \begin{pmatrix} 0 & I \\ -I & 0 \end{pmatrix}$ on
+/// The canonical structure matrix $J = \begin{pmatrix} 0 & I \cr -I & 0 \end{pmatrix}$ on
 /// $z = (x, p)$.
 pub fn canonical_structure<const S: usize>() -> SMatrix<f64, S, S> {
     let half = S / 2;
@@ -60,7 +60,7 @@ pub fn canonical_structure<const S: usize>() -> SMatrix<f64, S, S> {
 }
 
 /// The derivative $D\Psi$ of the one-step map at $z_0$ and the new state $z_1$, by the
-/// implicit function theorem: $D\Psi = -[(\partial F/\partial w)^{-1}\,\partial F/\partial z_0]_{1..S}$.
+/// implicit function theorem: $D\Psi = -[(\partial F/\partial w)^{-1}\thinspace\partial F/\partial z_0]_{1..S}$.
 ///
 /// # Errors
 /// A failed step, or a singular Newton matrix at the solution.

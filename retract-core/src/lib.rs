@@ -5,8 +5,8 @@
 //! Ostrogradsky construction, a Hamiltonian system on $z = (x, p) \in \mathbb{R}^{2nk}$.
 //! The lifted midpoint ($\theta = 1/2$) or theta-scheme with step $h$ is
 //!
-//! $$x_1 - x_0 = h\,\partial_p H(x_\theta, p_\theta), \quad
-//!   p_1 - p_0 = -h\,\partial_x H(x_\theta, p_\theta),$$
+//! $$x_1 - x_0 = h\thinspace\partial_p H(x_\theta, p_\theta), \quad
+//!   p_1 - p_0 = -h\thinspace\partial_x H(x_\theta, p_\theta),$$
 //! $$x_\theta = (1-\theta) x_0 + \theta x_1, \quad p_\theta = \theta p_0 + (1-\theta) p_1,$$
 //!
 //! symplectic for every $\theta \in [0, 1]$, of order 2 for $\theta = 1/2$ and 1 otherwise.

@@ -313,7 +313,7 @@ where
     jac
 }
 
-/// $h\,L(x_\theta, u)$, the cost of one step.
+/// $h\thinspace L(x_\theta, u)$, the cost of one step.
 pub fn step_cost<L, const N: usize, const K: usize, const S: usize, const M: usize>(
     lagrangian: &L,
     z0: &SVector<f64, S>,
@@ -328,7 +328,7 @@ where
     h * lagrangian.lagrangian(&pt.x_th, &pt.u)
 }
 
-/// Explicit Euler guess $w = (z_0 + h\,z'(z_0),\ u(z_0))$.
+/// Explicit Euler guess $w = (z_0 + h\thinspace z'(z_0),\ u(z_0))$.
 ///
 /// # Errors
 /// When the vector field at $z_0$ cannot be evaluated.

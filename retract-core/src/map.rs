@@ -6,8 +6,8 @@
 //! integrator: from $(x_0, p_0)$ find the base point $x$, its tangent vector $\xi$ and the
 //! momenta $p$, $p_1$ with
 //!
-//! $$R_1(x, \xi) = x_0, \quad x_1 = R_2(x, \xi), \quad \xi = h\,\partial_p H(x, p),$$
-//! $$-h\,\partial_x H(x, p) = -(\partial_x R_1)^T p_0 + (\partial_x R_2)^T p_1, \quad
+//! $$R_1(x, \xi) = x_0, \quad x_1 = R_2(x, \xi), \quad \xi = h\thinspace\partial_p H(x, p),$$
+//! $$-h\thinspace\partial_x H(x, p) = -(\partial_x R_1)^T p_0 + (\partial_x R_2)^T p_1, \quad
 //!   p = -(\partial_\xi R_1)^T p_0 + (\partial_\xi R_2)^T p_1.$$
 //!
 //! With the Ostrogradsky Hamiltonian, $\partial_{p_j} H = x_{j+1}$ ($j < k-1$),
@@ -15,11 +15,11 @@
 //! ($p_{-1} = 0$), where the top derivative $u$ solves $p_{k-1} = \partial L/\partial u$.
 //! As in the built-in scheme, $u$ is an unknown instead of a Legendre inversion, and $p$ is
 //! eliminated: the Newton unknowns are $w = (x, u, p_1) \in \mathbb{R}^{2nk + n}$, with
-//! $\xi(x, u) = h\,(x_1, \dots, x_{k-1}, u)$ and the residual
+//! $\xi(x, u) = h\thinspace(x_1, \dots, x_{k-1}, u)$ and the residual
 //!
 //! $$F_1 = R_1(x, \xi) - x_0, \qquad
-//!   F_2 = (\partial_x R_2)^T p_1 - (\partial_x R_1)^T p_0 + h\,\partial_x H(x, p),$$
-//! $$F_3 = p_{k-1} - \partial L/\partial u\,(x, u).$$
+//!   F_2 = (\partial_x R_2)^T p_1 - (\partial_x R_1)^T p_0 + h\thinspace\partial_x H(x, p),$$
+//! $$F_3 = p_{k-1} - \partial L/\partial u\thinspace(x, u).$$
 //!
 //! Its Jacobian needs the Hessian of $\phi = p_1 \cdot R_2 - p_0 \cdot R_1$ in $(x, \xi)$
 //! ([`DiscretizationMap::covector_hessian`]): $\partial_x \phi$ is the first two terms of
@@ -475,8 +475,8 @@ where
 }
 
 /// The derivative $D\Psi$ of the one-step map $\Psi: z_0 \mapsto z_1$ of [`step`], by the
-/// implicit function theorem: $D\Psi = -G\,(\partial F/\partial w)^{-1}\,\partial F /
-/// \partial z_0$ with $G$ the derivative of the output $(R_2(x, \xi), p_1)$ in $w$, all at the
+/// implicit function theorem: $D\Psi = -G\thinspace(\partial F/\partial w)^{-1}\thinspace\partial F
+/// / \partial z_0$ with $G$ the derivative of the output $(R_2(x, \xi), p_1)$ in $w$, all at the
 /// solution. Symplectic maps have $D\Psi^T J D\Psi = J$.
 ///
 /// # Errors

@@ -2,22 +2,23 @@
 //!
 //! Solves $F(w) = 0$, $F: \mathbb{R}^M \to \mathbb{R}^M$, by
 //! $w \leftarrow w + \alpha \Delta$ with $J(w) \Delta = -F(w)$, where the step length
-//! $\alpha \in \{1, 1/2, 1/4, \dots\}$ is the first that satisfies the Armijo condition on
-//! $\phi = \tfrac12 |F|^2$:
-//! $\phi(w + \alpha\Delta) \le (1 - 2 c \alpha)\, \phi(w)$.
+//! $\alpha \in \lbrace 1, 1/2, 1/4, \dots\rbrace$ is the first that satisfies the Armijo
+//! condition on $\phi = \tfrac12 |F|^2$:
+//! $\phi(w + \alpha\Delta) \le (1 - 2 c \alpha)\thinspace \phi(w)$.
 //! A trial point whose residual is not finite is treated as a failed decrease, so the line
 //! search backs away from singularities of the Lagrangian.
 //!
-//! Convergence (max-norms):
-//! - residual: $|F(w)|_\infty \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty$, or
-//! - step: $|\Delta|_\infty \le \text{step\_abs} + \text{step\_rel}\,|w|_\infty$ (the step is
+//! Convergence, in max-norms $\Vert\cdot\Vert_\infty$, with the tolerances $r_a$, $r_r$, $s_a$,
+//! $s_r$ of [`NewtonOptions`] (`residual_abs`, `residual_rel`, `step_abs`, `step_rel`):
+//! - residual: $\Vert F(w)\Vert_\infty \le r_a + r_r \Vert F(w_0)\Vert_\infty$, or
+//! - step: $\Vert\Delta\Vert_\infty \le s_a + s_r \Vert w\Vert_\infty$ (the step is
 //!   then applied, so the returned iterate carries the quadratic-convergence gain), and the
 //!   residual there small row by row against the Jacobian's scale of the unknowns,
-//!   $|F_i| \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty +
-//!   \sum_j |J_{ij}|\,(\text{step\_abs} + \text{step\_rel}\,|w_j|)$ (what a step within the
-//!   tolerance could leave). A small step alone is not convergence: with one unknown of
-//!   $10^{154}$, every step is small against $|w|_\infty$, while a row of positions of
-//!   order 1 may still be off by 1. Such an iterate is not returned; Newton goes on from it.
+//!   $|F_i| \le r_a + r_r \Vert F(w_0)\Vert_\infty + \sum_j |J_{ij}| (s_a + s_r |w_j|)$
+//!   (what a step within the tolerance could leave). A small step alone is not convergence:
+//!   with one unknown of $10^{154}$, every step is small against $\Vert w\Vert_\infty$, while
+//!   a row of positions of order 1 may still be off by 1. Such an iterate is not returned;
+//!   Newton goes on from it.
 //!
 //! Nothing here allocates or panics.
 
@@ -37,13 +38,13 @@ pub trait Problem<const M: usize> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct NewtonOptions {
-    /// Absolute tolerance on $|F|_\infty$.
+    /// Absolute tolerance on $\Vert F\Vert_\infty$.
     pub residual_abs: f64,
-    /// Tolerance on $|F|_\infty$ relative to the initial residual.
+    /// Tolerance on $\Vert F\Vert_\infty$ relative to the initial residual.
     pub residual_rel: f64,
-    /// Absolute tolerance on the Newton step $|\Delta|_\infty$.
+    /// Absolute tolerance on the Newton step $\Vert\Delta\Vert_\infty$.
     pub step_abs: f64,
-    /// Tolerance on $|\Delta|_\infty$ relative to $|w|_\infty$.
+    /// Tolerance on $\Vert\Delta\Vert_\infty$ relative to $\Vert w\Vert_\infty$.
     pub step_rel: f64,
     /// Maximum number of Newton iterations (Jacobian factorisations).
     pub max_iterations: usize,
@@ -126,8 +127,8 @@ impl NewtonOptions {
 
     /// The residual test of an iterate accepted on the step test: every row $i$ of the
     /// residual must be what a step within the step tolerance could leave,
-    /// $|F_i| \le \text{residual\_abs} + \text{residual\_rel}\,|F(w_0)|_\infty +
-    /// \sum_j |J_{ij}| (\text{step\_abs} + \text{step\_rel}\,|w_j|)$; row by row, so that
+    /// $|F_i| \le r_a + r_r \Vert F(w_0)\Vert_\infty + \sum_j |J_{ij}| (s_a + s_r |w_j|)$
+    /// (the tolerances of the module docs); row by row, so that
     /// an iterate whose step is small against its largest entry (a momentum of 1e154) but not
     /// against the entries of a row (a position of order 1) is not taken for a root.
     /// `jacobian` is the last one factorised (a scale only).

@@ -4,7 +4,7 @@
 //! of a body in a barrier potential) and on no component of the top derivative, the
 //! theta-scheme residual splits as
 //!
-//! $$F(z_0, w) = A\, w + B\, z_0 + n(y), \qquad y = P w + (1-\theta) E z_0,$$
+//! $$F(z_0, w) = A\thinspace w + B\thinspace z_0 + n(y), \qquad y = P w + (1-\theta) E z_0,$$
 //!
 //! with $y$ the core values at the evaluation point ($E$ picks the core components of a
 //! state, $P = \theta E$ those of $w$), $A = A(h, \theta)$ and $B = B(h, \theta)$ independent
@@ -12,7 +12,7 @@
 //! $w = -A^{-1}(B z_0 + n(y))$, and $y$ solves the small system
 //!
 //! $$r(y) = y - G z_0 + K n(y) = 0, \qquad K = P A^{-1}, \qquad
-//!   G = (1-\theta) E - K B, \qquad \partial r/\partial y = I + K\, \partial n/\partial y,$$
+//!   G = (1-\theta) E - K B, \qquad \partial r/\partial y = I + K\thinspace \partial n/\partial y,$$
 //!
 //! $R$ unknowns instead of $M$. After Newton the step is
 //!
@@ -33,13 +33,13 @@
 //! momentum of a rotation-invariant system: $6.5 \cdot 10^{-17}$ per step). The factors
 //! therefore carry their rounding errors,
 //!
-//! $$T_{lo} = -A^{-1}(A T + B), \qquad A^{-1}_{lo} = A^{-1}(E - A\, A^{-1})$$
+//! $$T_{lo} = -A^{-1}(A T + B), \qquad A^{-1}_{lo} = A^{-1}(E - A\thinspace A^{-1})$$
 //!
 //! ([`ReducedFactors::t_lo`], [`ReducedFactors::a_inv_lo`]: the residuals summed compensated,
 //! so that they are the residuals of the rounded factors, not rounding noise; $E$ the unit
 //! columns at the forced rows), and the step computes
 //!
-//! $$w = (T + T_{lo})\, z_0 - (A^{-1} + A^{-1}_{lo})\, n(y),$$
+//! $$w = (T + T_{lo})\thinspace z_0 - (A^{-1} + A^{-1}_{lo})\thinspace n(y),$$
 //!
 //! each entry a balanced sum of the terms of $T$ and $A^{-1}$ whose last addition is made exact
 //! ([`two_sum`]), with the corrections $T_{lo} z_0 - A^{-1}_{lo} n$ added to its error: they
@@ -90,7 +90,7 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         z0: &SVector<f64, S>,
     ) -> SVector<f64, R>;
 
-    /// $r(y) = y - \text{offset} + K n(y)$ and $\partial r / \partial y = I + K\,\partial n/\partial y$.
+    /// $r(y) = y - \text{offset} + K n(y)$ and $\partial r / \partial y = I + K\thinspace\partial n/\partial y$.
     fn core_system(
         &self,
         factors: &ReducedFactors<S, M, R>,
@@ -164,12 +164,12 @@ pub struct ReducedFactors<const S: usize, const M: usize, const R: usize> {
     /// The columns of $A^{-1}$ at the forced rows ([`ReducedScheme::FORCED`]); the other
     /// columns are zero (the step never multiplies them).
     pub a_inv: SMatrix<f64, M, M>,
-    /// The rounding error of `a_inv`: $A^{-1}(E - A\,a^{-1})$ at the forced columns ($E$ their
-    /// unit columns; the other columns are zero), the residual summed compensated, as `t_lo`
+    /// The rounding error of `a_inv`: $A^{-1}(E - A\thinspace a^{-1})$ at the forced columns ($E$
+    /// their unit columns; the other columns are zero), the residual summed compensated, as `t_lo`
     /// for `t`.
     pub a_inv_lo: SMatrix<f64, M, M>,
-    /// $K = \theta\, E A^{-1}$ (rows of $A^{-1}$ at the core components, times $\theta$), at
-    /// the forced columns as `a_inv`.
+    /// $K = \theta\thinspace E A^{-1}$ (rows of $A^{-1}$ at the core components, times $\theta$),
+    /// at the forced columns as `a_inv`.
     pub k: SMatrix<f64, R, M>,
     /// $G = (1-\theta) E - K B = (1-\theta) E + \theta E T$.
     pub g: SMatrix<f64, R, S>,
@@ -299,10 +299,10 @@ where
     Ok((-minus_t, a_inv))
 }
 
-/// The rounding errors of `t` and `a_inv` as solutions of $A T = -B$ and $A\,a^{-1} = E$
+/// The rounding errors of `t` and `a_inv` as solutions of $A T = -B$ and $A\thinspace a^{-1} = E$
 /// ($E$ the unit columns at the forced rows): $T_{lo} = -A^{-1}(A T + B)$ and
-/// $A^{-1}(E - A\,a^{-1})$. The residuals are summed compensated ([`Dot2`]: one rounding per
-/// entry, so they are the residuals of the rounded factors, not rounding noise), then solved
+/// $A^{-1}(E - A\thinspace a^{-1})$. The residuals are summed compensated ([`Dot2`]: one rounding
+/// per entry, so they are the residuals of the rounded factors, not rounding noise), then solved
 /// for by the LU of the blocks of $A$; the corrections' own relative error is that of the
 /// solve, so `t` plus $T_{lo}$ is $-A^{-1} B$ to about $u^2$ (relative, $u$ the unit
 /// roundoff), and the same for $A^{-1}$.
@@ -446,8 +446,8 @@ where
 }
 
 /// Whether `t` and `a_inv` (from [`ReducedScheme::closed_form_factors`]) solve
-/// $A T = -B$ and $A\,a^{-1}_q = e_q$ for the forced rows $q$, checked on one test vector each
-/// to a relative $10^{-10}$; a closed form whose elimination divided by a nearly vanishing
+/// $A T = -B$ and $A\thinspace a^{-1}_q = e_q$ for the forced rows $q$, checked on one test vector
+/// each to a relative $10^{-10}$; a closed form whose elimination divided by a nearly vanishing
 /// pivot, or any non-finite entry, fails.
 fn solves_linear_part<Sys, const S: usize, const M: usize, const R: usize>(
     a: &SMatrix<f64, M, M>,
@@ -560,6 +560,35 @@ pub const CACHE_SIZE: usize = 16;
 /// Steps a [`ReducedScheme`] with Newton on its core; caches [`ReducedFactors`] for the
 /// [`CACHE_SIZE`] most recently used $(h, \theta)$ pairs (least recently used replaced). No
 /// heap.
+///
+/// # Example
+/// The obstacle system of the paper: its Hessian depends on the position $q$ only, so the
+/// macro reduces the step from $M = 15$ Newton unknowns to $R = 2$. The reduced step is the
+/// same map as [`crate::step()`], and a constant step size factorises once:
+/// ```
+/// use retract::nalgebra::SVector;
+/// use retract::{LiftedSystem, ReducedStepper, StepOptions, higher_order_lagrangian, step};
+///
+/// #[higher_order_lagrangian(order = 2)]
+/// fn obstacle(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64) -> f64 {
+///     0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
+///         + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
+/// }
+///
+/// let system = Obstacle::new(1e-2);
+/// assert_eq!(Obstacle::REDUCED_UNKNOWNS, 2); // the core: x and y of the body
+/// let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+/// let mut general = system.legendre(&SVector::from(jet));
+/// let mut reduced = general;
+/// let (mut stepper, options) = (ReducedStepper::new(&system), StepOptions::default());
+/// for _ in 0..200 {
+///     general = step(&system, &general, 0.01, &options)?.0;
+///     reduced = stepper.step(&reduced, 0.01, &options)?.0;
+///     assert!((general - reduced).amax() < 1e-10 * general.amax());
+/// }
+/// assert_eq!(stepper.factorisations(), 1);
+/// # Ok::<(), retract::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct ReducedStepper<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,

@@ -27,14 +27,14 @@ pub struct StepOptions {
     /// $x_0, \dots, x_{k-1}$, in the units of the state); $0.02$ by default, `f64::INFINITY`
     /// checks only the three points of [`LiftedSystem::check_domain`]. With
     /// [`Self::check_domain`] on, a step whose chord has max-norm length
-    /// $\ell = |x_1 - x_0|_\infty$ above the spacing is cut into
-    /// $m = \min(\lceil \ell / \text{spacing} \rceil,$ [`Self::max_chord_pieces`]$)$ equal
-    /// pieces, and each piece is checked like a step of its own (at its two ends and its
-    /// midpoint, with the top derivative $u$ of the step), after the step itself.
+    /// $\ell = \Vert x_1 - x_0\Vert_\infty$ above the spacing $d$ is cut into
+    /// $m = \min(\lceil \ell / d \rceil, m_{\max})$ equal pieces ($m_{\max}$ =
+    /// [`Self::max_chord_pieces`]), and each piece is checked like a step of its own (at its two
+    /// ends and its midpoint, with the top derivative $u$ of the step), after the step itself.
     ///
     /// What this guarantees, and what not: the checked points are at most
     /// $\ell / (2m)$ apart along the chord (max-norm): at most half the spacing, or
-    /// $\ell / (2\,\text{max\_chord\_pieces})$ when the cap binds. A guarded expression
+    /// $\ell / (2 m_{\max})$ when the cap binds. A guarded expression
     /// that leaves its domain on a piece of the chord longer than that is reported. A
     /// violation on a shorter piece (an obstacle thinner than that, or a chord grazing a
     /// region) can still be missed: sampling is not a proof. The chord is the straight segment
@@ -391,6 +391,38 @@ where
 
 /// One step $z_1 = \Psi_h(z_0)$ of the theta-scheme, from the explicit predictor.
 ///
+/// # Example
+/// Without a potential ($\tau = 0$: $L = \tfrac12|q''|^2$) the midpoint step has a closed
+/// form. With $p_1 = q''$ and $p_0 = -q'''$ the scheme is linear and gives
+/// $q_1 = q_0 + h q_0' + \tfrac{h^2}{2} p_{1,0} - \tfrac{h^3}{4} p_{0,0}$,
+/// $q_1' = q_0' + h p_{1,0} - \tfrac{h^2}{2} p_{0,0}$, $p_{1,1} = p_{1,0} - h p_{0,0}$,
+/// $p_{0,1} = p_{0,0}$:
+/// ```
+/// use nalgebra::SVector;
+/// use retract_core::models::PlanarBarrier;
+/// use retract_core::{LiftedSystem, StepOptions, step};
+///
+/// let system = PlanarBarrier { tau: 0.0, radius: 1.0, mass: 1.0 };
+/// // the jet (q, q', q'', q''') -> the state z = (q, q', p0, p1), blocks of 2
+/// let jet = SVector::<f64, 8>::from_column_slice(&[2.0, 0.0, 1.0, 0.5, 0.2, 0.0, 0.1, -0.3]);
+/// let z0 = system.legendre(&jet);
+/// let h = 0.1;
+/// let (z1, _) = step(&system, &z0, h, &StepOptions::default())?;
+/// for i in 0..2 {
+///     let (q, dq, p0, p1) = (z0[i], z0[2 + i], z0[4 + i], z0[6 + i]);
+///     let expected = [
+///         q + h * dq + h * h / 2.0 * p1 - h * h * h / 4.0 * p0,
+///         dq + h * p1 - h * h / 2.0 * p0,
+///         p0,
+///         p1 - h * p0,
+///     ];
+///     for (block, value) in expected.into_iter().enumerate() {
+///         assert!((z1[2 * block + i] - value).abs() < 1e-14);
+///     }
+/// }
+/// # Ok::<(), retract_core::Error>(())
+/// ```
+///
 /// # Errors
 /// Invalid `h` or options, a predictor that cannot be evaluated at $z_0$ (e.g. a
 /// non-finite state), or any Newton failure.
@@ -545,6 +577,34 @@ impl<F, const S: usize> OneStep<S> for F where
 
 #[cfg(feature = "std")]
 /// Runs `steps` steps of size `h` from `z0`, each from the explicit predictor.
+///
+/// # Example
+/// The barrier $V = \tau/(|q|^2 - r^2)$ is invariant under rotations, so by Noether the
+/// angular momentum $q \times p_0 + q' \times p_1$ is conserved; it is quadratic, and the
+/// midpoint rule conserves quadratic invariants exactly, so it holds to rounding (and the
+/// Newton tolerance) along a pass that the barrier bends:
+/// ```
+/// use nalgebra::SVector;
+/// use retract_core::models::PlanarBarrier;
+/// use retract_core::{LiftedSystem, StepOptions, trajectory};
+///
+/// let system = PlanarBarrier { tau: 1e-2, radius: 1.0, mass: 1.0 };
+/// let jet = SVector::<f64, 8>::from_column_slice(&[-2.0, 1.2, 1.0, -0.1, 0.0, 0.1, 0.1, 0.0]);
+/// let run = trajectory(&system, &system.legendre(&jet), 0.01, 400, &StepOptions::default())?;
+/// assert_eq!(run.states.len(), 401);
+/// let cross = |a: f64, b: f64, c: f64, d: f64| a * d - b * c;
+/// let angular = |z: &SVector<f64, 8>| {
+///     cross(z[0], z[1], z[4], z[5]) + cross(z[2], z[3], z[6], z[7])
+/// };
+/// let first = angular(&run.states[0]); // 0.22
+/// // q x q' alone is not conserved: the barrier turns the velocity
+/// let last = &run.states[400];
+/// assert!((cross(last[0], last[1], last[2], last[3]) - cross(-2.0, 1.2, 1.0, -0.1)).abs() > 1e-3);
+/// for z in &run.states {
+///     assert!((angular(z) - first).abs() < 1e-11 * first.abs());
+/// }
+/// # Ok::<(), retract_core::Interrupted<8>>(())
+/// ```
 ///
 /// With [`StepOptions::check_domain`] on, `z0` itself is checked first: a state where a
 /// guarded expression of $L$ fails (a denominator vanishes, a `sqrt` argument is negative, an

@@ -100,7 +100,7 @@ pub trait Lagrangian<const N: usize, const K: usize> {
         upper: &[SVector<f64, N>; K],
     ) -> [SVector<f64, N>; K];
 
-    /// Solves $p_{k-1} = \partial L/\partial u\,(x, u)$ for $u$, starting from `guess`.
+    /// Solves $p_{k-1} = \partial L/\partial u\thinspace(x, u)$ for $u$, starting from `guess`.
     ///
     /// The default runs [`crate::newton::solve`] with the Jacobian
     /// $\partial^2 L / \partial u^2$; a system with a closed-form inverse overrides it.
@@ -124,7 +124,7 @@ pub trait Lagrangian<const N: usize, const K: usize> {
     }
 }
 
-/// $F(u) = \partial L/\partial u\,(x, u) - p_{k-1}$, the Legendre inversion as a root problem.
+/// $F(u) = \partial L/\partial u\thinspace(x, u) - p_{k-1}$, the Legendre inversion as a root problem.
 struct TopDerivative<'a, L: ?Sized, const N: usize, const K: usize> {
     lagrangian: &'a L,
     x: &'a [SVector<f64, N>; K],
@@ -167,7 +167,7 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
 
     /// The Ostrogradsky Hamiltonian
     /// $H(x, p) = \sum_{j<k-1} p_j \cdot x_{j+1} + p_{k-1} \cdot u - L(x, u)$ with $u$
-    /// solving $p_{k-1} = \partial L/\partial u\,(x, u)$.
+    /// solving $p_{k-1} = \partial L/\partial u\thinspace(x, u)$.
     ///
     /// # Errors
     /// When the solve for $u$ fails or a value is not finite.
@@ -213,12 +213,12 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
         theta: f64,
     ) -> SMatrix<f64, M, S>;
 
-    /// The cost of one step, $h\,L(x_\theta, u)$: summed over a trajectory, the midpoint-type
-    /// quadrature of $J = \int L\,dt$.
+    /// The cost of one step, $h\thinspace L(x_\theta, u)$: summed over a trajectory, the
+    /// midpoint-type quadrature of $J = \int L\thinspace dt$.
     fn step_cost(&self, z0: &SVector<f64, S>, w: &SVector<f64, M>, h: f64, theta: f64) -> f64;
 
     /// An explicit first guess of $w$: one explicit Euler step
-    /// $z_1 \approx z_0 + h\, z'(z_0)$ and $u \approx u(z_0)$.
+    /// $z_1 \approx z_0 + h\thinspace z'(z_0)$ and $u \approx u(z_0)$.
     ///
     /// # Errors
     /// When the vector field at $z_0$ cannot be evaluated.

@@ -6,10 +6,10 @@
 //! satisfy the inequalities. With multipliers $z \approx \mu / s$ and the residual
 //! $r = g - s$, eliminating $\delta s = \nabla g^T \delta y + r$ and $\delta z$ from the
 //! primal-dual Newton system leaves, per step, the gradient
-//! $-h \nabla g\,(\mu/s - (z/s)\,r)$ and the Hessian $h (z/s) \nabla g \nabla g^T - h z \nabla^2 g$
-//! added to the model of $h L$; then $\delta z = (\mu - z s - z\,\delta s)/s$. The slacks take
-//! the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$ of
-//! the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
+//! $-h \nabla g\thinspace(\mu/s - (z/s)\thinspace r)$ and the Hessian $h (z/s) \nabla g \nabla g^T - h z \nabla^2 g$
+//! added to the model of $h L$; then $\delta z = (\mu - z s - z\thinspace\delta s)/s$. The slacks
+//! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$
+//! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
 //! \min(\mu / 5, \mu^{1.5}))$.
 

@@ -65,8 +65,8 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     (momenta, worst / (h * scale))
 }
 
-/// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\, Z$ ($Z$ orthonormal) of a
-/// positive definite factorisation, by Lanczos on its inverse: the subproblem's solution
+/// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\thinspace Z$ ($Z$ orthonormal) of
+/// a positive definite factorisation, by Lanczos on its inverse: the subproblem's solution
 /// operator $v \mapsto \delta$ (min $\tfrac12 \delta^T \nabla^2 J \delta - v^T \delta$ subject
 /// to the homogeneous constraints) is $Z (Z^T \nabla^2 J Z)^{-1} Z^T$, whose largest
 /// eigenvalue is the reciprocal of the one sought. NaN if Lanczos does not settle.

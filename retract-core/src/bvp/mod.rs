@@ -4,7 +4,7 @@
 //! $N$ steps of $h = T/N$, the discrete necessary conditions of the lifted scheme are the
 //! KKT system of the direct transcription
 //!
-//! $$\min \sum_{i<N} h\,L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad x_{i+1} - x_i = h A
+//! $$\min \sum_{i<N} h\thinspace L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad x_{i+1} - x_i = h A
 //!   x_{\theta,i} + h B u_i, \quad x_0 = a, \quad x_N = b,$$
 //!
 //! whose multipliers are the momenta.
@@ -36,6 +36,38 @@
 //! assert!((plan.cost - 12.0).abs() < 1e-2, "{}", plan.cost);
 //! assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
 //! assert_eq!(plan.x.len(), 51);
+//! ```
+//!
+//! # Receding horizon
+//! Each control period the system moves one step along the plan, and the problem is solved
+//! again from there, warm-started from [`Plan::shifted`] with a budget of SQP iterations
+//! ([`OptimalControlProblem::solve_real_time`]). Without the barrier ($\tau = 0$) the cost is
+//! quadratic and the dynamics linear, so one SQP step from any guess reaches the minimum. By
+//! the principle of optimality, the rest of an optimal plan is the optimal plan from its
+//! second state over the remaining $N - 1$ steps:
+//! ```
+//! use retract_core::bvp::{OptimalControlProblem, PlanGuess};
+//! use retract_core::models::PlanarBarrier;
+//!
+//! let system = PlanarBarrier { tau: 0.0, radius: 1.0, mass: 1.0 };
+//! let (goal, t_end, steps) = ([3.0, 1.0, 0.0, 0.0], 1.0, 50);
+//! let problem = OptimalControlProblem::new(&system, &[2.0, 0.0, 0.0, 0.0], &goal, t_end, steps);
+//! let mut plan = problem.solve(PlanGuess::Spline)?;
+//! for _ in 0..3 {
+//!     let start = plan.x[1].into(); // where the first step of the plan went
+//!     let problem = OptimalControlProblem::new(&system, &start, &goal, t_end, steps);
+//!     let next = problem.solve_real_time(PlanGuess::Plan(&plan.shifted()), 1)?;
+//!     assert!(next.converged);
+//!     plan = next.plan;
+//! }
+//! // shrinking horizon: the tail of the plan is optimal for the tail problem
+//! let start = plan.x[1].into();
+//! let tail = OptimalControlProblem::new(&system, &start, &goal, t_end - plan.h, steps - 1)
+//!     .solve(PlanGuess::Path { x: &plan.x[1..], u: &plan.u[1..] })?;
+//! for (a, b) in tail.x.iter().zip(&plan.x[1..]) {
+//!     assert!((a - b).amax() < 1e-8);
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 mod barrier;

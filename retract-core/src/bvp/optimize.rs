@@ -157,8 +157,8 @@ pub struct Certificate {
     pub complementarity: f64,
     /// Negative eigenvalues of the reduced Hessian (0 for a returned plan).
     pub negative_directions: usize,
-    /// The smallest eigenvalue of $Z^T \nabla^2 J\, Z$, $Z$ an orthonormal basis of the null
-    /// space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
+    /// The smallest eigenvalue of $Z^T \nabla^2 J\thinspace Z$, $Z$ an orthonormal basis of the
+    /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
     /// u_{N-1})$; positive for a strict local minimum. NaN unless
     /// [`PlanOptions::min_eigenvalue`] is set (the inertia count proves positivity either way).
     pub min_reduced_hessian_eig: f64,
@@ -178,7 +178,7 @@ pub struct Plan<const N: usize, const X: usize> {
     /// Ostrogradsky momenta $p_i$ recovered from the multipliers: $z_i = (x_i, p_i)$ is the
     /// state of the lifted scheme.
     pub momenta: Vec<SVector<f64, X>>,
-    /// $J = \sum_i h\,L(x_{\theta,i}, u_i)$.
+    /// $J = \sum_i h\thinspace L(x_{\theta,i}, u_i)$.
     pub cost: f64,
     /// SQP iterations.
     pub iterations: usize,
@@ -336,7 +336,7 @@ impl<const N: usize, const X: usize> core::fmt::Debug for PlanError<N, X> {
 
 impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 
-/// An optimal-control problem: minimise $\sum_i h\,L(x_{\theta,i}, u_i)$ over the lifted
+/// An optimal-control problem: minimise $\sum_i h\thinspace L(x_{\theta,i}, u_i)$ over the lifted
 /// scheme from the jet $a$ to the jet $b$ in time $T$ with $N$ steps.
 ///
 /// `N` is the dimension $n$, `K` the order $k$ and `X` $= nk$ the length of a jet; `S` and

@@ -126,7 +126,7 @@ pub struct BvpSolution<const S: usize, const M: usize> {
     pub states: Vec<SVector<f64, S>>,
     /// The Newton unknowns $w_i = (z_{i+1}, u_i)$ of each step.
     pub unknowns: Vec<SVector<f64, M>>,
-    /// $J = \sum_i h\,L(x_{\theta,i}, u_i)$.
+    /// $J = \sum_i h\thinspace L(x_{\theta,i}, u_i)$.
     pub cost: f64,
     /// Minimum clearance to each obstacle over $z_0..z_N$ (empty without a clearance function).
     pub clearance: Vec<f64>,
@@ -805,14 +805,14 @@ type StepMap<'a, const S: usize, const M: usize> =
     &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<Linearized<S, M>>;
 
 /// The linearised map of one step at the current iterate, $\delta w = \Phi \delta z + c$, with
-/// $\Phi$ and $c$ solving $\partial_z F\, \delta z + \partial_w F\, \delta w = -F$.
+/// $\Phi$ and $c$ solving $\partial_z F\thinspace \delta z + \partial_w F\thinspace \delta w = -F$.
 struct Linearized<const S: usize, const M: usize> {
     phi: SMatrix<f64, M, S>,
     c: SVector<f64, M>,
 }
 
 impl<const S: usize, const M: usize> Linearized<S, M> {
-    /// $\Phi\, \delta z + c$.
+    /// $\Phi\thinspace \delta z + c$.
     fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M> {
         let mut out = self.c;
         self.add_product(&mut out, dz);
@@ -859,7 +859,7 @@ where
 /// The step maps of a [`ReducedScheme`]. With $F = A w + B z + n(y)$,
 /// $y = \theta E w + (1-\theta) E z$, $N = \partial n / \partial y$ at the iterate,
 /// $g = A^{-1} F$ and $H = A^{-1} N$, the linearised step is
-/// $(I + \theta E H)\, \delta y = G \delta z - \theta E g$ and
+/// $(I + \theta E H)\thinspace \delta y = G \delta z - \theta E g$ and
 /// $\delta w = T \delta z - g - H \delta y$ (notation of [`crate::reduced`]): a rank-$R$ change
 /// of the constant map $T$ (formed densely: the dense products vectorise, an index list of
 /// the nonzeros of $T$ measured slower).
@@ -952,9 +952,9 @@ where
 /// Eliminating $\delta w_i = \Phi_i \delta z_i + c_i$ step by step leaves the recursion
 /// $\delta z_{i+1} = \Phi^z_i \delta z_i + c^z_i$ ($z$ rows), with $\delta x_0 = -(x_0 - a)$ known and
 /// $\delta p_0 = \xi$ free: $\delta z_i = Z_i \xi + \zeta_i$, and $\xi$ solves the $nk \times nk$
-/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\, nk\, S M)$, no banded matrix.
-/// Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or the end
-/// system is singular or the direction is not finite.
+/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\thinspace nk\thinspace S M)$, no
+/// banded matrix. Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or
+/// the end system is singular or the direction is not finite.
 fn condensed_direction<Sys, const S: usize, const M: usize>(
     problem: &BoundaryValueProblem<'_, Sys, S, M>,
     v: &[f64],
