@@ -6,72 +6,22 @@
 //! maps converge with order 2 (the initial-point map with order 1) to an independent RK4
 //! solution of the embedded Euler-Lagrange equation D_t^3 V + R(D_t V, V) V = 0.
 
+use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::diagnostics::canonical_structure;
 use retract::higher_order_lagrangian;
 use retract::map;
-use retract::nalgebra::{SVector, Vector3};
+use retract::nalgebra::{SVector, Vector2, Vector3};
 use retract::sphere::{
     self, Chart, ExponentialMidpoint, ProjectionInitial, ProjectionMidpoint, SphereMap,
     SphereState, SphereSystem,
 };
 use retract::{Error, NewtonOptions};
 
-#[higher_order_lagrangian(order = 2, sphere)]
-fn cubic(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3]) -> f64 {
-    // the covariant acceleration D_t q' = q'' - (q'' . q) q on the unit sphere
-    let a = q[0] * ddq[0] + q[1] * ddq[1] + q[2] * ddq[2];
-    0.5 * ((ddq[0] - a * q[0]).powi(2) + (ddq[1] - a * q[1]).powi(2) + (ddq[2] - a * q[2]).powi(2))
-}
-
 type State = SphereState<2, 8>;
 
-/// The tangent data (q, V, A, J) of the test cubic: q a unit vector, V, A, J tangent at q.
-fn data() -> [Vector3<f64>; 4] {
-    let q = Vector3::new(0.3, -0.4, 0.8).normalize();
-    let tangent = |v: Vector3<f64>| v - q * q.dot(&v);
-    [
-        q,
-        tangent(Vector3::new(0.9, 0.5, -0.2)),
-        tangent(Vector3::new(-0.4, 0.7, 0.6)),
-        tangent(Vector3::new(0.2, -0.3, 0.5)),
-    ]
-}
-
-/// The ambient jet (q, q', q'', q''') of the cubic through (q, V, A, J) (see `rhs`):
-/// q'' = A - |V|^2 q and q''' = J - 3 (A . V) q - |V|^2 V.
-fn jet([q, v, a, j]: [Vector3<f64>; 4]) -> [Vector3<f64>; 4] {
-    let vv = v.dot(&v);
-    [q, v, a - q * vv, j - q * (3.0 * a.dot(&v)) - v * vv]
-}
-
-/// The embedded Euler-Lagrange equation of the cubic on the unit sphere, for tangent fields
-/// along q (D_t W = W' + (W . V) q, curvature R(X, Y) Z = (Y . Z) X - (X . Z) Y):
-/// q' = V, V' = A - |V|^2 q, A' = J - (A . V) q, J' = D_t J - (J . V) q with
-/// D_t J = -R(A, V) V = -(|V|^2 A - (A . V) V).
-fn rhs([q, v, a, j]: [Vector3<f64>; 4]) -> [Vector3<f64>; 4] {
-    let (vv, av) = (v.dot(&v), a.dot(&v));
-    let dj = -(a * vv - v * av);
-    [v, a - q * vv, j - q * av, dj - q * j.dot(&v)]
-}
-
-/// The reference solution at `t` by classical RK4 with `steps` steps.
-fn reference(t: f64, steps: usize) -> [Vector3<f64>; 4] {
-    let h = t / steps as f64;
-    let mut y = data();
-    let add = |y: &[Vector3<f64>; 4], k: &[Vector3<f64>; 4], c: f64| -> [Vector3<f64>; 4] {
-        core::array::from_fn(|i| y[i] + k[i] * c)
-    };
-    for _ in 0..steps {
-        let k1 = rhs(y);
-        let k2 = rhs(add(&y, &k1, h / 2.0));
-        let k3 = rhs(add(&y, &k2, h / 2.0));
-        let k4 = rhs(add(&y, &k3, h));
-        y = core::array::from_fn(|i| {
-            y[i] + (k1[i] + k2[i] * 2.0 + k3[i] * 2.0 + k4[i]) * (h / 6.0)
-        });
-    }
-    y
-}
+#[path = "../examples/common/sphere_cubic.rs"]
+mod sphere_cubic;
+use sphere_cubic::{Cubic, OutsideCap, data, jet, on_equator, reference};
 
 #[higher_order_lagrangian(order = 1, sphere)]
 fn geodesic(_q: [f64; 3], dq: [f64; 3]) -> f64 {
@@ -151,8 +101,7 @@ fn the_state_stays_on_the_sphere_and_the_momentum_is_conserved() {
 fn the_noether_momentum_is_q_cross_j_minus_v_cross_a() {
     // the momentum map <p, omega x x> = omega . (q x p_0 + V x p_1) with p_1 = A and
     // p_0 = -J (tangentially) is -(q x J - V x A): the conserved m up to its sign convention
-    let [q, v, a, j] = data();
-    let m = q.cross(&j) - v.cross(&a);
+    let m = sphere_cubic::momentum(data());
     let mu = start().momentum();
     assert!((mu + m).amax() < 1e-12 * m.norm(), "{mu} against -{m}");
 }
@@ -268,7 +217,7 @@ fn sym<Map: map::DiscretizationMap<2, 2>>(
 #[test]
 fn the_midpoint_maps_have_order_2_and_the_initial_point_map_order_1() {
     let t = 1.0;
-    let exact = reference(t, 20_000)[0];
+    let exact = reference(data(), t, 20_000)[0];
     let error = |map: &dyn Fn(f64, usize) -> State, steps: usize| {
         (map(t / steps as f64, steps).point() - exact).norm()
     };
@@ -311,4 +260,73 @@ fn bad_jets_and_far_charts_are_errors() {
         s.in_chart(&opposite),
         Err(Error::InvalidArgument { name: "chart", .. })
     ));
+}
+
+/// The chart jet (y, y') of an ambient (q, q') as the optimizer's boundary data.
+fn boundary(chart: &Chart, jet: &[Vector3<f64>; 2]) -> [f64; 4] {
+    let [y, dy] = chart.coordinates(jet).expect("in the chart");
+    [y[0], y[1], dy[0], dy[1]]
+}
+
+/// The cubic from 60 degrees west to 60 degrees east on the equator in T = 2, N = 80 steps,
+/// in the chart centred between them, with the inequalities `caps`.
+fn plan_on_equator(caps: &[&OutsideCap]) -> (Chart, Plan<2, 4>) {
+    let chart = Chart::at(&Vector3::x()).unwrap();
+    let system = Cubic::new().with_chart(chart.params());
+    let (a, b) = (on_equator(-60.0, 0.5), on_equator(60.0, 0.5));
+    let (start, goal) = (boundary(&chart, &a), boundary(&chart, &b));
+    let charted: Vec<OutsideCap> = caps.iter().map(|c| c.with_chart(chart.params())).collect();
+    let mut problem = OptimalControlProblem::new(&system, &start, &goal, 2.0, 80)
+        .with_options(PlanOptions::default().with_min_eigenvalue(true));
+    for c in &charted {
+        problem = problem.with_inequality(c);
+    }
+    let plan = problem
+        .solve(PlanGuess::Spline)
+        .expect("a certified minimum");
+    assert_eq!(plan.certificate.negative_directions, 0);
+    assert!(plan.certificate.min_reduced_hessian_eig > 0.0);
+    (chart, plan)
+}
+
+#[test]
+fn a_spline_between_points_of_the_equator_stays_on_it() {
+    // the equator is a geodesic and the data are symmetric under z -> -z: so is the optimum
+    let (chart, plan) = plan_on_equator(&[]);
+    let off = plan
+        .x
+        .iter()
+        .map(|x| chart.point(&Vector2::new(x[0], x[1]))[2].abs())
+        .fold(0.0, f64::max);
+    assert!(off < 1e-9, "{off:e}");
+}
+
+#[test]
+fn a_spline_around_a_keep_out_cap_goes_around_it() {
+    // a cap of radius 20 degrees around the point 5 degrees north of (1, 0, 0)
+    let axis = Vector3::new(1.0, 0.0, 5f64.to_radians().tan()).normalize();
+    let cap = OutsideCap::new(axis.into(), 20f64.to_radians().cos());
+    let (chart, plan) = plan_on_equator(&[&cap]);
+    let (free_chart, free) = plan_on_equator(&[]);
+    // the constraint holds at the evaluation points (the midpoints in the chart); between
+    // them, at the nodes, the path may cut the cap's edge by O(h^2)
+    let point = |c: &Chart, x: &SVector<f64, 4>| c.point(&Vector2::new(x[0], x[1]));
+    let inside = |x: &SVector<f64, 4>| point(&chart, x).dot(&axis) - 20f64.to_radians().cos();
+    let at_midpoints = plan
+        .x
+        .windows(2)
+        .map(|w| inside(&((w[0] + w[1]) / 2.0)))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let at_nodes = plan.x.iter().map(inside).fold(f64::NEG_INFINITY, f64::max);
+    assert!(at_midpoints <= 1e-9, "inside the cap by {at_midpoints:e}");
+    assert!(at_nodes <= 1e-3, "inside the cap by {at_nodes:e} at a node");
+    // the cap sits north of the equator, so the path passes south of it, and costs more
+    let south = plan
+        .x
+        .iter()
+        .map(|x| point(&chart, x)[2])
+        .fold(0.0, f64::min);
+    assert!(south < -0.1, "{south}");
+    assert!(plan.cost > free.cost, "{} against {}", plan.cost, free.cost);
+    assert_eq!(free_chart, chart);
 }

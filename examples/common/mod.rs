@@ -217,3 +217,111 @@ where
         .draw()?;
     Ok(())
 }
+
+/// An orthographic view of the unit sphere from the direction `eye` (a unit vector, z up):
+/// the outline, a 30-degree graticule and the caps `(axis, angular radius)` on the visible
+/// side, and curves of points on the sphere (their visible parts), with start and end markers.
+pub fn sphere(
+    path: &Path,
+    title: &str,
+    eye: [f64; 3],
+    curves: &[(String, Vec<[f64; 3]>)],
+    caps: &[([f64; 3], f64)],
+) -> Result<(), Box<dyn Error>> {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let unit = |a: [f64; 3]| {
+        let n = dot(a, a).sqrt();
+        a.map(|c| c / n)
+    };
+    let eye = unit(eye);
+    let up = unit([-eye[0] * eye[2], -eye[1] * eye[2], 1.0 - eye[2] * eye[2]]);
+    let right = cross(up, eye);
+    // the screen point of p and whether p faces the eye
+    let project = |p: [f64; 3]| ((dot(p, right), dot(p, up)), dot(p, eye) >= 0.0);
+    let visible_runs = |points: &[[f64; 3]]| -> Vec<Vec<(f64, f64)>> {
+        let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for &p in points {
+            let (xy, front) = project(p);
+            match (front, runs.last_mut()) {
+                (true, Some(run)) => run.push(xy),
+                (false, Some(run)) if !run.is_empty() => runs.push(Vec::new()),
+                _ => {}
+            }
+        }
+        runs.into_iter().filter(|r| r.len() > 1).collect()
+    };
+    let circle = |axis: [f64; 3], radius: f64| -> Vec<[f64; 3]> {
+        let axis = unit(axis);
+        let helper = if axis[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let e1 = unit(cross(axis, helper));
+        let e2 = cross(axis, e1);
+        (0..=180)
+            .map(|i| {
+                let a = i as f64 / 180.0 * std::f64::consts::TAU;
+                let (c, s) = (radius.cos(), radius.sin());
+                core::array::from_fn(|k| axis[k] * c + (e1[k] * a.cos() + e2[k] * a.sin()) * s)
+            })
+            .collect()
+    };
+    let root = SVGBackend::new(path, (720, 720)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .build_cartesian_2d(-1.1..1.1, -1.1..1.1)?;
+    let grey = RGBColor(200, 200, 200);
+    let outline: Vec<(f64, f64)> = circle(eye, std::f64::consts::FRAC_PI_2)
+        .iter()
+        .map(|&p| project(p).0)
+        .collect();
+    chart.draw_series(std::iter::once(PathElement::new(
+        outline,
+        BLACK.stroke_width(1),
+    )))?;
+    for degrees in (-60..=60).step_by(30) {
+        let parallel = circle([0.0, 0.0, 1.0], (90.0 - degrees as f64).to_radians());
+        for run in visible_runs(&parallel) {
+            chart.draw_series(std::iter::once(PathElement::new(run, grey)))?;
+        }
+    }
+    for degrees in (0..180).step_by(30) {
+        let a = (degrees as f64).to_radians();
+        let meridian = circle([-a.sin(), a.cos(), 0.0], std::f64::consts::FRAC_PI_2);
+        for run in visible_runs(&meridian) {
+            chart.draw_series(std::iter::once(PathElement::new(run, grey)))?;
+        }
+    }
+    for &(axis, radius) in caps {
+        for run in visible_runs(&circle(axis, radius)) {
+            chart.draw_series(std::iter::once(Polygon::new(
+                run.clone(),
+                RGBColor(255, 200, 120).mix(0.6).filled(),
+            )))?;
+            chart.draw_series(std::iter::once(PathElement::new(
+                run,
+                RGBColor(255, 127, 14),
+            )))?;
+        }
+    }
+    let projected: Vec<Curve> = curves
+        .iter()
+        .map(|(label, points)| {
+            let front = visible_runs(points).into_iter().flatten().collect();
+            Curve::new(label.clone(), front)
+        })
+        .collect();
+    draw_curves(&mut chart, &projected, Markers::Ends)?;
+    root.present()?;
+    Ok(())
+}
