@@ -107,6 +107,15 @@ fn the_noether_momentum_is_q_cross_j_minus_v_cross_a() {
 }
 
 #[test]
+fn the_hamiltonian_is_j_dot_v_minus_half_a_squared() {
+    // H = p_0 . q' + p_1 . q'' - L with p_1 = A, p_0 = -J (tangentially), L = |A|^2 / 2
+    let [_, v, a, j] = data();
+    let h = start().hamiltonian(&Cubic::new()).expect("finite");
+    let expected = -(j.dot(&v)) + 0.5 * a.dot(&a);
+    assert!((h - expected).abs() < 1e-12, "{h} against {expected}");
+}
+
+#[test]
 fn every_map_conserves_the_momentum() {
     let m0 = start().momentum();
     let initial = run(&ProjectionInitial, 0.02, 500).expect("regular steps");
