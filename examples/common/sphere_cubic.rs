@@ -2,7 +2,7 @@
 //! Euler-Lagrange equation D_t^3 V + R(D_t V, V) V = 0 as a first-order system in
 //! (q, V, A, J) (A = D_t V, J = D_t A), integrated by classical RK4; and the cubic's
 //! Lagrangian, a keep-out cap and boundary data for `retract`. Shared by
-//! `examples/sphere.rs` and `tests/sphere.rs` (by path).
+//! `examples/sphere.rs` and `tests/integrators/sphere.rs` (by path).
 #![allow(dead_code)] // each user takes a subset
 
 use retract::nalgebra::Vector3;

@@ -103,3 +103,20 @@ pub fn hess_entry<const N: usize, const K: usize>(
         (false, false) => h.uu[(ia, ib)],
     }
 }
+
+/// f'(0) of a scalar function of one variable, fourth-order central stencil (error
+/// O(eps^4)).
+pub fn fd(f: impl Fn(f64) -> f64, eps: f64) -> f64 {
+    (-f(2.0 * eps) + 8.0 * f(eps) - 8.0 * f(-eps) + f(-2.0 * eps)) / (12.0 * eps)
+}
+
+/// Asserts |got - want| <= 1e-8 (1 + scale), naming `what` (a generated derivative against
+/// its finite differences).
+pub fn close(what: &str, got: f64, want: f64, scale: f64) {
+    let tol = 1e-8 * (1.0 + scale);
+    assert!(
+        (got - want).abs() <= tol,
+        "{what}: generated {got:e}, finite differences {want:e} (|diff| {:e} > {tol:e})",
+        (got - want).abs()
+    );
+}

@@ -2,7 +2,7 @@
 //! self-convergence with obstacles, agreement with shooting, and hard cases that end in
 //! convergence or a typed error (never NaN, never a panic).
 
-mod common;
+use crate::common;
 
 use common::largest_gap;
 use common::models::Scene;

@@ -1,7 +1,7 @@
 //! Symmetric compositions of the midpoint rule: observed orders 4, 6 and 8, and a symplectic
 //! composed map.
 
-mod common;
+use crate::common;
 
 use common::models::RigidBody;
 use retract::compose::{coefficients, compose_with, triple_jump};

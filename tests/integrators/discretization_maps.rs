@@ -3,7 +3,7 @@
 //! steps of order 2 when symmetric and 1 otherwise, and the Newton Jacobian is the derivative
 //! of the residual.
 
-mod common;
+use crate::common;
 
 use common::models::bounded_pais_uhlenbeck;
 

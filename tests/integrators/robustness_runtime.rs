@@ -2,7 +2,7 @@
 //! accepted only with a small residual row by row (item 11), the reduced stepper's cache of
 //! factorisations (item 14), and sizes too large for memory (item 15).
 
-mod common;
+use crate::common;
 
 use common::models::RigidBody;
 use retract::bvp::{BoundaryValueProblem, BvpOptions, Guess};

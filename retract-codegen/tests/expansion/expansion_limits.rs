@@ -2,7 +2,7 @@
 //! expand in quasi-linear time, deep inputs expand to code of bounded nesting, and inputs
 //! beyond the documented limits are errors at their span, never an abort. (The work of the
 //! chains is counted in `codegen`'s unit tests; a deep case is compiled in the workspace's
-//! `tests/item_6_deep_nesting.rs`.)
+//! `tests/integrators/item_6_deep_nesting.rs`.)
 
 use std::time::{Duration, Instant};
 

@@ -8,7 +8,7 @@
 //!
 //! Each run takes `CASES` cases from a fixed seed and `CASES` from a random one (printed; set
 //! `RETRACT_FUZZ_SEED` to replay it). A sample of well-behaved Lagrangians from the fixed
-//! seed is compiled in the workspace's `tests/fuzz_corpus.rs`, whose derivatives are checked
+//! seed is compiled in the workspace's `tests/integrators/fuzz_corpus.rs`, whose derivatives are checked
 //! against finite differences there; `item_10_compiled_corpus_is_the_fixed_seed_sample`
 //! keeps that file equal to what the generator makes (`RETRACT_BLESS_CORPUS=1` rewrites it).
 
@@ -530,7 +530,7 @@ fn item_10_grammar_fuzzer_random_seed() {
     run(seed);
 }
 
-/// The corpus section of `tests/fuzz_corpus.rs`: the first `CORPUS` smooth Lagrangians of
+/// The corpus section of `tests/integrators/fuzz_corpus.rs`: the first `CORPUS` smooth Lagrangians of
 /// the fixed seed that expand, and one derivative check per Lagrangian.
 fn corpus() -> String {
     let mut rng = Rng(FIXED_SEED ^ 0xc0de);
@@ -565,13 +565,17 @@ fn corpus() -> String {
     format!("{items}pub fn corpus_checks() {{\n{checks}}}\n")
 }
 
-const BEGIN: &str = "// ---- BEGIN GENERATED (retract-codegen/tests/grammar_fuzz.rs) ----\n";
+const BEGIN: &str =
+    "// ---- BEGIN GENERATED (retract-codegen/tests/expansion/grammar_fuzz.rs) ----\n";
 const END: &str = "// ---- END GENERATED ----\n";
 
 #[test]
 fn item_10_compiled_corpus_is_the_fixed_seed_sample() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/fuzz_corpus.rs");
-    let text = std::fs::read_to_string(path).expect("tests/fuzz_corpus.rs");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/integrators/fuzz_corpus.rs"
+    );
+    let text = std::fs::read_to_string(path).expect("tests/integrators/fuzz_corpus.rs");
     let (Some(start), Some(end)) = (text.find(BEGIN), text.find(END)) else {
         panic!("markers missing in {path}");
     };
@@ -583,8 +587,8 @@ fn item_10_compiled_corpus_is_the_fixed_seed_sample() {
             std::fs::write(path, new).expect("write the corpus");
         } else {
             panic!(
-                "tests/fuzz_corpus.rs is not the fixed-seed sample; regenerate it with \
-                 RETRACT_BLESS_CORPUS=1 cargo test -p retract-codegen --test grammar_fuzz"
+                "tests/integrators/fuzz_corpus.rs is not the fixed-seed sample; regenerate it with \
+                 RETRACT_BLESS_CORPUS=1 cargo test -p retract-codegen --test expansion"
             );
         }
     }

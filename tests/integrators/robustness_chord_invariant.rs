@@ -2,7 +2,7 @@
 //! check samples the chord of a step (item 12), and the reduced step conserves the angular
 //! momentum of a rotation-invariant system (item 13).
 
-mod common;
+use crate::common;
 
 use retract::nalgebra::SVector;
 use retract::{

@@ -1,7 +1,7 @@
 //! Hard cases through the macro. Each ends in convergence or a typed error: never a NaN in
 //! a returned state, never a panic.
 
-mod common;
+use crate::common;
 
 use common::models::{RigidBody, bounded_pais_uhlenbeck};
 use retract::higher_order_lagrangian;

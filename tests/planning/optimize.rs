@@ -2,7 +2,7 @@
 //! certificate agrees with a dense computation, it descends where the root finder stops at a
 //! saddle, it never returns a path through an obstacle, and its failures carry the iterate.
 
-mod common;
+use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 

@@ -2,7 +2,7 @@
 //! order, symplecticity, Noether momentum, bounded energy error against RK4's drift, and
 //! agreement with exact polynomial splines for k = 3 and k = 4.
 
-mod common;
+use crate::common;
 
 use common::models::{PaisUhlenbeck, RigidBody, bounded_pais_uhlenbeck};
 use retract::diagnostics::{component_drift, rk4_step, symplecticity_error};

@@ -6,10 +6,9 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::common;
 
-use common::{grad_entry, hess_entry};
+use common::{close, fd, grad_entry, hess_entry};
 
 use proptest::prelude::*;
 use retract::higher_order_lagrangian;
@@ -125,20 +124,6 @@ fn chain24(q: [f64; 24], dq: [f64; 24], kappa: f64) -> f64 {
 }
 
 // ---- finite differences -----------------------------------------------------------------
-
-/// f'(0) of a scalar function of one variable, fourth-order central stencil.
-fn fd(f: impl Fn(f64) -> f64, eps: f64) -> f64 {
-    (-f(2.0 * eps) + 8.0 * f(eps) - 8.0 * f(-eps) + f(-2.0 * eps)) / (12.0 * eps)
-}
-
-fn close(what: &str, got: f64, want: f64, scale: f64) {
-    let tol = 1e-8 * (1.0 + scale);
-    assert!(
-        (got - want).abs() <= tol,
-        "{what}: generated {got:e}, finite differences {want:e} (|diff| {:e} > {tol:e})",
-        (got - want).abs()
-    );
-}
 
 fn blocks<const N: usize, const K: usize>(v: &[f64]) -> [SVector<f64, N>; K] {
     core::array::from_fn(|j| SVector::from_fn(|i, _| v[j * N + i]))

@@ -19,7 +19,7 @@ use retract::{Error, NewtonOptions};
 
 type State = SphereState<2, 8>;
 
-#[path = "../examples/common/sphere_cubic.rs"]
+#[path = "../../examples/common/sphere_cubic.rs"]
 mod sphere_cubic;
 use sphere_cubic::{Cubic, OutsideCap, data, jet, on_equator, reference};
 

@@ -2,7 +2,7 @@
 //! L = 1/2|q''|^2 + tau/(|q|^2 - r^2) on R^2): order, symplecticity, the closed-form V = 0
 //! solution, Jacobians against finite differences, and every error variant from a real input.
 
-mod common;
+use crate::common;
 
 use retract::diagnostics::{energy_error, rk4_step, symplecticity_error};
 use retract::models::PlanarBarrier;

@@ -1,7 +1,7 @@
 //! Issue 14, the macro: hostile but valid inputs compile to code that computes what the
 //! annotated function computes, with the right derivatives. (Inputs that must be rejected are
 //! in `validation/tests/ui/fail/item_*.rs`; the expansion itself is tested in
-//! `retract-codegen/tests/robustness_items.rs`.)
+//! `retract-codegen/tests/expansion/robustness_items.rs`.)
 
 use retract::Lagrangian;
 use retract::higher_order_lagrangian;

@@ -1,5 +1,5 @@
 //! Issue 14, item 10: a fixed sample of the grammar fuzzer's Lagrangians
-//! (`retract-codegen/tests/grammar_fuzz.rs`, fixed seed, smooth mode: every singular
+//! (`retract-codegen/tests/expansion/grammar_fuzz.rs`, fixed seed, smooth mode: every singular
 //! operation with an argument bounded away from its singular set), compiled through the
 //! macro, with the generated gradient and Hessian checked against fourth-order central
 //! finite differences at 8 points each. The section between the markers is written by the
@@ -125,7 +125,7 @@ fn item_10_compiled_fuzz_corpus_derivatives_match_finite_differences() {
 mod corpus {
 use super::*;
 
-// ---- BEGIN GENERATED (retract-codegen/tests/grammar_fuzz.rs) ----
+// ---- BEGIN GENERATED (retract-codegen/tests/expansion/grammar_fuzz.rs) ----
 #[higher_order_lagrangian(order = 2)]
 fn fuzz_0(q: f64, dq: f64, ddq: f64, obs0: &[[f64; 1]], a1: f64, c2: [f64; 1]) -> f64 { const N_I: i32 = 2; const C_0: f64 = 1.25; let t0 = f64::hypot((2.0 + (f64::hypot(a1, 1.0 + (q).powi(2))).tanh()).recip(), 1.0 + ((2.0 + ((0.5 * (1.45).sin()).exp()).tanh()).recip()).powi(2)); let t1 = a1; let mut acc = 0.0; acc -= (2.0 + (C_0).tanh()).recip() - ((q).sin() * 1.37); acc -= -((0.5 * (c2[0]).sin()).exp()); for i in 0..4 { acc += q; } for o in obs0 { acc -= q + 1.41; } 0.5 * (ddq * ddq) + acc + (f64::hypot(t0, 1.0 + ((0.5 * (t0).sin()).exp()).powi(2))).atan2(2.0 + (f64::hypot((a1).sin() * 1.36, 1.0 + ((1.0 + 0.5 * (q).sin()).abs() * (c2[0])).powi(2))).cos()) }
 

@@ -3,7 +3,7 @@
 //! moderate N agrees with one at a much larger N within its error estimate, and for the
 //! minimum-acceleration spline it recovers the exact continuous cost.
 
-mod common;
+use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 use retract::bvp::{Extrapolated, OptimalControlProblem, PlanError, PlanGuess, PlanOptions};

@@ -6,10 +6,9 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::common;
 
-use common::{grad_entry, hess_entry};
+use common::{close, fd, grad_entry, hess_entry};
 
 use proptest::prelude::*;
 use retract::JetFunction;
@@ -55,20 +54,6 @@ fn jerk_limit(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], dddq: [f64; 2], a: f64) 
 }
 
 // ---- finite differences -----------------------------------------------------------------
-
-/// f'(0) of a scalar function of one variable, fourth-order central stencil.
-fn fd(f: impl Fn(f64) -> f64, eps: f64) -> f64 {
-    (-f(2.0 * eps) + 8.0 * f(eps) - 8.0 * f(-eps) + f(-2.0 * eps)) / (12.0 * eps)
-}
-
-fn close(what: &str, got: f64, want: f64, scale: f64) {
-    let tol = 1e-8 * (1.0 + scale);
-    assert!(
-        (got - want).abs() <= tol,
-        "{what}: generated {got:e}, finite differences {want:e} (|diff| {:e} > {tol:e})",
-        (got - want).abs()
-    );
-}
 
 /// `value`, `gradient` and `hessian` of `f` at the flat jet `v` = (q, ..., q^(k)) against
 /// `original`, the annotated function called on the same flat jet.

@@ -4,7 +4,7 @@
 //! paper's S^2 initial-point map, whose lifts are the paper's formulas with MATH.md slip 5
 //! corrected.
 
-mod common;
+use crate::common;
 
 use common::models::bounded_pais_uhlenbeck;
 use common::rk4_final;

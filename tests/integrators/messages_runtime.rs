@@ -3,7 +3,7 @@
 //! state outside the domain is flagged at step 0, and `{:?}` of an interrupted trajectory is
 //! a summary. Every test asserts on the message text.
 
-mod common;
+use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 use retract::bvp::{
@@ -398,7 +398,7 @@ fn leaving_a_denominator_obstacle_is_not_called_entering_it() {
 
 #[test]
 fn debug_of_an_interrupted_trajectory_is_a_summary() {
-    // the case of tests/guard.rs: the path reaches the circle near t = 1.955 (step 195)
+    // the case of tests/integrators/guard.rs: the path reaches the circle near t = 1.955 (step 195)
     let system = OneDisc { tau: 1e-2 };
     let z0 = state(&system, [-2.0, 1.19, 1.0, -0.1]);
     let stop = trajectory(&system, &z0, 0.01, 400, &StepOptions::default()).unwrap_err();

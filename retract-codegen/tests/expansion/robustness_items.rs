@@ -1,7 +1,7 @@
 //! Regression tests of the macro items of issue 14 at the level of the expansion: each
 //! input ends in correct code or in an error at its span, never in a panic, a hang or a
 //! silently wrong derivative. (The compiled behaviour is checked in the workspace's
-//! `tests/macro_robustness.rs`, `validation/tests/derivatives.rs` and `validation/tests/ui`.)
+//! `tests/integrators/macro_robustness.rs`, `validation/tests/properties/derivatives.rs` and `validation/tests/ui`.)
 
 use proc_macro2::TokenStream;
 use retract_codegen::{try_expand, try_expand_jet_function};
@@ -219,7 +219,7 @@ fn item_7_non_finite_constants_are_folded_as_f64_does() {
 /// deeper) is differentiated and substituted without deep recursion, so the expansion fits a
 /// 1 MiB stack even unoptimised (the compiler's own stack overflowed on it before). The
 /// emitted code of this case compiles too (about 80 s and 0.8 GB in a release build, so it is
-/// not compiled here; `tests/item_6_deep_nesting.rs` compiles the 1000-iteration case).
+/// not compiled here; `tests/integrators/item_6_deep_nesting.rs` compiles the 1000-iteration case).
 #[test]
 fn item_6_a_recurrence_unrolled_to_the_limit_expands_on_a_small_stack() {
     let run = std::thread::Builder::new()

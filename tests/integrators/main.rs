@@ -1,0 +1,25 @@
+//! Integration tests of the integrators: the scheme, compositions, discretization maps, the
+//! sphere, the macro against hand-written code, the guard on steps, messages and robustness.
+//!
+//! One test crate per group (fewer crates build and link faster): each module was a test
+//! crate of its own; `common` holds the shared helpers and Lagrangians.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod compositions;
+mod core_scheme;
+mod discretization_maps;
+mod fuzz_corpus;
+mod guard;
+mod guard_singular;
+mod hard_cases;
+mod item_6_deep_nesting;
+mod macro_robustness;
+mod macro_vs_handwritten;
+mod map_macro;
+mod messages_runtime;
+mod robustness_chord_invariant;
+mod robustness_runtime;
+mod sphere;
+mod structure;

@@ -1,0 +1,12 @@
+//! Integration tests of planning: the optimizer, the root finder, inequalities, extrapolation.
+//!
+//! One test crate per group (fewer crates build and link faster): each module was a test
+//! crate of its own; `common` holds the shared helpers and Lagrangians.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bvp;
+mod extrapolate;
+mod inequalities;
+mod optimize;
