@@ -254,7 +254,7 @@ fn normalised_jet(s: &Jet<3>, len: usize) -> Jet<3> {
     for j in 0..len {
         let ss: f64 = (0..=j).map(|i| binomial(j, i) * s[i].dot(&s[j - i])).sum();
         r[j] = if j == 0 {
-            ss.sqrt()
+            num_traits::Float::sqrt(ss)
         } else {
             let cross: f64 = (1..j).map(|i| binomial(j, i) * r[i] * r[j - i]).sum();
             (ss - cross) / (2.0 * r[0])
