@@ -38,8 +38,7 @@ use std::error::Error;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use retract::LiftedSystem;
-use retract::bvp::{BvpOptions, ClearanceFn, Guess, continuation};
+use retract::bvp::{BvpOptions, ClearanceFn, Curve, Guess, continuation};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{SVector, Vector2};
 use scene::Scene;
@@ -115,34 +114,6 @@ fn guess_path(scene: &Scene) -> impl Fn(f64) -> [f64; 3] + '_ {
     }
 }
 
-/// z_i = Leg(q, q', q'', q''') of the guessed path, derivatives by central differences.
-fn guess_states(scene: &Scene, system: &PlanarBody<'_>) -> Vec<SVector<f64, 12>> {
-    let path = guess_path(scene);
-    let d = 1e-3;
-    (0..=scene.steps)
-        .map(|i| {
-            let t = i as f64 * scene.horizon / scene.steps as f64;
-            let (m2, m1, c, p1, p2) = (
-                path(t - 2.0 * d),
-                path(t - d),
-                path(t),
-                path(t + d),
-                path(t + 2.0 * d),
-            );
-            let jet = SVector::<f64, 12>::from_fn(|r, _| {
-                let j = r % 3;
-                match r / 3 {
-                    0 => c[j],
-                    1 => (p1[j] - m1[j]) / (2.0 * d),
-                    2 => (p1[j] - 2.0 * c[j] + m1[j]) / (d * d),
-                    _ => (p2[j] - 2.0 * p1[j] + 2.0 * m1[j] - m2[j]) / (2.0 * d * d * d),
-                }
-            });
-            system.legendre(&jet)
-        })
-        .collect()
-}
-
 fn run() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
     let scene_path: PathBuf = args.next().map_or_else(
@@ -166,13 +137,15 @@ fn run() -> Result<(), Box<dyn Error>> {
     };
     let clearance: ClearanceFn<'_, 12> = &clearance;
     let (start, goal) = (scene.start.jet(), scene.goal.jet());
-    let guess = guess_states(
-        &scene,
+    // z_i = Leg(q, q', q'', q''')(t_i) of the guessed path, derivatives by central differences
+    let guess = Curve::from_fn(guess_path(&scene)).states(
         &PlanarBody {
             tau: scene.barrier,
             obstacles: &discs,
         },
-    );
+        scene.horizon,
+        scene.steps,
+    )?;
     let weights: Vec<f64> = scene
         .continuation
         .iter()

@@ -21,6 +21,8 @@
 //!   among them.
 //! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
 //!   discretization map of $S^2$.
+//! - [`state`](mod@state): typed derivative data ([`Jet`]) and states ([`State`]), built by
+//!   the Legendre map and read by name ($q^{(j)}$, $p_j$, $u$).
 //! - [`models`]: a system written by hand.
 //!
 //! # References
@@ -50,6 +52,7 @@ pub mod models;
 pub mod newton;
 pub mod reduced;
 pub mod sphere;
+pub mod state;
 pub mod step;
 pub mod system;
 
@@ -59,6 +62,7 @@ pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
 pub use reduced::{ClosedForm, ReducedFactors, ReducedScheme, ReducedStepper};
+pub use state::{Jet, State};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};

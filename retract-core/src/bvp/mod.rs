@@ -15,7 +15,8 @@
 //!   failure carries the last iterate ([`PlanError`]). Modules: `optimize` (the problem and its
 //!   results), `sqp` (the iteration), `riccati` (the KKT solve and its inertia),
 //!   `constraints` and `barrier` (stage constraints), `certificate` (residuals, momenta,
-//!   curvature), `guess` (the spline guess), `extrapolate` (Richardson extrapolation).
+//!   curvature), `guess` (the spline guess), `curve` (guesses from a path $q(t)$,
+//!   [`Curve`]), `extrapolate` (Richardson extrapolation).
 //! - [`BoundaryValueProblem`] solves the same conditions by Newton's method on their residual
 //!   (`root_finder`): fast where the answer is known to be a minimum, but blind to the cost.
 //!
@@ -73,6 +74,7 @@
 mod barrier;
 mod certificate;
 mod constraints;
+mod curve;
 mod extrapolate;
 mod guess;
 mod optimize;
@@ -80,6 +82,7 @@ mod riccati;
 mod sqp;
 
 pub use constraints::Variable;
+pub use curve::Curve;
 pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions, RealTime,

@@ -30,6 +30,7 @@ use std::time::{Duration, Instant};
 use nalgebra::SVector;
 
 use super::constraints::{StageConstraint, Variable};
+use super::curve::Curve;
 use super::guess::Hermite;
 use super::riccati::Dynamics;
 use super::sqp::Sqp;
@@ -140,6 +141,10 @@ pub enum PlanGuess<'a, const N: usize, const X: usize> {
         /// $u_i = q^{(k)}$ at the evaluation point of step $i$.
         u: &'a [SVector<f64, N>],
     },
+    /// A path $q(t)$ ([`Curve`]: a closure, or waypoints): the library samples the jets
+    /// $x_i = (q, \dots, q^{(k-1)})(t_i)$ and the top derivatives
+    /// $u_i = q^{(k)}((i + \theta) h)$.
+    Curve(&'a Curve<'a, N>),
 }
 
 /// What a returned plan is certified to satisfy.
@@ -187,6 +192,83 @@ pub struct Plan<const N: usize, const X: usize> {
 }
 
 impl<const N: usize, const X: usize> Plan<N, X> {
+    /// The times $t_i = i h$ of the jets $x_i$, $i = 0, \dots, N$.
+    pub fn times(&self) -> Vec<f64> {
+        (0..self.x.len()).map(|i| i as f64 * self.h).collect()
+    }
+
+    /// The state $z_i = (x_i, p_i)$ by blocks ([`crate::State`]: $q^{(j)}$, $p_j$ by name), or
+    /// `None` past the end; `X` $= nk$ is checked at compile time.
+    pub fn state<const K: usize>(&self, i: usize) -> Option<crate::State<N, K>> {
+        const { assert!(N * K == X, "X must equal N K") };
+        Some(crate::State {
+            x: blocks::<N, K, X>(self.x.get(i)?),
+            p: blocks::<N, K, X>(self.momenta.get(i)?),
+        })
+    }
+
+    /// The jet $x(t) = (q, \dots, q^{(k-1)})(t)$ at any $t \in [0, T]$, $T = N h$: on the step
+    /// $t_i \le t \le t_{i+1}$ the Hermite interpolant of degree $2k-1$ in each coordinate
+    /// that matches the plan's jets $x_i$ at $t_i$ and $x_{i+1}$ at $t_{i+1}$ (for $k = 2$,
+    /// with $s = (t - t_i)/h$: $q(t) = (2s^3 - 3s^2 + 1) q_i + (s^3 - 2s^2 + s) h q'_i +
+    /// (3s^2 - 2s^3) q_{i+1} + (s^3 - s^2) h q'_{i+1}$). It reproduces polynomials of degree
+    /// $2k-1$ exactly and is $C^{k-1}$ across the nodes, where it equals the plan's jets.
+    ///
+    /// ```
+    /// use retract_core::bvp::{OptimalControlProblem, PlanGuess};
+    /// use retract_core::models::PlanarBarrier;
+    ///
+    /// let system = PlanarBarrier { tau: 0.0, radius: 1.0, mass: 1.0 };
+    /// let problem = OptimalControlProblem::new(&system, &[0.0; 4], &[1.0, 2.0, 0.0, 0.0], 1.0, 40);
+    /// let plan = problem.solve(PlanGuess::Spline)?;
+    /// // the continuous optimum from rest to rest is the smoothstep q(T) (3 s^2 - 2 s^3)
+    /// let x = plan.evaluate(0.3)?;
+    /// let smooth = 3.0 * 0.3f64.powi(2) - 2.0 * 0.3f64.powi(3);
+    /// assert!((x[0] - smooth).abs() < 1e-3 && (x[1] - 2.0 * smooth).abs() < 1e-3);
+    /// assert_eq!(plan.evaluate(plan.times()[20])?, plan.x[20]); // a node: the plan's jet
+    /// assert!(plan.evaluate(1.5).is_err()); // outside [0, T]
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for $t$ outside $[0, T]$ (beyond a relative $10^{-12}$ for
+    /// rounding), not finite, or a plan without steps.
+    pub fn evaluate(&self, t: f64) -> Result<SVector<f64, X>, Error> {
+        let steps = self.x.len().saturating_sub(1);
+        let t_end = self.h * steps as f64;
+        let slack = 1e-12 * t_end.abs();
+        if steps == 0 || N == 0 || !X.is_multiple_of(N) || !(self.h.is_finite() && self.h > 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "plan",
+                requirement: "a plan to evaluate needs at least one step of finite h > 0",
+            });
+        }
+        if !(t >= -slack && t <= t_end + slack) {
+            return Err(Error::InvalidArgument {
+                name: "t",
+                requirement: "a plan is evaluated at times 0 <= t <= T = N h",
+            });
+        }
+        let t = t.clamp(0.0, t_end);
+        if t == t_end {
+            return Ok(self.x[steps]);
+        }
+        // the step holding t; at a node (t = i h up to the rounding of t / h) the one it starts
+        let mut i = ((t / self.h) as usize).min(steps - 1);
+        if i + 1 < steps && (i + 1) as f64 * self.h <= t {
+            i += 1;
+        }
+        let local = t - i as f64 * self.h;
+        let piece = Hermite::new(
+            self.x[i].as_slice(),
+            self.x[i + 1].as_slice(),
+            self.h,
+            N,
+            X / N,
+        )?;
+        Ok(SVector::from_fn(|r, _| piece.jet_entry(r, local)))
+    }
+
     /// The plan shifted one step forward in time, for a receding-horizon warm start
     /// ([`PlanGuess::Plan`]): $x_i \leftarrow x_{i+1}$, $u_i \leftarrow u_{i+1}$, the last
     /// top derivative repeated and the new last jet one step of the scheme's $x$-equations
@@ -627,6 +709,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     u: plan.u.clone(),
                 }
             }
+            PlanGuess::Curve(curve) => curve.sample::<K, X>(self.t_end, steps, theta)?,
             PlanGuess::Path { x, u } => {
                 if x.len() != steps + 1 || u.len() != steps {
                     return Err(wrong("a path guess needs N + 1 jets and N top derivatives"));

@@ -112,6 +112,7 @@ pub enum Guess<'a, const S: usize, const M: usize> {
     Solution(&'a BvpSolution<S, M>),
     /// States $z_0, \dots, z_N$ of a path chosen by the caller (e.g. around an obstacle);
     /// the top derivatives come from [`LiftedSystem::predictor`] at each state.
+    /// [`Curve::states`](super::Curve::states) forms them from a path $q(t)$ or waypoints.
     States(&'a [SVector<f64, S>]),
 }
 
@@ -137,6 +138,27 @@ pub struct BvpSolution<const S: usize, const M: usize> {
 }
 
 impl<const S: usize, const M: usize> BvpSolution<S, M> {
+    /// The times $t_i = i h$ of the states, $i = 0, \dots, N$.
+    pub fn times(&self) -> Vec<f64> {
+        (0..self.states.len()).map(|i| i as f64 * self.h).collect()
+    }
+
+    /// State $z_i$ by blocks ([`crate::State`]: $q^{(j)}$, $p_j$ by name), or `None` past the
+    /// end; `S` $= 2nk$ is checked at compile time.
+    pub fn state<const N: usize, const K: usize>(&self, i: usize) -> Option<crate::State<N, K>> {
+        self.states.get(i).map(crate::State::from_vector)
+    }
+
+    /// The top derivative $u_i = q^{(k)}$ at the evaluation point of step $i$ (the last $n$
+    /// entries of the unknowns $w_i$), or `None` past the last step; `N` $= M - S$ is
+    /// checked at compile time.
+    pub fn top_derivative<const N: usize>(&self, i: usize) -> Option<SVector<f64, N>> {
+        const { assert!(N + S == M, "N must equal M - S") };
+        self.unknowns
+            .get(i)
+            .map(|w| w.fixed_rows::<N>(S).into_owned())
+    }
+
     /// The solution shifted one step forward in time, for a receding-horizon warm start:
     /// $z_i \leftarrow z_{i+1}$, the new last step one integrator step from the old end
     /// (repeating the last step's unknowns if that step fails).

@@ -1,0 +1,238 @@
+//! Typed data: derivative data ([`Jet`]) and Hamiltonian states ([`State`]) by blocks.
+//!
+//! Both are $2nk$ numbers, and the runtime steps flat vectors `SVector<f64, S>`, $S = 2nk$:
+//!
+//! - a [`Jet`] is the derivative data $(q, q', \dots, q^{(2k-1)})$ at one time, the argument
+//!   of the Legendre map;
+//! - a [`State`] is $z = (x, p)$ with $x_j = q^{(j)}$ ($j < k$) and the Ostrogradsky momenta
+//!   $p_{k-1} = \partial L/\partial q^{(k)}$,
+//!   $p_{j-1} = \partial L/\partial q^{(j)} - D p_j$ ($j = k-1, \dots, 1$).
+//!
+//! The only way from one to the other is [`State::from_jet`], which runs the Legendre map, so
+//! derivative data cannot be stepped as if it were a state by mistake. The accessors name the
+//! blocks: [`State::q`], [`State::derivative`] ($q^{(j)}$), [`State::momentum`] ($p_j$),
+//! [`State::top_derivative`] ($u = q^{(k)}$). [`State::to_vector`] and
+//! [`State::from_vector`] convert to and from the flat layout
+//! $z = (x_0, \dots, x_{k-1}, p_0, \dots, p_{k-1})$ of [`crate::LiftedSystem`].
+//!
+//! # Example
+//! For $L = \tfrac12|q''|^2$ the momenta are $p_1 = q''$ and $p_0 = -q'''$:
+//! ```
+//! use retract_core::models::PlanarBarrier;
+//! use retract_core::state::{Jet, State};
+//! use retract_core::{StepOptions, step};
+//!
+//! let system = PlanarBarrier { tau: 0.0, radius: 1.0, mass: 1.0 };
+//! // q, q', q'', q''' of a point in the plane
+//! let jet = Jet::new(&[[2.0, 0.0], [1.0, 0.5], [0.2, 0.0], [0.1, -0.3]])?;
+//! let z0 = State::from_jet(&system, &jet)?;
+//! assert_eq!(z0.momentum(1), Some([0.2, 0.0].into())); // p_1 = q''
+//! assert_eq!(z0.momentum(0), Some([-0.1, 0.3].into())); // p_0 = -q'''
+//! let (z1, _) = step(&system, &z0.to_vector(), 0.1, &StepOptions::default())?;
+//! let z1: State<2, 2> = State::from_vector(&z1);
+//! // the midpoint step: q(h) = q + h q' + h^2/2 p_1 - h^3/4 p_0
+//! assert!((z1.q()[0] - (2.0 + 0.1 + 0.005 * 0.2 + 0.00025 * 0.1)).abs() < 1e-14);
+//! # Ok::<(), retract_core::Error>(())
+//! ```
+
+use nalgebra::SVector;
+
+use crate::lifted::{Blocks, join, split};
+use crate::{Error, Lagrangian};
+
+/// Derivative data $(q, q', \dots, q^{(2k-1)})$ of a curve at one time, $K = k$ blocks below
+/// the top derivative ([`Self::lower`]) and $K$ from it on ([`Self::upper`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Jet<const N: usize, const K: usize> {
+    /// $(q, q', \dots, q^{(k-1)})$.
+    pub lower: Blocks<N, K>,
+    /// $(q^{(k)}, \dots, q^{(2k-1)})$.
+    pub upper: Blocks<N, K>,
+}
+
+fn finite_blocks<const N: usize, const K: usize>(blocks: &Blocks<N, K>) -> bool {
+    blocks.iter().all(|b| b.iter().all(|v| v.is_finite()))
+}
+
+impl<const N: usize, const K: usize> Jet<N, K> {
+    /// The jet with `derivatives[j]` $= q^{(j)}$, $j = 0, \dots, 2k-1$.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] unless there are exactly $2k$ rows, all finite.
+    pub fn new(derivatives: &[[f64; N]]) -> Result<Self, Error> {
+        if derivatives.len() != 2 * K {
+            return Err(Error::InvalidArgument {
+                name: "derivatives",
+                requirement: "a jet holds q, q', ..., q^(2k-1): exactly 2k rows",
+            });
+        }
+        let block = |j: usize| SVector::<f64, N>::from(derivatives[j]);
+        let jet = Self {
+            lower: core::array::from_fn(block),
+            upper: core::array::from_fn(|j| block(K + j)),
+        };
+        jet.checked()
+    }
+
+    fn checked(self) -> Result<Self, Error> {
+        if finite_blocks(&self.lower) && finite_blocks(&self.upper) {
+            Ok(self)
+        } else {
+            Err(Error::InvalidArgument {
+                name: "jet",
+                requirement: "the derivative data must be finite",
+            })
+        }
+    }
+
+    /// The jet whose flat layout is `v` $= (q, q', \dots, q^{(2k-1)})$ in blocks of $n$ (the
+    /// argument of [`LiftedSystem::legendre`](crate::LiftedSystem::legendre)); `S` $= 2nk$ is
+    /// checked at compile time.
+    pub fn from_vector<const S: usize>(v: &SVector<f64, S>) -> Self {
+        let (lower, upper) = split::<N, K, S>(v);
+        Self { lower, upper }
+    }
+
+    /// The flat layout $(q, q', \dots, q^{(2k-1)})$, the inverse of [`Self::from_vector`].
+    pub fn to_vector<const S: usize>(&self) -> SVector<f64, S> {
+        join::<N, K, S>(&self.lower, &self.upper)
+    }
+
+    /// $q^{(j)}$, or `None` for $j \ge 2k$.
+    pub fn derivative(&self, j: usize) -> Option<SVector<f64, N>> {
+        self.lower
+            .get(j)
+            .or_else(|| self.upper.get(j.checked_sub(K)?))
+            .copied()
+    }
+}
+
+/// A Hamiltonian state $z = (x, p)$ of the lifted scheme, by blocks: $x_j = q^{(j)}$ and the
+/// Ostrogradsky momenta $p_j$, $j < k$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State<const N: usize, const K: usize> {
+    /// $x = (q, q', \dots, q^{(k-1)})$.
+    pub x: Blocks<N, K>,
+    /// $p = (p_0, \dots, p_{k-1})$.
+    pub p: Blocks<N, K>,
+}
+
+impl<const N: usize, const K: usize> State<N, K> {
+    /// The Legendre map: $x_j = q^{(j)}$ and the Ostrogradsky momenta
+    /// $p_{k-1} = \partial L/\partial q^{(k)}$,
+    /// $p_{j-1} = \partial L/\partial q^{(j)} - D p_j$, from the jet's derivative data.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] when a momentum is not finite (a jet outside the domain of $L$).
+    pub fn from_jet<L>(system: &L, jet: &Jet<N, K>) -> Result<Self, Error>
+    where
+        L: Lagrangian<N, K> + ?Sized,
+    {
+        let state = Self {
+            x: jet.lower,
+            p: system.momenta(&jet.lower, &jet.upper),
+        };
+        if finite_blocks(&state.x) && finite_blocks(&state.p) {
+            Ok(state)
+        } else {
+            Err(Error::NonFinite {
+                iteration: 0,
+                location: "momenta of the Legendre map",
+            })
+        }
+    }
+
+    /// The state whose flat layout is `z` $= (x_0, \dots, x_{k-1}, p_0, \dots, p_{k-1})$;
+    /// `S` $= 2nk$ is checked at compile time.
+    pub fn from_vector<const S: usize>(z: &SVector<f64, S>) -> Self {
+        let (x, p) = split::<N, K, S>(z);
+        Self { x, p }
+    }
+
+    /// The flat layout $z = (x, p)$ that [`crate::step()`] and [`crate::trajectory`] take.
+    pub fn to_vector<const S: usize>(&self) -> SVector<f64, S> {
+        join::<N, K, S>(&self.x, &self.p)
+    }
+
+    /// The configuration $q = x_0$.
+    pub fn q(&self) -> SVector<f64, N> {
+        self.x[0]
+    }
+
+    /// $x_j = q^{(j)}$, or `None` for $j \ge k$ (the top derivative is
+    /// [`Self::top_derivative`]).
+    pub fn derivative(&self, j: usize) -> Option<SVector<f64, N>> {
+        self.x.get(j).copied()
+    }
+
+    /// The momentum $p_j$, or `None` for $j \ge k$.
+    pub fn momentum(&self, j: usize) -> Option<SVector<f64, N>> {
+        self.p.get(j).copied()
+    }
+
+    /// The top derivative $u = q^{(k)}$ that solves $p_{k-1} = \partial L/\partial u\thinspace(x, u)$
+    /// ([`Lagrangian::top_derivative`], from $u = 0$).
+    ///
+    /// # Errors
+    /// As [`Lagrangian::top_derivative`].
+    pub fn top_derivative<L>(&self, system: &L) -> Result<SVector<f64, N>, Error>
+    where
+        L: Lagrangian<N, K> + ?Sized,
+    {
+        system.top_derivative(&self.x, &self.p[K - 1], &SVector::zeros())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::PlanarBarrier;
+
+    #[test]
+    fn jet_rejects_wrong_length_and_non_finite_data() {
+        assert!(Jet::<2, 2>::new(&[[0.0; 2]; 3]).is_err());
+        assert!(Jet::<2, 2>::new(&[[0.0, 0.0], [f64::NAN, 0.0], [0.0; 2], [0.0; 2]]).is_err());
+        let jet = Jet::<2, 2>::new(&[[1.0, 2.0], [3.0, 4.0], [5.0, 6.0], [7.0, 8.0]]).unwrap();
+        assert_eq!(jet.derivative(3), Some([7.0, 8.0].into()));
+        assert_eq!(jet.derivative(4), None);
+        let flat: SVector<f64, 8> = jet.to_vector();
+        assert_eq!(flat.as_slice(), &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
+        assert_eq!(Jet::from_vector(&flat), jet);
+    }
+
+    /// `from_jet` is the system's Legendre map, and the top derivative inverts
+    /// $p_1 = \partial L/\partial u$ (for the disc system, $u = p_1 / m$).
+    #[test]
+    fn from_jet_is_the_legendre_map() {
+        use crate::LiftedSystem;
+        let system = PlanarBarrier {
+            tau: 0.3,
+            radius: 1.0,
+            mass: 2.0,
+        };
+        let jet = Jet::<2, 2>::new(&[[2.0, 0.5], [1.0, -0.5], [0.2, 0.4], [0.1, -0.3]]).unwrap();
+        let state = State::from_jet(&system, &jet).unwrap();
+        let flat: SVector<f64, 8> = state.to_vector();
+        assert_eq!(flat, system.legendre(&jet.to_vector()));
+        assert_eq!(State::from_vector(&flat), state);
+        let u = state.top_derivative(&system).unwrap();
+        assert!((u - SVector::from([0.2, 0.4])).amax() < 1e-12, "{u}");
+        assert_eq!(state.derivative(1), Some([1.0, -0.5].into()));
+        assert_eq!(state.derivative(2), None);
+        assert_eq!(state.momentum(2), None);
+    }
+
+    #[test]
+    fn from_jet_reports_non_finite_momenta() {
+        let system = PlanarBarrier {
+            tau: 0.3,
+            radius: 1.0,
+            mass: f64::INFINITY,
+        };
+        let jet = Jet::<2, 2>::new(&[[2.0, 0.5], [1.0, -0.5], [0.2, 0.4], [0.1, -0.3]]).unwrap();
+        assert!(matches!(
+            State::from_jet(&system, &jet),
+            Err(Error::NonFinite { .. })
+        ));
+    }
+}
