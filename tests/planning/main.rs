@@ -1,4 +1,5 @@
-//! Integration tests of planning: the optimizer, the root finder, inequalities, extrapolation.
+//! Integration tests of planning: the optimizer, the root finder, inequalities, extrapolation,
+//! and the typed states, plan evaluation and path guesses around them.
 //!
 //! One test crate per group (fewer crates build and link faster): each module was a test
 //! crate of its own; `common` holds the shared helpers and Lagrangians.
@@ -10,3 +11,4 @@ mod bvp;
 mod extrapolate;
 mod inequalities;
 mod optimize;
+mod typed_data;

@@ -2,7 +2,7 @@
 //! polynomials it must reproduce and against the exact minimum-acceleration spline, named
 //! accessors on trajectories and solutions, and `Curve` guesses for both solvers.
 
-mod common;
+use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 
