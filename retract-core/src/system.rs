@@ -44,6 +44,7 @@ pub struct Hessian<const N: usize, const K: usize> {
 
 impl<const N: usize, const K: usize> Gradient<N, K> {
     /// The zero gradient.
+    #[inline]
     pub fn zeros() -> Self {
         Self {
             x: [SVector::zeros(); K],
@@ -54,6 +55,7 @@ impl<const N: usize, const K: usize> Gradient<N, K> {
 
 impl<const N: usize, const K: usize> Hessian<N, K> {
     /// The zero Hessian.
+    #[inline]
     pub fn zeros() -> Self {
         Self {
             xx: [[SMatrix::zeros(); K]; K],

@@ -32,7 +32,8 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     };
     let mut momenta = Vec::with_capacity(stages.len() + 1);
     let mut worst: f64 = 0.0;
-    let mut scale: f64 = 1.0;
+    // max |grad (h L)|_inf over the steps (divided by h once, at the end)
+    let mut largest: f64 = 0.0;
     let mut previous: Option<(SVector<f64, X>, SVector<f64, X>)> = None;
     for (((stage, (gx, gu)), lambda), y) in stages
         .iter()
@@ -40,7 +41,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         .zip(&direction.costate)
         .zip(&direction.multipliers)
     {
-        scale = scale.max(gx.amax() / h).max(gu.amax() / h);
+        largest = largest.max(gx.amax()).max(gu.amax());
         // the gradient of the stage's Lagrangian h L - h z^T g_ineq + y^T g_eq
         let (gx, gu) = if stage.constraints > 0 {
             (gx + stage.cx.transpose() * y, gu + stage.cu.transpose() * y)
@@ -62,7 +63,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     if let Some((mu, d)) = previous {
         momenta.push(mu + d * theta);
     }
-    (momenta, worst / (h * scale))
+    (momenta, worst / (h * (largest / h).max(1.0)))
 }
 
 /// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\thinspace Z$ ($Z$ orthonormal) of

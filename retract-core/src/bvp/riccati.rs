@@ -558,7 +558,13 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let mut x = *r0;
         let mut nu = SVector::<f64, X>::zeros();
         d.dx.push(x);
-        for (i, (f, l)) in self.stages.iter().rev().zip(&backward).enumerate() {
+        for (i, (f, l)) in self
+            .stages
+            .iter()
+            .rev()
+            .zip(backward.iter().rev())
+            .enumerate()
+        {
             let tail = (i >= boundary).then(|| self.tail_factor(i));
             if i == boundary {
                 nu = self.d_inv * (r_end - self.terminal(dynamics, &backward, &x, None));
@@ -593,7 +599,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         d
     }
 
-    /// The backward pass of a solve: per step (first step first) the feed-forward term, $q_u$,
+    /// The backward pass of a solve: per step (last step first) the feed-forward term, $q_u$,
     /// $s_{i+1}$ and the defect for the linear terms `linear(i)`. At the tail's first state
     /// (if not step 0) $\nu$ is eliminated: $s_b \leftarrow s_b + S_b D^{-1} (r_N - e)$ with
     /// $e = \delta x_N$ of the tail from $\delta x_b = 0$, $\nu = 0$.
@@ -632,12 +638,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 defect: l.defect,
             });
             if i == boundary && i > 0 {
-                // the tail's entries are the last ones pushed, last step first
+                // the tail's entries are the ones pushed so far, last step first
                 let x_end = self.tail_terminal(dynamics, out.iter().rev(), i);
                 s += self.sens_boundary * (self.d_inv * (r_end - x_end));
             }
         }
-        out.reverse();
         out
     }
 
@@ -662,7 +667,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// $\delta x_N$ of the closed loop over the tail from its first state $\delta x_b = $ `xb`
-    /// with the terminal multiplier `nu` (none: 0).
+    /// with the terminal multiplier `nu` (none: 0), for the backward pass entries `backward`
+    /// (last step first).
     fn terminal(
         &self,
         dynamics: &Dynamics<N, X>,
@@ -673,7 +679,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let boundary = self.boundary();
         let mut x = *xb;
-        for (i, l) in backward.iter().enumerate().skip(boundary) {
+        for (i, l) in (boundary..).zip(backward[..backward.len() - boundary].iter().rev()) {
             let mut du = self.step_factor(i).gain * x + l.feedforward;
             if let Some(nu) = nu {
                 du += self.tail_factor(i).gain_nu * nu;

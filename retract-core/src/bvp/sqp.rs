@@ -221,6 +221,9 @@ where
 
     /// Every inequality linearised at every step (step-major).
     pub fn inequalities(&self, iterate: &Iterate<N, X>) -> Vec<Linearized<N, X>> {
+        if self.problem.inequalities.is_empty() {
+            return Vec::new();
+        }
         let mut out = Vec::with_capacity(iterate.u.len() * self.problem.inequalities.len());
         for (i, u) in iterate.u.iter().enumerate() {
             let xt = self.x_theta(iterate, i);
