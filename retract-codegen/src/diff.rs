@@ -140,6 +140,7 @@ impl Differentiator {
                     }
                     Func::Abs => g.unary(Func::Signum, a),
                     Func::Signum => return g.constant(0.0),
+                    _ => inverse_and_hyperbolic(g, f, node, a),
                 };
                 g.mul(outer, da)
             }
@@ -170,6 +171,56 @@ impl Differentiator {
                 g.sum(param, db)
             }
         }
+    }
+}
+
+/// f'(a) for the functions beyond the elementary ones (`node` = f(a)):
+/// asin' = 1/sqrt(1 - a^2), acos' = -1/sqrt(1 - a^2), atan' = 1/(1 + a^2), sinh' = cosh,
+/// cosh' = sinh, cbrt' = 1/(3 cbrt(a)^2), ln_1p' = 1/(1 + a), exp_m1' = exp(a),
+/// log2' = 1/(a ln 2), log10' = 1/(a ln 10).
+fn inverse_and_hyperbolic(g: &mut Graph, f: Func, node: Id, a: Id) -> Id {
+    let one = g.constant(1.0);
+    let one_minus_square = |g: &mut Graph| {
+        let sq = g.powi(a, 2);
+        let d = g.sub(one, sq);
+        g.unary(Func::Sqrt, d)
+    };
+    match f {
+        Func::Asin => {
+            let r = one_minus_square(g);
+            g.div(one, r)
+        }
+        Func::Acos => {
+            let r = one_minus_square(g);
+            let q = g.div(one, r);
+            g.neg(q)
+        }
+        Func::Atan => {
+            let sq = g.powi(a, 2);
+            let d = g.add_op(one, sq);
+            g.div(one, d)
+        }
+        Func::Sinh => g.unary(Func::Cosh, a),
+        Func::Cosh => g.unary(Func::Sinh, a),
+        Func::Cbrt => {
+            let three = g.constant(3.0);
+            let sq = g.powi(node, 2);
+            let d = g.mul(three, sq);
+            g.div(one, d)
+        }
+        Func::Ln1p => {
+            let d = g.add_op(one, a);
+            g.div(one, d)
+        }
+        Func::ExpM1 => g.unary(Func::Exp, a),
+        Func::Log2 | Func::Log10 => {
+            let base: f64 = if f == Func::Log2 { 2.0 } else { 10.0 };
+            let ln = g.constant(base.ln());
+            let d = g.mul(a, ln);
+            g.div(one, d)
+        }
+        // the elementary functions are differentiated by the caller
+        _ => g.constant(f64::NAN),
     }
 }
 

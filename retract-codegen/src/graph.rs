@@ -48,6 +48,16 @@ pub enum Func {
     Tanh,
     Abs,
     Signum,
+    Asin,
+    Acos,
+    Atan,
+    Sinh,
+    Cosh,
+    Cbrt,
+    Ln1p,
+    ExpM1,
+    Log2,
+    Log10,
 }
 
 impl Func {
@@ -63,6 +73,16 @@ impl Func {
             Func::Tanh => "tanh",
             Func::Abs => "abs",
             Func::Signum => "signum",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
+            Func::Atan => "atan",
+            Func::Sinh => "sinh",
+            Func::Cosh => "cosh",
+            Func::Cbrt => "cbrt",
+            Func::Ln1p => "ln_1p",
+            Func::ExpM1 => "exp_m1",
+            Func::Log2 => "log2",
+            Func::Log10 => "log10",
         }
     }
 
@@ -77,6 +97,16 @@ impl Func {
             Func::Tanh => x.tanh(),
             Func::Abs => x.abs(),
             Func::Signum => x.signum(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
+            Func::Atan => x.atan(),
+            Func::Sinh => x.sinh(),
+            Func::Cosh => x.cosh(),
+            Func::Cbrt => x.cbrt(),
+            Func::Ln1p => x.ln_1p(),
+            Func::ExpM1 => x.exp_m1(),
+            Func::Log2 => x.log2(),
+            Func::Log10 => x.log10(),
         }
     }
 }

@@ -25,8 +25,9 @@ use crate::signature::{Attribute, Kind, Signature};
 use crate::util::tidy;
 
 /// The supported f64 methods.
-pub const METHODS: &str =
-    "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, abs";
+pub const METHODS: &str = "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, \
+     abs, asin, acos, atan, sinh, cosh, cbrt, ln_1p, exp_m1, log2, log10, mul_add (and the \
+     functions smooth_max(a, b, eps) and smooth_min(a, b, eps) of `retract`)";
 
 /// Unrolled iterations allowed in one function (a guard against runaway expansion).
 const MAX_UNROLLED: usize = 10_000;
@@ -83,6 +84,8 @@ pub enum GuardKind {
     LnArgument,
     /// A `powf` base: must stay > 0.
     PowfBase,
+    /// `1 - x^2` for the argument x of `asin` or `acos`: must stay > 0.
+    AsinArgument,
 }
 
 /// An expression of the Lagrangian where it can become singular.
@@ -918,6 +921,11 @@ impl<'a> Lower<'a> {
             .iter()
             .map(|s| s.ident.to_string())
             .collect();
+        if let Some(last) = segments.last()
+            && (last == "smooth_max" || last == "smooth_min")
+        {
+            return self.smooth_extremum(last == "smooth_max", c);
+        }
         if segments.len() == 2 && segments[0] == "f64" && !c.args.is_empty() {
             let args: Vec<&Expr> = c.args.iter().collect();
             let receiver = self.expr(args[0]);
@@ -940,6 +948,32 @@ impl<'a> Lower<'a> {
         )
     }
 
+    /// `smooth_max(a, b, eps)` = (a + b + sqrt((a - b)^2 + eps^2)) / 2 and `smooth_min` with
+    /// the sign of the root flipped (`retract::smooth_max`): smooth for eps != 0, within
+    /// |eps| / 2 of max(a, b) (min(a, b)).
+    fn smooth_extremum(&mut self, max: bool, c: &syn::ExprCall) -> Id {
+        if c.args.len() != 3 {
+            return self.error(
+                c.span(),
+                "`smooth_max` and `smooth_min` take 3 arguments: (a, b, eps)",
+            );
+        }
+        let [a, b, eps] = [0, 1, 2].map(|i| self.expr(&c.args[i]));
+        let diff = self.g.sub(a, b);
+        let d2 = self.g.powi(diff, 2);
+        let e2 = self.g.powi(eps, 2);
+        let arg = self.g.add_op(d2, e2);
+        let root = self.g.unary(Func::Sqrt, arg);
+        let sum = self.g.add_op(a, b);
+        let twice = if max {
+            self.g.add_op(sum, root)
+        } else {
+            self.g.sub(sum, root)
+        };
+        let half = self.g.constant(0.5);
+        self.g.mul(half, twice)
+    }
+
     fn apply(
         &mut self,
         name: &str,
@@ -950,7 +984,10 @@ impl<'a> Lower<'a> {
     ) -> Id {
         let expected = match name {
             "powi" | "powf" | "atan2" | "hypot" => 1,
-            "sqrt" | "exp" | "ln" | "sin" | "cos" | "tan" | "tanh" | "recip" | "abs" => 0,
+            "mul_add" => 2,
+            "sqrt" | "exp" | "ln" | "sin" | "cos" | "tan" | "tanh" | "recip" | "abs" | "asin"
+            | "acos" | "atan" | "sinh" | "cosh" | "cbrt" | "ln_1p" | "exp_m1" | "log2"
+            | "log10" => 0,
             _ => {
                 return self.error(
                     name_span,
@@ -971,23 +1008,29 @@ impl<'a> Lower<'a> {
             "tan" => unary(Func::Tan),
             "tanh" => unary(Func::Tanh),
             "abs" => unary(Func::Abs),
+            "asin" => unary(Func::Asin),
+            "acos" => unary(Func::Acos),
+            "atan" => unary(Func::Atan),
+            "sinh" => unary(Func::Sinh),
+            "cosh" => unary(Func::Cosh),
+            "cbrt" => unary(Func::Cbrt),
+            "ln_1p" => unary(Func::Ln1p),
+            "exp_m1" => unary(Func::ExpM1),
+            "log2" => unary(Func::Log2),
+            "log10" => unary(Func::Log10),
             _ => None,
         };
         if let Some(f) = func {
-            match f {
-                Func::Sqrt => self.guard(GuardKind::SqrtArgument, x, x_expr),
-                Func::Ln => self.guard(GuardKind::LnArgument, x, x_expr),
-                Func::Tan => {
-                    // tan = sin / cos: singular where cos(x) = 0
-                    let cos = self.g.unary(Func::Cos, x);
-                    let text = format!("{}.cos()", atom_text(x_expr));
-                    self.guard_text(GuardKind::Denominator, cos, text);
-                }
-                _ => {}
-            }
+            self.guard_function(f, x, x_expr);
             return self.g.unary(f, x);
         }
         match name {
+            "mul_add" => {
+                // x * a + b
+                let (a, b) = (self.expr(args[0]), self.expr(args[1]));
+                let product = self.g.mul(x, a);
+                self.g.add_op(product, b)
+            }
             "recip" => {
                 self.guard(GuardKind::Denominator, x, x_expr);
                 let one = self.g.constant(1.0);
@@ -1039,6 +1082,36 @@ impl<'a> Lower<'a> {
                     self.g.hypot(x, other)
                 }
             }
+        }
+    }
+
+    /// The guard of the function `f` of `x` (written as `x_expr`): sqrt needs x >= 0; ln, log2
+    /// and log10 x > 0; ln_1p 1 + x > 0; asin and acos 1 - x^2 > 0; tan a nonzero cos(x);
+    /// cbrt (whose derivative is singular at 0) a nonzero x. The others are entire.
+    fn guard_function(&mut self, f: Func, x: Id, x_expr: &Expr) {
+        let atom = atom_text(x_expr);
+        match f {
+            Func::Sqrt => self.guard(GuardKind::SqrtArgument, x, x_expr),
+            Func::Ln | Func::Log2 | Func::Log10 => self.guard(GuardKind::LnArgument, x, x_expr),
+            Func::Cbrt => self.guard(GuardKind::Denominator, x, x_expr),
+            Func::Ln1p => {
+                let one = self.g.constant(1.0);
+                let arg = self.g.add_op(one, x);
+                let text = format!("1 + ({})", text_of(x_expr));
+                self.guard_text(GuardKind::LnArgument, arg, text);
+            }
+            Func::Asin | Func::Acos => {
+                let one = self.g.constant(1.0);
+                let sq = self.g.powi(x, 2);
+                let arg = self.g.sub(one, sq);
+                self.guard_text(GuardKind::AsinArgument, arg, text_of(x_expr));
+            }
+            Func::Tan => {
+                // tan = sin / cos: singular where cos(x) = 0
+                let cos = self.g.unary(Func::Cos, x);
+                self.guard_text(GuardKind::Denominator, cos, format!("{atom}.cos()"));
+            }
+            _ => {}
         }
     }
 

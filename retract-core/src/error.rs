@@ -13,6 +13,9 @@ pub enum DomainKind {
     LnArgument,
     /// The base of `powf` left $(0, \infty)$.
     PowfBase,
+    /// The argument of `asin` or `acos` left $(-1, 1)$ (the guarded expression is
+    /// $1 - x^2$, which must stay positive).
+    AsinArgument,
 }
 
 /// A guarded expression of the Lagrangian that left its domain during a step.
@@ -38,6 +41,9 @@ impl fmt::Display for DomainViolation {
             }
             DomainKind::LnArgument => write!(f, "argument `{expression}` of ln left (0, inf)")?,
             DomainKind::PowfBase => write!(f, "base `{expression}` of powf left (0, inf)")?,
+            DomainKind::AsinArgument => {
+                write!(f, "argument `{expression}` of asin or acos left (-1, 1)")?
+            }
         }
         element(f, self)
     }
@@ -58,6 +64,7 @@ fn kind_name(kind: DomainKind) -> &'static str {
         DomainKind::SqrtArgument => "sqrt argument",
         DomainKind::LnArgument => "ln argument",
         DomainKind::PowfBase => "powf base",
+        DomainKind::AsinArgument => "asin or acos argument",
     }
 }
 
@@ -84,6 +91,10 @@ fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Res
         DomainKind::SqrtArgument => write!(f, "argument `{expression}` of sqrt is negative")?,
         DomainKind::LnArgument => write!(f, "argument `{expression}` of ln is not positive")?,
         DomainKind::PowfBase => write!(f, "base `{expression}` of powf is not positive")?,
+        DomainKind::AsinArgument => write!(
+            f,
+            "argument `{expression}` of asin or acos is outside (-1, 1)"
+        )?,
     }
     element(f, violation)
 }

@@ -75,3 +75,16 @@ pub use nalgebra;
 /// The float methods (`sqrt`, `powi`, ...) for `no_std` code: generated code imports it, and
 /// a `no_std` crate can too (with std the inherent methods take precedence).
 pub use num_traits::Float;
+
+/// A smooth maximum, $\max_\epsilon(a, b) = \tfrac12\big(a + b + \sqrt{(a - b)^2 +
+/// \epsilon^2}\big)$: within $|\epsilon|/2$ of $\max(a, b)$, smooth for $\epsilon \ne 0$. A
+/// Lagrangian may call it (`#[higher_order_lagrangian]` differentiates it).
+pub fn smooth_max(a: f64, b: f64, eps: f64) -> f64 {
+    0.5 * (a + b + num_traits::Float::sqrt((a - b) * (a - b) + eps * eps))
+}
+
+/// A smooth minimum, $\min_\epsilon(a, b) = \tfrac12\big(a + b - \sqrt{(a - b)^2 +
+/// \epsilon^2}\big)$ ([`smooth_max`] with the root's sign flipped).
+pub fn smooth_min(a: f64, b: f64, eps: f64) -> f64 {
+    0.5 * (a + b - num_traits::Float::sqrt((a - b) * (a - b) + eps * eps))
+}

@@ -1,6 +1,7 @@
 //! The singularity guard: a step that crosses a pole of the Lagrangian is an error naming the
 //! expression, the trajectory keeps every state before it, and the crossing time can be
-//! located. Every guarded kind (division, sqrt, ln, powf) is exercised.
+//! located. Every guarded kind (division, sqrt, ln, powf, asin) is exercised, with cbrt, log2 and
+//! ln_1p.
 
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
@@ -33,6 +34,26 @@ fn with_ln(q: f64, dq: f64) -> f64 {
 #[higher_order_lagrangian(order = 1)]
 fn with_powf(q: f64, dq: f64) -> f64 {
     0.5 * dq * dq + 0.1 * q.powf(1.5)
+}
+
+#[higher_order_lagrangian(order = 1)]
+fn with_cbrt(q: f64, dq: f64) -> f64 {
+    0.5 * dq * dq + 0.01 * q.cbrt()
+}
+
+#[higher_order_lagrangian(order = 1)]
+fn with_log2(q: f64, dq: f64) -> f64 {
+    0.5 * dq * dq + 0.01 * q.log2() + 0.01 * (q + 1.0).log10()
+}
+
+#[higher_order_lagrangian(order = 1)]
+fn with_ln_1p(q: f64, dq: f64) -> f64 {
+    0.5 * dq * dq + 0.01 * (q - 1.0).ln_1p()
+}
+
+#[higher_order_lagrangian(order = 1)]
+fn with_asin(q: f64, dq: f64) -> f64 {
+    0.5 * dq * dq + 0.1 * (1.0 - q).asin() + 0.1 * (0.5 * q).acos()
 }
 
 /// The case of the issue: the exact solution reaches the circle near t = 1.955.
@@ -162,6 +183,24 @@ fn every_guarded_kind_is_checked() {
     expect(first_step_kind(&WithSqrt {}), DomainKind::SqrtArgument, "q");
     expect(first_step_kind(&WithLn {}), DomainKind::LnArgument, "q");
     expect(first_step_kind(&WithPowf {}), DomainKind::PowfBase, "q");
+    // the functions of issue 17, item 7: cbrt (singular derivative at 0), log2, ln_1p, asin
+    expect(first_step_kind(&WithCbrt {}), DomainKind::Denominator, "q");
+    expect(first_step_kind(&WithLog2 {}), DomainKind::LnArgument, "q");
+    expect(
+        first_step_kind(&WithLn1p {}),
+        DomainKind::LnArgument,
+        "1 + (q - 1.0)",
+    );
+    expect(
+        first_step_kind(&WithAsin {}),
+        DomainKind::AsinArgument,
+        "1.0 - q",
+    );
+    let message = first_step_kind(&WithAsin {}).unwrap_err().to_string();
+    assert!(
+        message.contains("of asin or acos left (-1, 1)"),
+        "{message}"
+    );
     // and a regular step of the same systems passes
     let z0 = WithSqrt {}.legendre(&SVector::from([1.0, -1.0]));
     assert!(step(&WithSqrt {}, &z0, 0.06, &StepOptions::default()).is_ok());

@@ -171,7 +171,7 @@ fn check(
             || (#a < 0.0 && #b < 0.0 && #c < 0.0 && #a > ::core::f64::NEG_INFINITY
                 && #b > ::core::f64::NEG_INFINITY && #c > ::core::f64::NEG_INFINITY)),
         GuardKind::SqrtArgument => quote!(#a >= 0.0 && #b >= 0.0 && #c >= 0.0),
-        GuardKind::LnArgument | GuardKind::PowfBase => {
+        GuardKind::LnArgument | GuardKind::PowfBase | GuardKind::AsinArgument => {
             quote!(#a > 0.0 && #b > 0.0 && #c > 0.0)
         }
     };
@@ -180,6 +180,7 @@ fn check(
         GuardKind::SqrtArgument => quote!(SqrtArgument),
         GuardKind::LnArgument => quote!(LnArgument),
         GuardKind::PowfBase => quote!(PowfBase),
+        GuardKind::AsinArgument => quote!(AsinArgument),
     };
     let condition = if guard.touch {
         quote!((#condition) && __clear_of_zero(#a, #b, #c, theta))

@@ -13,7 +13,7 @@ use common::{close, fd, grad_entry, hess_entry};
 use proptest::prelude::*;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{SMatrix, SVector};
-use retract::{Lagrangian, LiftedSystem};
+use retract::{Lagrangian, LiftedSystem, smooth_max, smooth_min};
 
 // ---- the Lagrangians --------------------------------------------------------------------
 
@@ -81,6 +81,25 @@ fn transcendental(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], alpha: f64) -> f64 {
         + 0.2 * ddq[0] * ddq[1] * q[1].atan2(q[0]).cos()
         + alpha * q[1].atan2(q[0])
         + (1.0 + q[0].powi(2) + dq[1].powi(2)).sqrt()
+}
+
+/// k = 2 with every method beyond the elementary ones (issue 17, item 7): asin, acos, atan,
+/// sinh, cosh, cbrt, ln_1p, exp_m1, log2, log10, mul_add, smooth_max and smooth_min, in q, q'
+/// and q'' (the arguments kept inside their domains at the sample points).
+#[higher_order_lagrangian(order = 2)]
+fn special(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], eps: f64) -> f64 {
+    let weight = 1.0 + 0.1 * (0.2 * q[0]).sinh().powi(2) + 0.05 * (0.3 * q[1]).cosh();
+    0.5 * weight * (ddq[0].powi(2) + ddq[1].powi(2))
+        + 0.1 * ddq[0] * (0.4 * q[1]).atan()
+        + (0.3 * q[0]).asin() * (0.2 * dq[1]).acos()
+        + (2.0 + q[0].powi(2)).cbrt()
+        + (q[1].powi(2) + dq[0].powi(2)).ln_1p()
+        + (0.2 * dq[0] * q[1]).exp_m1()
+        + (3.0 + q[0] * q[1]).log2()
+        + (2.0 + dq[1].powi(2)).log10()
+        + q[0].mul_add(dq[1], 0.5 * q[1])
+        + smooth_max(q[0], dq[1], eps)
+        - smooth_min(q[1], dq[0], eps)
 }
 
 /// n = 7 (above nalgebra's `SVector::new`, n <= 6), constant weights on q' with a coupling:
@@ -351,6 +370,11 @@ proptest! {
     #[test]
     fn minimum_snap_k4(v in point(24, -1.0, 1.0), h in 0.01..0.1, theta in 0.0..1.0) {
         check_all(&Snap {}, &v, h, theta);
+    }
+
+    #[test]
+    fn special_functions_k2(v in point(8, -1.0, 1.0), eps in 0.05..0.5, h in 0.01..0.1, theta in 0.0..1.0) {
+        check_all(&Special { eps }, &v, h, theta);
     }
 
     #[test]
