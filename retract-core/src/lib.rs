@@ -15,7 +15,8 @@
 //!
 //! - [`Lagrangian`] and [`LiftedSystem`]: what a system provides ([`system`]);
 //!   [`lifted`] assembles the scheme from a [`Lagrangian`].
-//! - [`newton`]: the solver; [`step`](mod@step): one step and trajectories;
+//! - [`newton`]: the solver; [`step`](mod@step): one step and trajectories; [`forced`]: a
+//!   step under an external force (plant simulation);
 //!   [`diagnostics`]: energy, symplecticity, drift, RK4.
 //! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
 //!   among them.
@@ -45,6 +46,7 @@ pub mod bvp;
 pub mod compose;
 pub mod diagnostics;
 mod error;
+pub mod forced;
 pub mod lifted;
 pub mod linalg;
 pub mod map;

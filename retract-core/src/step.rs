@@ -318,20 +318,26 @@ pub struct StepReport {
     pub halvings: u32,
 }
 
-/// $F(z_0, \cdot)$ of one step as a Newton [`Problem`].
-struct StepProblem<'a, Sys: ?Sized, const S: usize> {
+/// $F(z_0, \cdot) - c$ of one step as a Newton [`Problem`], $c$ a constant `offset` (an
+/// external force, [`crate::forced`]) or zero.
+struct StepProblem<'a, Sys: ?Sized, const S: usize, const M: usize> {
     system: &'a Sys,
     z0: &'a SVector<f64, S>,
     h: f64,
     theta: f64,
+    offset: Option<&'a SVector<f64, M>>,
 }
 
-impl<Sys, const S: usize, const M: usize> Problem<M> for StepProblem<'_, Sys, S>
+impl<Sys, const S: usize, const M: usize> Problem<M> for StepProblem<'_, Sys, S, M>
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     fn residual(&self, w: &SVector<f64, M>) -> SVector<f64, M> {
-        self.system.residual(self.z0, w, self.h, self.theta)
+        let f = self.system.residual(self.z0, w, self.h, self.theta);
+        match self.offset {
+            Some(c) => f - c,
+            None => f,
+        }
     }
 
     fn jacobian(&self, w: &SVector<f64, M>) -> SMatrix<f64, M, M> {
@@ -369,11 +375,27 @@ fn solve_validated<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
+    solve_offset(system, z0, guess, h, options, None)
+}
+
+/// [`solve_validated`] for the residual $F(z_0, w) - c$ with a constant `offset` $c$.
+pub(crate) fn solve_offset<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    guess: SVector<f64, M>,
+    h: f64,
+    options: &StepOptions,
+    offset: Option<&SVector<f64, M>>,
+) -> Result<(SVector<f64, M>, StepReport), Error>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
     let problem = StepProblem {
         system,
         z0,
         h,
         theta: options.theta,
+        offset,
     };
     let solution = newton::solve_validated(&problem, guess, &options.newton)?;
     if options.check_domain {
