@@ -9,7 +9,49 @@ pub use retract_core::*;
 extern crate self as retract;
 
 pub mod sphere;
-pub use retract_macros::{higher_order_lagrangian, jet_function};
+/// A runnable example: an obstacle course's Lagrangian, stepped once.
+///
+/// ```
+/// use retract::nalgebra::SVector;
+/// use retract::{LiftedSystem, StepOptions, higher_order_lagrangian, step};
+///
+/// #[higher_order_lagrangian(order = 2)]
+/// fn obstacle(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
+///     0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
+/// }
+///
+/// let system = Obstacle::new(1e-3); // the type is named after the function
+/// assert_eq!((Obstacle::DIMENSION, Obstacle::ORDER, Obstacle::STATE), (2, 2, 8));
+/// // the function stays callable: L at q = (2, 0) at rest
+/// assert!((obstacle([2.0, 0.0], [0.0; 2], [0.0; 2], 1e-3) - 1e-3 / 3.0).abs() < 1e-18);
+/// let z0 = system.legendre(&SVector::from([2.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0]));
+/// let (z1, _) = step(&system, &z0, 0.01, &StepOptions::default())?;
+/// assert!((z1[1] - 0.01).abs() < 1e-6); // moving up at unit speed
+/// # Ok::<(), retract::Error>(())
+/// ```
+#[doc(inline)]
+pub use retract_macros::higher_order_lagrangian;
+
+/// A runnable example: the pole torque of a cart-pole as a stage constraint.
+///
+/// ```
+/// use retract::nalgebra::SVector;
+/// use retract::{JetFunction, jet_function};
+///
+/// #[jet_function(order = 2)]
+/// fn pole_torque(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], mp: f64, l: f64, g: f64) -> f64 {
+///     mp * l * q[1].cos() * ddq[0] + mp * l * l * ddq[1] + mp * g * l * q[1].sin()
+/// }
+///
+/// let tau = PoleTorque::new(0.3, 0.5, 9.81);
+/// let x = [SVector::from([0.0, 0.2]), SVector::zeros()];
+/// let u = SVector::from([1.0, -2.0]);
+/// // linear in q'': its gradient in u is (mp l cos q1, mp l^2)
+/// let g = tau.gradient(&x, &u);
+/// assert!((g.u[0] - 0.15 * 0.2f64.cos()).abs() < 1e-15 && (g.u[1] - 0.075).abs() < 1e-15);
+/// ```
+#[doc(inline)]
+pub use retract_macros::jet_function;
 
 /// A runnable example: the symmetric "bent midpoint" map lifted to order 2, stepping the
 /// Pais-Uhlenbeck oscillator with [`map::step`].

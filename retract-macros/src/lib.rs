@@ -4,20 +4,16 @@
 
 use proc_macro::TokenStream;
 
-/// Turns a higher-order Lagrangian into an integrator.
-///
-/// ```text
-/// #[higher_order_lagrangian(order = 2)]
-/// fn obstacle(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
-///     0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
-/// }
-/// ```
+/// Turns a higher-order Lagrangian into an integrator (a runnable example is in the docs of
+/// `retract`, which re-exports this attribute).
 ///
 /// The first k + 1 arguments are the jet q, q', ..., q^(k) (`[f64; N]`, or `f64` for
 /// N = 1); later arguments are parameters (`f64`, `[f64; M]`, `&[[f64; M]]`) and become
 /// public fields of the generated type (`Obstacle`, from the function's name, or
 /// `name = ...`). The function stays callable. Options: `order = k` (1..=4, required),
-/// `name = TypeName`. See the `retract` crate docs for the generated API.
+/// `name = TypeName`, `guard = false` (no singularity guard), `sphere` (a Lagrangian on the
+/// unit sphere written in ambient coordinates, `[f64; 3]`: composed with a gnomonic chart,
+/// see `retract::sphere`). See the `retract` crate docs for the generated API.
 ///
 /// The type name is the function's in UpperCamelCase; where that is not a type name (`_1`,
 /// `_2d_arm`, `self_`) the macro asks for `name = ...`. Compile-time integers (indices, loop
@@ -37,16 +33,11 @@ pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStr
 }
 
 /// Turns a scalar function of the jet into a `retract::JetFunction` (value, gradient and
-/// Hessian), e.g. a stage constraint of the optimal-control solver.
+/// Hessian), e.g. a stage constraint of the optimal-control solver (a runnable example is in
+/// the docs of `retract`, which re-exports this attribute).
 ///
-/// ```text
-/// #[jet_function(order = 2)]
-/// fn pole_torque(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], mp: f64, l: f64, g: f64) -> f64 {
-///     mp * l * q[1].cos() * ddq[0] + mp * l * l * ddq[1] + mp * g * l * q[1].sin()
-/// }
-/// ```
-///
-/// The signature, the body and the options (`order = k`, required; `name = TypeName`) follow
+/// The signature, the body and the options (`order = k`, required; `name = TypeName`;
+/// `sphere`) follow
 /// `#[higher_order_lagrangian]`, but g may be linear in, or independent of, q^(k): only
 /// `value`, `gradient` and `hessian` in (x, u) are generated, on a type named after the
 /// function (`PoleTorque`) with the parameters as public fields and `new`. The function
@@ -58,16 +49,8 @@ pub fn jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
 
 /// Turns a discretization map R_d(q, v) = (R1(q, v), R2(q, v)) on a chart of Q = R^n into a
 /// `retract::map::DiscretizationMap<n, k>` on T^(k-1)Q, for the integrator of any
-/// discretization map (`retract::map::step`, paper Prop. 5.1).
-///
-/// ```text
-/// #[discretization_map(order = 2)]
-/// fn bent_midpoint(q: [f64; 2], v: [f64; 2], c: f64) -> ([f64; 2], [f64; 2]) {
-///     let s = c * q[0].sin();
-///     ([q[0] - 0.5 * v[0] + s * v[0] * v[0], q[1] - 0.5 * v[1] + s * v[1] * v[1]],
-///      [q[0] + 0.5 * v[0] + s * v[0] * v[0], q[1] + 0.5 * v[1] + s * v[1] * v[1]])
-/// }
-/// ```
+/// discretization map (`retract::map::step`, paper Prop. 5.1); a runnable example is in the
+/// docs of `retract`, which re-exports this attribute.
 ///
 /// The arguments are the point q and the tangent vector v (`[f64; N]`, or `f64` for N = 1),
 /// then parameters (`f64`, `[f64; M]`); the body is `let` bindings of scalars (as in a
