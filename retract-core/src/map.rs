@@ -446,9 +446,14 @@ where
 /// # Ok::<(), retract_core::Error>(())
 /// ```
 ///
+/// The domain of the Lagrangian ([`LiftedSystem::check_domain`], the singularity guard) is
+/// checked at $x_0$, at the midpoint of the chord from $x_0$ to $x_1$ and at $x_1$ (the rule of
+/// the midpoint step; the map's own base point $x$ is not sampled).
+///
 /// # Errors
 /// [`Error::InvalidArgument`] for a step size that is zero or not finite, [`Error::NonFinite`]
-/// for a non-finite state or result, and any error of the Newton solve.
+/// for a non-finite state or result, [`Error::Domain`] for a step that leaves the domain of
+/// the Lagrangian, and any error of the Newton solve.
 pub fn step<Sys, Map, const N: usize, const K: usize, const S: usize, const M: usize>(
     system: &Sys,
     map: &Map,
@@ -464,14 +469,22 @@ where
     let x1 = scheme.end_point(&w);
     let p1: Blocks<N, K> = core::array::from_fn(|j| w.fixed_rows::<N>(N * K + N + j * N).into());
     let z1 = join::<N, K, S>(&x1, &p1);
-    if z1.iter().all(|v| v.is_finite()) {
-        Ok((z1, report))
-    } else {
-        Err(Error::NonFinite {
+    if !z1.iter().all(|v| v.is_finite()) {
+        return Err(Error::NonFinite {
             iteration: report.iterations,
             location: "state",
-        })
+        });
     }
+    // the guard of the Lagrangian at x_0, the chord's midpoint and x_1, with the solved u
+    let mut checked = SVector::<f64, M>::zeros();
+    checked.fixed_rows_mut::<S>(0).copy_from(&z1);
+    checked
+        .fixed_rows_mut::<N>(S)
+        .copy_from(&w.fixed_rows::<N>(N * K));
+    system
+        .check_domain(z0, &checked, 0.5)
+        .map_err(Error::Domain)?;
+    Ok((z1, report))
 }
 
 /// The derivative $D\Psi$ of the one-step map $\Psi: z_0 \mapsto z_1$ of [`step`], by the

@@ -339,3 +339,37 @@ fn a_spline_around_a_keep_out_cap_goes_around_it() {
     assert!(plan.cost > free.cost, "{} against {}", plan.cost, free.cost);
     assert_eq!(free_chart, chart);
 }
+
+/// A geodesic flow with a weak barrier around the cap q_0 > 0.9 (about 26 degrees around x).
+#[higher_order_lagrangian(order = 1, sphere)]
+fn with_cap(q: [f64; 3], dq: [f64; 3], tau: f64) -> f64 {
+    0.5 * (dq[0].powi(2) + dq[1].powi(2) + dq[2].powi(2)) - tau / (0.9 - q[0])
+}
+
+#[test]
+fn a_step_into_a_barrier_on_the_sphere_is_a_domain_error() {
+    // along the equator from 60 degrees west towards x: the barrier is too weak to turn the
+    // path, so a step crosses the cap's edge and the guard reports it
+    let system = WithCap::new(1e-9);
+    let [q, v] = on_equator(-60.0, 1.0);
+    let mut s = SphereState::<1, 4>::from_ambient(&system, &[q, v]).expect("on the sphere");
+    let options = NewtonOptions::default();
+    let mut stopped = None;
+    for i in 0..40 {
+        match sphere::step(&system, &ProjectionMidpoint, &s, 0.1, &options) {
+            Ok((next, _)) => s = next,
+            Err(e) => {
+                stopped = Some((i, e));
+                break;
+            }
+        }
+    }
+    let (i, error) = stopped.expect("the path reaches the cap");
+    let Error::Domain(violation) = error else {
+        panic!("expected a domain error, got {error}");
+    };
+    assert_eq!(violation.expression, "0.9 - q[0]");
+    // the edge is at longitude -25.8 degrees, 34.2 degrees = 0.597 from the start
+    assert!((5..=6).contains(&i), "stopped at step {i}");
+    assert!(s.point()[0] < 0.9, "the last state is outside the cap");
+}
