@@ -10,7 +10,7 @@
 //! | `q_c` | coordinate $c$ of $q$, $c = 0, \dots, n-1$ |
 //! | `d{j}q_c` | coordinate $c$ of $q^{(j)}$, $1 \le j < k$ (`d1q_0` is $q_0'$) |
 //! | `p{j}_c` | coordinate $c$ of the Ostrogradsky momentum $p_j$, $0 \le j < k$ |
-//! | `u_c` | coordinate $c$ of the top derivative $u = q^{(k)}$ of the step from $t_i$ ([`Plan`](crate::bvp::Plan), [`BvpSolution`](crate::BvpSolution) only; empty in the last row) |
+//! | `u_c` | coordinate $c$ of the top derivative $u = q^{(k)}$ of the step from $t_i$ ([`Plan`], [`BvpSolution`] only; empty in the last row) |
 //!
 //! The numbers are written with Rust's shortest representation that parses back to the
 //! same `f64` (`{}`; `NaN`, `inf`, `-inf` for the non-finite ones), so `str::parse::<f64>`
