@@ -141,7 +141,7 @@ impl<const S: usize> Trajectory<S> {
 impl<const N: usize, const X: usize> Plan<N, X> {
     /// Writes the plan as CSV (see [`crate::output`]): the header
     /// `t,q_0,..,d1q_0,..,p0_0,..,u_0,..` ([`state_columns`]`(N, k)` with $k = X/N$, then
-    /// `u_c`), then one row per node $i = 0, \dots, N$: $t_i$, the jet $x_i$, the momenta
+    /// `u_c`), then one row per node $t_i = i h$: $t_i$, the jet $x_i$, the momenta
     /// $p_i$ and the top derivative $u_i$ of step $i$ (at $t = (i + \theta) h$; empty cells in
     /// the last row, and where the plan has no momenta).
     ///
@@ -169,7 +169,7 @@ impl<const N: usize, const X: usize> Plan<N, X> {
 impl<const S: usize, const M: usize> BvpSolution<S, M> {
     /// Writes the solution as CSV (see [`crate::output`]): the header
     /// `t,q_0,..,d1q_0,..,p0_0,..,u_0,..` ([`state_columns`]`(N, K)`, then `u_c`), then one
-    /// row per node $i = 0, \dots, N$: $t_i$, $z_i$ and the top derivative $u_i$ of step $i$
+    /// row per node $t_i = i h$: $t_i$, $z_i$ and the top derivative $u_i$ of step $i$
     /// (the last $n$ unknowns $w_i$, at $t = (i + \theta) h$; empty cells in the last row).
     /// `S` $= 2nk$ and `M` $= S + n$ are checked at compile time.
     ///
