@@ -15,6 +15,7 @@ mod common;
 use retract::diagnostics::energy_error;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
+use retract::plot::{self, Scale};
 use retract::{Lagrangian, LiftedSystem, StepOptions, trajectory};
 
 /// Joint torques tau = M(q) q'' + c(q, q') + g(q) of the two-link arm.
@@ -96,24 +97,21 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     );
     let [q1, q2] = angles;
     let [t1, t2] = torque;
-    common::panels(
+    plot::panels(
         &figure,
         "Minimum-torque two-link arm, midpoint rule, h = 0.01",
         "t",
         &[
             (
                 "joint angle [rad]",
-                vec![common::Curve::new("q1", q1), common::Curve::new("q2", q2)],
+                vec![plot::Curve::new("q1", q1), plot::Curve::new("q2", q2)],
             ),
             (
                 "torque",
-                vec![
-                    common::Curve::new("tau1", t1),
-                    common::Curve::new("tau2", t2),
-                ],
+                vec![plot::Curve::new("tau1", t1), plot::Curve::new("tau2", t2)],
             ),
         ],
-        false,
+        Scale::Linear,
     )?;
     println!("figure: {}", figure.display());
     Ok(())

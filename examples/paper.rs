@@ -17,6 +17,7 @@ use std::time::Instant;
 use retract::diagnostics::{energy_error, symplecticity_error};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
+use retract::plot;
 use retract::{LiftedSystem, ReducedStepper, StepOptions, trajectory};
 
 /// The obstacle-avoidance Lagrangian on the SE(2) chart.
@@ -82,12 +83,12 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             run.max_iterations(),
             run.mean_iterations(),
         );
-        curves.push(common::Curve::new(
+        curves.push(plot::Curve::new(
             format!("tau = {tau:.0e}"),
             run.states.iter().map(|z| (z[0], z[1])).collect(),
         ));
     }
-    common::plane(
+    plot::plane(
         &figure,
         "SE(2) obstacle avoidance, midpoint rule, N = 400, h = 0.01",
         &curves,

@@ -20,6 +20,7 @@ use std::time::Instant;
 
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::nalgebra::{SVector, Vector2, Vector3};
+use retract::plot;
 use retract::sphere::{
     self, Chart, ExponentialMidpoint, ProjectionInitial, ProjectionMidpoint, SphereMap,
     SphereState, SphereSystem,
@@ -224,7 +225,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| common::docs_path("sphere.svg"));
-    common::sphere(
+    plot::sphere(
         &path,
         "Riemannian cubics on S^2 from 60 W to 60 E: free and around a keep-out cap",
         [1.0, -0.25, 0.45],

@@ -8,6 +8,8 @@ pub use retract_core::*;
 // the generated items name `::retract`, also inside this crate (`sphere`)
 extern crate self as retract;
 
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod sphere;
 /// A runnable example: an obstacle course's Lagrangian, stepped once.
 ///

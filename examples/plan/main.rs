@@ -41,6 +41,7 @@ use std::time::Instant;
 use retract::bvp::{BvpOptions, ClearanceFn, Curve, Guess, continuation};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::{SVector, Vector2};
+use retract::plot;
 use scene::Scene;
 
 /// The planner's Lagrangian: minimum acceleration plus a barrier per disc (cx, cy, r).
@@ -186,13 +187,13 @@ fn run() -> Result<(), Box<dyn Error>> {
         "Newton iterations (last solve): {}, final residual {:.1e}, total solve time {elapsed:.1?}",
         solution.iterations, solution.residual_norm
     );
-    let path = common::Curve::new(
+    let path = plot::Curve::new(
         "optimal path",
         solution.states.iter().map(|z| (z[0], z[1])).collect(),
     );
-    let first = common::Curve::new("first guess", guess.iter().map(|z| (z[0], z[1])).collect());
+    let first = plot::Curve::new("first guess", guess.iter().map(|z| (z[0], z[1])).collect());
     let circles: Vec<(f64, f64, f64)> = discs.iter().map(|d| (d[0], d[1], d[2])).collect();
-    common::plane(
+    plot::plane(
         &figure,
         "Optimal-control plan (SE(2), midpoint rule)",
         &[path, first],

@@ -4,6 +4,7 @@ use core::fmt;
 
 /// Which domain condition of the Lagrangian a step violated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum DomainKind {
     /// A denominator changed sign or vanished.
     Denominator,
@@ -20,6 +21,7 @@ pub enum DomainKind {
 
 /// A guarded expression of the Lagrangian that left its domain during a step.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DomainViolation {
     /// The expression as written in the Lagrangian.
     pub expression: &'static str,
@@ -105,6 +107,7 @@ fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Res
 /// text says what went wrong and what to try.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Error {
     /// A NaN or infinite value appeared in `location` ("initial guess", "residual",
     /// "Jacobian", "vector field", ...) at Newton iteration `iteration` (0: before the first

@@ -25,6 +25,8 @@
 //! - [`state`](mod@state): typed derivative data ([`Jet`]) and states ([`State`]), built by
 //!   the Legendre map and read by name ($q^{(j)}$, $p_j$, $u$).
 //! - [`models`]: a system written by hand.
+//! - [`output`]: CSV export of trajectories, plans and solutions, with a header naming
+//!   every column.
 //!
 //! # References
 //! A. Anahory Simoes, M. Barbero Liñán, L. Colombo, D. Martín de Diego,
@@ -35,6 +37,12 @@
 //! `std` (default): trajectories ([`trajectory`]), the boundary-value solver ([`bvp`]) and
 //! the banded LU. Without it the crate is `no_std` and allocation-free: steps, Newton,
 //! diagnostics and everything generated code needs; math goes through `libm`.
+//!
+//! `serde` (off by default): `Serialize` and `Deserialize` for the results and options
+//! ([`Trajectory`], [`StepReport`], [`bvp::Plan`], [`bvp::Certificate`], [`BvpSolution`],
+//! [`State`], [`Jet`], [`sphere::SphereState`], the option structs), `Serialize` for the
+//! errors ([`Error`], [`bvp::PlanError`], [`Interrupted`]). Vectors are lists of numbers
+//! (nalgebra's `serde-serialize-no-std`); it builds without std too.
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -52,6 +60,8 @@ pub mod linalg;
 pub mod map;
 pub mod models;
 pub mod newton;
+#[cfg(feature = "std")]
+pub mod output;
 pub mod reduced;
 pub mod sphere;
 pub mod state;

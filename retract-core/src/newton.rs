@@ -37,6 +37,7 @@ pub trait Problem<const M: usize> {
 /// Options of [`solve`]. Build with [`NewtonOptions::default`] and the `with_*` methods.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NewtonOptions {
     /// Absolute tolerance on $\Vert F\Vert_\infty$.
     pub residual_abs: f64,

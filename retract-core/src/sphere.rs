@@ -61,6 +61,7 @@ pub trait SphereMap<const K: usize> {
 /// a unit vector and $(e_1, e_2)$ an orthonormal basis of its tangent plane. It covers the
 /// open hemisphere $c \cdot q > 0$; $\varphi^{-1}(q) = (e_1 \cdot q, e_2 \cdot q) / (c \cdot q)$.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Chart {
     /// The centre $c = \varphi(0)$.
     pub centre: Vector3<f64>,
@@ -280,6 +281,7 @@ fn homogeneous<const K: usize>(x: &Blocks<2, K>) -> Jet<3> {
 /// A state of a system on $S^2$ of order `K` (state size `S` $= 4K$): the chart and
 /// $z = (x, p)$ in it, $x = (y, \dots, y^{(k-1)})$.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SphereState<const K: usize, const S: usize> {
     /// The chart the state is written in.
     pub chart: Chart,

@@ -42,11 +42,17 @@ use crate::{Error, Lagrangian};
 
 /// Derivative data $(q, q', \dots, q^{(2k-1)})$ of a curve at one time, $K = k$ blocks below
 /// the top derivative ([`Self::lower`]) and $K$ from it on ([`Self::upper`]).
+///
+/// With the `serde` feature: `{"lower": [[q], [q'], ...], "upper": [...]}`, each block a
+/// list of $n$ numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Jet<const N: usize, const K: usize> {
     /// $(q, q', \dots, q^{(k-1)})$.
+    #[cfg_attr(feature = "serde", serde(with = "blocks_serde"))]
     pub lower: Blocks<N, K>,
     /// $(q^{(k)}, \dots, q^{(2k-1)})$.
+    #[cfg_attr(feature = "serde", serde(with = "blocks_serde"))]
     pub upper: Blocks<N, K>,
 }
 
@@ -109,11 +115,17 @@ impl<const N: usize, const K: usize> Jet<N, K> {
 
 /// A Hamiltonian state $z = (x, p)$ of the lifted scheme, by blocks: $x_j = q^{(j)}$ and the
 /// Ostrogradsky momenta $p_j$, $j < k$.
+///
+/// With the `serde` feature: `{"x": [[q], [q'], ...], "p": [[p_0], ...]}`, each block a list
+/// of $n$ numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct State<const N: usize, const K: usize> {
     /// $x = (q, q', \dots, q^{(k-1)})$.
+    #[cfg_attr(feature = "serde", serde(with = "blocks_serde"))]
     pub x: Blocks<N, K>,
     /// $p = (p_0, \dots, p_{k-1})$.
+    #[cfg_attr(feature = "serde", serde(with = "blocks_serde"))]
     pub p: Blocks<N, K>,
 }
 
@@ -180,6 +192,61 @@ impl<const N: usize, const K: usize> State<N, K> {
         L: Lagrangian<N, K> + ?Sized,
     {
         system.top_derivative(&self.x, &self.p[K - 1], &SVector::zeros())
+    }
+}
+
+/// [`Blocks`] as a list of $K$ blocks (serde implements arrays only up to a fixed length, not
+/// for a const-generic one); deserializing needs no allocation.
+#[cfg(feature = "serde")]
+mod blocks_serde {
+    use core::fmt;
+    use core::marker::PhantomData;
+
+    use nalgebra::SVector;
+    use serde::de::{Error as _, SeqAccess, Visitor};
+    use serde::ser::SerializeTuple;
+    use serde::{Deserializer, Serializer};
+
+    use crate::lifted::Blocks;
+
+    pub fn serialize<S: Serializer, const N: usize, const K: usize>(
+        blocks: &Blocks<N, K>,
+        serializer: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut tuple = serializer.serialize_tuple(K)?;
+        for block in blocks {
+            tuple.serialize_element(block)?;
+        }
+        tuple.end()
+    }
+
+    struct BlocksVisitor<const N: usize, const K: usize>(PhantomData<Blocks<N, K>>);
+
+    impl<'de, const N: usize, const K: usize> Visitor<'de> for BlocksVisitor<N, K> {
+        type Value = Blocks<N, K>;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            write!(f, "a list of {K} blocks of {N} numbers")
+        }
+
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+            let mut blocks = [SVector::<f64, N>::zeros(); K];
+            for (j, block) in blocks.iter_mut().enumerate() {
+                *block = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(j, &self))?;
+            }
+            if seq.next_element::<SVector<f64, N>>()?.is_some() {
+                return Err(A::Error::invalid_length(K + 1, &self));
+            }
+            Ok(blocks)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize, const K: usize>(
+        deserializer: D,
+    ) -> Result<Blocks<N, K>, D::Error> {
+        deserializer.deserialize_tuple(K, BlocksVisitor(PhantomData))
     }
 }
 

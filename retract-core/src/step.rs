@@ -12,6 +12,7 @@ use crate::{Error, LiftedSystem};
 /// Options of a step: the scheme parameter $\theta$ and the Newton options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepOptions {
     /// $\theta \in [0, 1]$; $1/2$ (the default) is the lifted midpoint rule, order 2;
     /// 0 and 1 are the two symplectic Euler methods, order 1.
@@ -309,6 +310,7 @@ where
 
 /// What the Newton solve of one step reported.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepReport {
     /// Newton iterations used (summed over substeps).
     pub iterations: usize,
@@ -481,6 +483,7 @@ where
 #[cfg(feature = "std")]
 /// States $z_0, \dots, z_m$ at $t_i = i h$ and the Newton report of each step.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Trajectory<const S: usize> {
     /// The step size $h$.
     pub h: f64,
@@ -527,6 +530,7 @@ impl<const S: usize> Trajectory<S> {
 /// Its `Debug` output summarises the trajectory (step size, number of states and reports,
 /// the last state) instead of listing every state.
 #[derive(Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Interrupted<const S: usize> {
     /// The states up to and including the last valid one.
     pub trajectory: Trajectory<S>,

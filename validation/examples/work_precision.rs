@@ -23,6 +23,7 @@ use retract::compose::compose;
 use retract::diagnostics::rk4_step;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
+use retract::plot::{self, Scale};
 use retract::{LiftedSystem, ReducedScheme, ReducedStepper, StepOptions};
 
 #[higher_order_lagrangian(order = 2)]
@@ -185,7 +186,7 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
                 Err(e) => println!("| {name} | {n} | stopped: {e} | - |"),
             }
         }
-        curves.push(common::Curve::new(name, points));
+        curves.push(plot::Curve::new(name, points));
     }
     let mut points = Vec::new();
     for n in [50, 100, 200, 400, 800, 1600, 3200] {
@@ -206,7 +207,7 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
             Err(e) => println!("| RK4 | {n} | stopped: {e} | - |"),
         }
     }
-    curves.push(common::Curve::new("RK4", points));
+    curves.push(plot::Curve::new("RK4", points));
     for (label, h_max) in [("DOP853", t_end)] {
         let mut points = Vec::new();
         for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
@@ -219,7 +220,7 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
             );
             points.push((time, error.max(1e-16)));
         }
-        curves.push(common::Curve::new(label, points));
+        curves.push(plot::Curve::new(label, points));
     }
     println!("\nWall time at a final error of 1e-8 (log-log interpolation between sweep points):");
     let at_target: Vec<(&str, f64)> = curves
@@ -238,12 +239,12 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
         println!("  best composition ({label}) / DOP853: {:.1}x", best / dop);
     }
     let figure = common::docs_path("work_precision.svg");
-    common::panels(
+    plot::panels(
         &figure,
         "Obstacle IVP to T = 4: final error against wall time",
         "wall time [s]",
         &[("max-norm error at T", curves)],
-        true,
+        Scale::Log,
     )?;
     println!("\nfigure: {}", figure.display());
     Ok(())
@@ -317,7 +318,7 @@ fn long_run() -> Result<(), Box<dyn std::error::Error>> {
                 at(1e3),
                 at(1e5)
             );
-            curves.push(common::Curve::new(name, record));
+            curves.push(plot::Curve::new(name, record));
         };
     let mut stepper = ReducedStepper::new(&system);
     let h = 0.1;
@@ -383,12 +384,12 @@ fn long_run() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let figure = common::docs_path("energy_long_run.svg");
-    common::panels(
+    plot::panels(
         &figure,
         "Pais-Uhlenbeck: max |H - H(0)| up to time t, matched cost",
         "t",
         &[("max energy error", curves)],
-        true,
+        Scale::Log,
     )?;
     println!("\nfigure: {}", figure.display());
     Ok(())

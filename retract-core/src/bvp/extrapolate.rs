@@ -43,6 +43,7 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// Every value below is $R_2$ of the three plans' values and every error estimate is
 /// $|R_2 - R_1(2N, 4N)|$, componentwise.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Extrapolated<const N: usize, const X: usize> {
     /// The coarse step $h = T/N$.
     pub h: f64,

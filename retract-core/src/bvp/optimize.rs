@@ -39,6 +39,7 @@ use crate::{DomainViolation, Error, JetFunction, Lagrangian, LiftedSystem};
 /// Options of [`OptimalControlProblem::solve`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PlanOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
     pub theta: f64,
@@ -149,6 +150,7 @@ pub enum PlanGuess<'a, const N: usize, const X: usize> {
 
 /// What a returned plan is certified to satisfy.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Certificate {
     /// Max-norm of the gradient of the Lagrangian of the transcription, with the multipliers
     /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
@@ -166,11 +168,29 @@ pub struct Certificate {
     /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
     /// u_{N-1})$; positive for a strict local minimum. NaN unless
     /// [`PlanOptions::min_eigenvalue`] is set (the inertia count proves positivity either way).
+    /// With `serde`, NaN is written as "none" (JSON `null`) and read back as NaN.
+    #[cfg_attr(feature = "serde", serde(with = "nan_as_none"))]
     pub min_reduced_hessian_eig: f64,
+}
+
+/// An `f64` that may be NaN as an `Option<f64>` (`None` for NaN): formats without NaN, as
+/// JSON, write it as `null` and read it back.
+#[cfg(feature = "serde")]
+mod nan_as_none {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, serializer: S) -> Result<S::Ok, S::Error> {
+        (!v.is_nan()).then_some(*v).serialize(serializer)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::NAN))
+    }
 }
 
 /// A plan: a certified local minimum of the transcription.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Plan<const N: usize, const X: usize> {
     /// Step size $h = T/N$.
     pub h: f64,
@@ -294,6 +314,7 @@ impl<const N: usize, const X: usize> Plan<N, X> {
 
 /// The result of [`OptimalControlProblem::solve_real_time`].
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RealTime<const N: usize, const X: usize> {
     /// The last iterate (a certified minimum only if `converged`).
     pub plan: Plan<N, X>,
@@ -304,6 +325,7 @@ pub struct RealTime<const N: usize, const X: usize> {
 /// Why the optimizer stopped without a certified plan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Failure {
     /// Invalid input (no iterate).
     Invalid(Error),
@@ -337,6 +359,7 @@ pub enum Failure {
 /// (its `certificate` describes it; it is not a minimum). Its `Debug` output summarises the
 /// iterate instead of listing it.
 #[derive(Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PlanError<const N: usize, const X: usize> {
     /// Why.
     pub failure: Failure,

@@ -35,6 +35,7 @@ use crate::{Error, LiftedSystem, ReducedFactors, ReducedScheme};
 /// Options of the boundary-value solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BvpOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
     pub theta: f64,
@@ -54,6 +55,7 @@ pub struct BvpOptions {
 /// rounding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum LinearSolver {
     /// Eliminate each step's unknowns through its linearised step map and solve the
     /// remaining $nk \times nk$ system for the free initial momenta (cost $O(N)$ small dense
@@ -118,6 +120,7 @@ pub enum Guess<'a, const S: usize, const M: usize> {
 
 /// A solved boundary-value problem.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BvpSolution<const S: usize, const M: usize> {
     /// Step size $h = T/N$.
     pub h: f64,
