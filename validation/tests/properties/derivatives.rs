@@ -373,7 +373,7 @@ proptest! {
     }
 
     #[test]
-    fn special_functions_k2(v in point(8, -1.0, 1.0), eps in 0.05..0.5, h in 0.01..0.1, theta in 0.0..1.0) {
+    fn special_functions_k2(v in point(8, -1.0, 1.0), eps in 0.25..0.5, h in 0.01..0.1, theta in 0.0..1.0) {
         check_all(&Special { eps }, &v, h, theta);
     }
 
