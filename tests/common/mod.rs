@@ -120,3 +120,19 @@ pub fn close(what: &str, got: f64, want: f64, scale: f64) {
         (got - want).abs()
     );
 }
+
+/// (x, u) with component `c` of the flat (x, u) moved by `t`.
+pub fn shifted<const N: usize, const K: usize>(
+    x: &[SVector<f64, N>; K],
+    u: &SVector<f64, N>,
+    c: usize,
+    t: f64,
+) -> ([SVector<f64, N>; K], SVector<f64, N>) {
+    let (mut x, mut u) = (*x, *u);
+    if c < N * K {
+        x[c / N][c % N] += t;
+    } else {
+        u[c - N * K] += t;
+    }
+    (x, u)
+}

@@ -8,59 +8,9 @@
 
 #![allow(unused_variables, unused_mut, clippy::all)]
 
+use crate::common::{fd, grad_entry, hess_entry, shifted};
 use retract::nalgebra::SVector;
 use retract::{Lagrangian, higher_order_lagrangian};
-
-/// f'(0) of a scalar function of one variable, fourth-order central stencil.
-fn fd(f: impl Fn(f64) -> f64, eps: f64) -> f64 {
-    (-f(2.0 * eps) + 8.0 * f(eps) - 8.0 * f(-eps) + f(-2.0 * eps)) / (12.0 * eps)
-}
-
-/// Entry `c` of (x, u), flattened.
-fn entry<const N: usize, const K: usize>(
-    x: &[SVector<f64, N>; K],
-    u: &SVector<f64, N>,
-    c: usize,
-) -> f64 {
-    if c < N * K {
-        x[c / N][c % N]
-    } else {
-        u[c - N * K]
-    }
-}
-
-fn shifted<const N: usize, const K: usize>(
-    x: &[SVector<f64, N>; K],
-    u: &SVector<f64, N>,
-    c: usize,
-    t: f64,
-) -> ([SVector<f64, N>; K], SVector<f64, N>) {
-    let (mut x, mut u) = (*x, *u);
-    if c < N * K {
-        x[c / N][c % N] += t;
-    } else {
-        u[c - N * K] += t;
-    }
-    (x, u)
-}
-
-fn grad_entry<const N: usize, const K: usize>(g: &retract::Gradient<N, K>, c: usize) -> f64 {
-    entry(&g.x, &g.u, c)
-}
-
-fn hess_entry<const N: usize, const K: usize>(
-    h: &retract::Hessian<N, K>,
-    a: usize,
-    b: usize,
-) -> f64 {
-    let (ja, ia, jb, ib) = (a / N, a % N, b / N, b % N);
-    match (ja < K, jb < K) {
-        (true, true) => h.xx[ja][jb][(ia, ib)],
-        (true, false) => h.xu[ja][(ia, ib)],
-        (false, true) => h.xu[jb][(ib, ia)],
-        (false, false) => h.uu[(ia, ib)],
-    }
-}
 
 /// Gradient and Hessian of `l` at 8 points of [-1, 1]^(N (K + 1)) against finite
 /// differences (relative tolerance 1e-7 of the largest entry).

@@ -8,7 +8,7 @@
 
 use crate::common;
 
-use common::{close, fd, grad_entry, hess_entry};
+use common::{close, fd, grad_entry, hess_entry, shifted};
 
 use proptest::prelude::*;
 use retract::higher_order_lagrangian;
@@ -146,22 +146,6 @@ fn chain24(q: [f64; 24], dq: [f64; 24], kappa: f64) -> f64 {
 
 fn blocks<const N: usize, const K: usize>(v: &[f64]) -> [SVector<f64, N>; K] {
     core::array::from_fn(|j| SVector::from_fn(|i, _| v[j * N + i]))
-}
-
-/// (x, u) with (x, u)[c] moved by `t`.
-fn shifted<const N: usize, const K: usize>(
-    x: &[SVector<f64, N>; K],
-    u: &SVector<f64, N>,
-    c: usize,
-    t: f64,
-) -> ([SVector<f64, N>; K], SVector<f64, N>) {
-    let (mut x, mut u) = (*x, *u);
-    if c < N * K {
-        x[c / N][c % N] += t;
-    } else {
-        u[c - N * K] += t;
-    }
-    (x, u)
 }
 
 /// Gradient and Hessian of L at (x, u) against finite differences.
