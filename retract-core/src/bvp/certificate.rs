@@ -4,6 +4,7 @@
 use nalgebra::{DMatrix, SVector, SymmetricEigen};
 
 use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
+use crate::newton::max_abs;
 
 /// The multipliers $\mu_i$ of the scheme's $x$-equations
 /// $x_{i+1} - x_i - h A x_{\theta,i} - h B u_i = 0$, the momenta and the stationarity residual.
@@ -30,38 +31,36 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     let shift_t = |mu: &SVector<f64, X>| {
         SVector::<f64, X>::from_fn(|r, _| if r >= N { mu[r - N] } else { 0.0 })
     };
-    let mut momenta = Vec::with_capacity(stages.len() + 1);
+    let steps = stages.len();
+    let mut momenta = Vec::with_capacity(steps + 1);
     let mut worst: f64 = 0.0;
     // max |grad (h L)|_inf over the steps (divided by h once, at the end)
     let mut largest: f64 = 0.0;
-    let mut previous: Option<(SVector<f64, X>, SVector<f64, X>)> = None;
-    for (((stage, (gx, gu)), lambda), y) in stages
-        .iter()
-        .zip(gradients)
-        .zip(&direction.costate)
-        .zip(&direction.multipliers)
-    {
-        largest = largest.max(gx.amax()).max(gu.amax());
+    let (mut mu_prev, mut d_prev) = (SVector::<f64, X>::zeros(), SVector::<f64, X>::zeros());
+    for i in 0..steps {
+        let (stage, (gx, gu)) = (&stages[i], &gradients[i]);
+        largest = largest.max(max_abs(gx)).max(max_abs(gu));
         // the gradient of the stage's Lagrangian h L - h z^T g_ineq + y^T g_eq
         let (gx, gu) = if stage.constraints > 0 {
+            let y = &direction.multipliers[i];
             (gx + stage.cx.transpose() * y, gu + stage.cu.transpose() * y)
         } else {
             (*gx, *gu)
         };
-        let mu = -wt.left_t(&(lambda + gx * theta));
+        let mu = -wt.left_t(&(direction.costate[i] + gx * theta));
         let d = gx - shift_t(&mu) * h;
         for a in 0..N {
             worst = worst.max((gu[a] - h * mu[X - N + a]).abs());
         }
-        if let Some((mu_prev, d_prev)) = previous {
+        if i > 0 {
             let r = d * (1.0 - theta) + d_prev * theta - (mu - mu_prev);
-            worst = worst.max(r.amax());
+            worst = worst.max(max_abs(&r));
         }
         momenta.push(mu - d * (1.0 - theta));
-        previous = Some((mu, d));
+        (mu_prev, d_prev) = (mu, d);
     }
-    if let Some((mu, d)) = previous {
-        momenta.push(mu + d * theta);
+    if steps > 0 {
+        momenta.push(mu_prev + d_prev * theta);
     }
     (momenta, worst / (h * (largest / h).max(1.0)))
 }

@@ -280,6 +280,8 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
     let scale = (0..D).fold(0.0_f64, |s, i| s.max(m[(i, i)].abs()));
     let mut l = SMatrix::<f64, D, D>::identity();
     let mut d = [0.0_f64; D];
+    // the pivots' reciprocals: one division per pivot
+    let mut d_inv = [0.0_f64; D];
     for j in 0..D {
         let mut pivot = m[(j, j)];
         for k in 0..j {
@@ -290,12 +292,13 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
             return None;
         }
         d[j] = pivot;
+        d_inv[j] = 1.0 / pivot;
         for i in j + 1..D {
             let mut v = m[(i, j)];
             for k in 0..j {
                 v -= l[(i, k)] * l[(j, k)] * d[k];
             }
-            l[(i, j)] = v / pivot;
+            l[(i, j)] = v * d_inv[j];
         }
     }
     // M^{-1} = L^{-T} D^{-1} L^{-1}, column by column
@@ -310,7 +313,7 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
             y[i] = v;
         }
         for i in (0..D).rev() {
-            let mut v = y[i] / d[i];
+            let mut v = y[i] * d_inv[i];
             for k in i + 1..D {
                 v -= l[(k, i)] * inv[(k, c)];
             }
@@ -346,17 +349,14 @@ fn stage_factor<const N: usize, const X: usize>(
     for a in 0..N {
         huu[(a, a)] += rho;
     }
-    // fu = theta B: the evaluation point's dependence on the control
-    let hxx_e = e.right(&hxx);
-    let pa = a.right(p);
-    let qxx = e.left_t(&hxx_e) + a.left_t(&pa);
-    let qux = b.left_t(&hxx_e) * theta + e.right(&stage.hux) + b.left_t(&pa);
+    // fu = theta B: the evaluation point's dependence on the control; B^T H and B^T P are
+    // shared by Q_ux and Q_uu
+    let bth = b.left_t(&hxx) * theta;
+    let btp = b.left_t(p);
+    let qxx = e.left_t(&e.right(&hxx)) + a.left_t(&a.right(p));
+    let qux = e.right(&(bth + stage.hux)) + a.right(&btp);
     let cross = b.right(&stage.hux) * theta;
-    let quu = b.left_t(&b.right(&hxx)) * (theta * theta)
-        + cross
-        + cross.transpose()
-        + huu
-        + b.left_t(&b.right(p));
+    let quu = b.right(&bth) * theta + cross + cross.transpose() + huu + b.right(&btp);
     let quu = (quu + quu.transpose()) * 0.5;
     let mut factor = StageFactor {
         quu_inv: SMatrix::zeros(),

@@ -8,10 +8,12 @@
 
 use nalgebra::SMatrix;
 
-/// $\sum_d c_d S^d$ on jets of $X = nk$ entries in blocks of `N`.
+/// $I + \sum_{d \ge 1} c_d S^d$ on jets of $X = nk$ entries in blocks of `N`: every
+/// polynomial of the scheme ($W$, $\bar A$, $E$) starts with the identity, so the products
+/// below start from a copy and add the shifted terms only.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BlockPoly<const N: usize, const X: usize> {
-    /// $c_d$ for $d < k$ (zero beyond).
+    /// $c_d$ for $1 \le d < k$ ($c_0 = 1$; zero beyond).
     c: [f64; X],
 }
 
@@ -21,77 +23,68 @@ pub(crate) struct BlockColumn<const N: usize, const X: usize> {
     b: [f64; X],
 }
 
-/// `dst += c src`, entry by entry.
-#[inline(always)]
-fn axpy(dst: &mut [f64], c: f64, src: &[f64]) {
-    for (d, s) in dst.iter_mut().zip(src) {
-        *d += c * s;
-    }
-}
-
-// The products work on the column-major storage slices: a column of an R x C matrix is
-// `R` consecutive entries, and a block of `N` rows within a column is `N` consecutive
-// entries, so every update is an `axpy` on contiguous runs (vectorised, bounds checked once
-// per run rather than per entry).
+// The products index the column-major storage `data.0[column][row]` with constant bounds,
+// so the compiler unrolls them completely.
 
 impl<const N: usize, const X: usize> BlockPoly<N, X> {
-    /// The coefficients of a matrix known to be a polynomial in $S$: its first block row.
+    /// The coefficients of a matrix known to be a polynomial in $S$ with $c_0 = 1$: its first
+    /// block row.
     pub fn of(m: &SMatrix<f64, X, X>) -> Self {
+        debug_assert!((m[(0, 0)] - 1.0).abs() < 1e-14, "c_0 = {}", m[(0, 0)]);
         Self {
             c: core::array::from_fn(|d| if d * N < X { m[(0, d * N)] } else { 0.0 }),
         }
     }
 
-    /// $M P(S)$: column block $j$ is $\sum_{d \le j} c_d$ times column block $j - d$ of $M$.
+    /// $M P(S)$: column block $j$ is column block $j$ of $M$ plus $\sum_{1 \le d \le j}
+    /// c_d$ times column block $j - d$.
     #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, X> {
-        let mut out = SMatrix::<f64, R, X>::zeros();
-        let (src, dst) = (m.as_slice(), out.as_mut_slice());
-        let block = R * N;
-        for j in 0..X / N {
-            for d in 0..=j {
-                let from = (j - d) * block;
-                axpy(
-                    &mut dst[j * block..(j + 1) * block],
-                    self.c[d],
-                    &src[from..from + block],
-                );
-            }
-        }
-        out
-    }
-
-    /// $P(S)^T M$: row block $j$ is $\sum_{d \le j} c_d$ times row block $j - d$ of $M$.
-    #[inline(always)]
-    pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
-        let mut out = SMatrix::<f64, X, C>::zeros();
-        let (src, dst) = (m.as_slice(), out.as_mut_slice());
-        for col in 0..C {
-            let base = col * X;
-            for j in 0..X / N {
-                for d in 0..=j {
-                    let from = base + (j - d) * N;
-                    let to = base + j * N;
-                    axpy(&mut dst[to..to + N], self.c[d], &src[from..from + N]);
+        let (src, mut out) = (&m.data.0, *m);
+        let dst = &mut out.data.0;
+        for j in 1..X / N {
+            for d in 1..=j {
+                for col in 0..N {
+                    for r in 0..R {
+                        dst[j * N + col][r] += self.c[d] * src[(j - d) * N + col][r];
+                    }
                 }
             }
         }
         out
     }
 
-    /// $P(S) M$: row block $j$ is $\sum_{j + d < k} c_d$ times row block $j + d$ of $M$.
+    /// $P(S)^T M$: row block $j$ is row block $j$ of $M$ plus $\sum_{1 \le d \le j} c_d$
+    /// times row block $j - d$.
+    #[inline(always)]
+    pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
+        let (src, mut out) = (&m.data.0, *m);
+        let dst = &mut out.data.0;
+        for col in 0..C {
+            for j in 1..X / N {
+                for d in 1..=j {
+                    for a in 0..N {
+                        dst[col][j * N + a] += self.c[d] * src[col][(j - d) * N + a];
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// $P(S) M$: row block $j$ is row block $j$ of $M$ plus $\sum_{1 \le d,\ j + d < k}
+    /// c_d$ times row block $j + d$.
     #[inline(always)]
     pub fn left<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, X, C> {
         let k = X / N;
-        let mut out = SMatrix::<f64, X, C>::zeros();
-        let (src, dst) = (m.as_slice(), out.as_mut_slice());
+        let (src, mut out) = (&m.data.0, *m);
+        let dst = &mut out.data.0;
         for col in 0..C {
-            let base = col * X;
             for j in 0..k {
-                for d in 0..k - j {
-                    let from = base + (j + d) * N;
-                    let to = base + j * N;
-                    axpy(&mut dst[to..to + N], self.c[d], &src[from..from + N]);
+                for d in 1..k - j {
+                    for a in 0..N {
+                        dst[col][j * N + a] += self.c[d] * src[col][(j + d) * N + a];
+                    }
                 }
             }
         }
@@ -110,11 +103,14 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     /// $M \bar B = \sum_j b_j$ (column block $j$ of $M$).
     #[inline(always)]
     pub fn right<const R: usize>(&self, m: &SMatrix<f64, R, X>) -> SMatrix<f64, R, N> {
-        let mut out = SMatrix::<f64, R, N>::zeros();
-        let (src, dst) = (m.as_slice(), out.as_mut_slice());
-        let block = R * N;
+        let (src, mut out) = (&m.data.0, SMatrix::<f64, R, N>::zeros());
+        let dst = &mut out.data.0;
         for j in 0..X / N {
-            axpy(dst, self.b[j], &src[j * block..(j + 1) * block]);
+            for col in 0..N {
+                for r in 0..R {
+                    dst[col][r] += self.b[j] * src[j * N + col][r];
+                }
+            }
         }
         out
     }
@@ -122,16 +118,13 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
     /// $\bar B^T M = \sum_j b_j$ (row block $j$ of $M$).
     #[inline(always)]
     pub fn left_t<const C: usize>(&self, m: &SMatrix<f64, X, C>) -> SMatrix<f64, N, C> {
-        let mut out = SMatrix::<f64, N, C>::zeros();
-        let (src, dst) = (m.as_slice(), out.as_mut_slice());
+        let (src, mut out) = (&m.data.0, SMatrix::<f64, N, C>::zeros());
+        let dst = &mut out.data.0;
         for col in 0..C {
             for j in 0..X / N {
-                let from = col * X + j * N;
-                axpy(
-                    &mut dst[col * N..(col + 1) * N],
-                    self.b[j],
-                    &src[from..from + N],
-                );
+                for a in 0..N {
+                    dst[col][a] += self.b[j] * src[col][j * N + a];
+                }
             }
         }
         out

@@ -269,7 +269,7 @@ where
         &self,
         models: &Models<N, X>,
         barrier: &Barrier,
-        riccati: &Riccati<N, X>,
+        negative_directions: usize,
         direction: &Direction<N, X>,
     ) -> (Vec<SVector<f64, X>>, Certificate) {
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
@@ -288,7 +288,7 @@ where
             stationarity,
             feasibility: models.violation_max(),
             complementarity: barrier.complementarity().0,
-            negative_directions: riccati.negative,
+            negative_directions,
             min_reduced_hessian_eig: f64::NAN,
         };
         (momenta, certificate)
@@ -358,6 +358,14 @@ where
                     certificate,
                 ))),
             };
+            // after a full step the last subproblem's multipliers are the Newton estimates
+            // here: if they already certify this point, no subproblem is solved at it
+            if let Some(last) = full_step.take().filter(|_| rho_last == 0.0) {
+                let state = (&iterate, &y[..], &barrier);
+                if let Some(plan) = self.certify_without_solve(state, &last, iterations) {
+                    return Ok(plan);
+                }
+            }
             let Some(models) = self.models(&iterate, &y, &barrier) else {
                 return Err(PlanError {
                     failure: Failure::NonFinite,
@@ -370,23 +378,6 @@ where
                 return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
             };
             rho_last = rho;
-            // after a full step the last subproblem's multipliers are the Newton estimates
-            // here: if they already certify this point, no subproblem is solved at it
-            if let Some(last) = full_step
-                .take()
-                .filter(|_| rho == 0.0 && barrier.mu <= floor)
-            {
-                let (momenta, certificate) = self.residuals(&models, &barrier, &riccati, &last);
-                if certificate.stationarity.max(certificate.feasibility) <= options.tolerance {
-                    let state = (&iterate, &y[..], &barrier);
-                    if let Ok(certificate) =
-                        self.certify(state, &models, &riccati, rho, certificate)
-                    {
-                        let cost = models.cost;
-                        return Ok(self.plan(&iterate, cost, iterations, momenta, certificate));
-                    }
-                }
-            }
             let direction = riccati.solve(
                 &self.dynamics,
                 &models.stages,
@@ -394,7 +385,8 @@ where
                 &models.r0,
                 &models.r_end,
             );
-            let (momenta, certificate) = self.residuals(&models, &barrier, &riccati, &direction);
+            let (momenta, certificate) =
+                self.residuals(&models, &barrier, riccati.negative, &direction);
             let (complementarity, complementarity_error) = barrier.complementarity();
             let error = certificate.stationarity.max(certificate.feasibility);
             if barrier.mu > floor && error.max(complementarity_error) <= 10.0 * barrier.mu {
@@ -408,8 +400,7 @@ where
                     .certify(
                         (&iterate, &y, &barrier),
                         &models,
-                        &riccati,
-                        rho,
+                        (rho == 0.0).then_some(&riccati),
                         certificate,
                     )
                     .map(|certificate| {
@@ -457,18 +448,43 @@ where
         }
     }
 
+    /// The plan at the point reached by a full step, certified with the last subproblem's
+    /// multipliers (the Newton estimates here) instead of a solve of its own: if the residuals
+    /// are below the tolerance with the barrier at its floor and the second-order check
+    /// ([`Self::certify`]) passes; `None` (solve as usual) otherwise.
+    fn certify_without_solve(
+        &self,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        last: &Direction<N, X>,
+        iterations: usize,
+    ) -> Option<Plan<N, X>> {
+        let (iterate, y, barrier) = state;
+        let options = &self.problem.options;
+        if barrier.mu > options.tolerance / 10.0 {
+            return None;
+        }
+        let models = self.models(iterate, y, barrier)?;
+        let (momenta, certificate) = self.residuals(&models, barrier, 0, last);
+        if certificate.stationarity.max(certificate.feasibility) > options.tolerance {
+            return None;
+        }
+        let certificate = self.certify(state, &models, None, certificate).ok()?;
+        Some(self.plan(iterate, models.cost, iterations, momenta, certificate))
+    }
+
     /// The second-order check at a KKT point: the Hessian of the Lagrangian must be positive
     /// definite on the null space of the constraints, with the active inequalities
     /// ($s_k < z_k$: strict complementarity separates them by orders of magnitude) as
     /// equalities and the barrier terms left out (the second-order sufficient condition; the
     /// barrier Hessian itself is too ill-conditioned near the end to count its inertia). Then
-    /// its smallest eigenvalue completes the certificate.
+    /// its smallest eigenvalue completes the certificate. `factored`: the factorisation of
+    /// `models` without correction, if there is one (without inequalities it is the one
+    /// checked; else it is computed here).
     fn certify(
         &self,
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         models: &Models<N, X>,
-        riccati: &Riccati<N, X>,
-        rho: f64,
+        factored: Option<&Riccati<N, X>>,
         mut certificate: Certificate,
     ) -> Result<Certificate, (Failure, Certificate)> {
         let (iterate, y, barrier) = state;
@@ -481,11 +497,11 @@ where
                 0.0,
             );
             &refactored
-        } else if rho > 0.0 {
+        } else if let Some(riccati) = factored {
+            riccati
+        } else {
             refactored = Riccati::factor(&self.dynamics, &models.stages, 0.0);
             &refactored
-        } else {
-            riccati
         };
         certificate.negative_directions = exact.negative;
         if !exact.positive_definite() {
