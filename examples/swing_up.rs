@@ -12,31 +12,9 @@ use std::time::Instant;
 use retract::bvp::{OptimalControlProblem, PlanGuess, PlanOptions};
 use retract::{higher_order_lagrangian, jet_function};
 
-/// Double pendulum (point masses at the rod ends, angles from the downward vertical, the
-/// second relative to the first): L = 1/2 |tau|^2, tau = M(q) q'' + C(q, q') q' + G(q).
-#[higher_order_lagrangian(order = 2)]
-fn double_pendulum(
-    q: [f64; 2],
-    dq: [f64; 2],
-    ddq: [f64; 2],
-    m1: f64,
-    m2: f64,
-    l1: f64,
-    l2: f64,
-    g: f64,
-) -> f64 {
-    let c2 = q[1].cos();
-    let s2 = q[1].sin();
-    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
-    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
-    let m22 = m2 * l2 * l2;
-    let b = m2 * l1 * l2 * s2;
-    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
-    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
-    let tau1 = m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
-    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
-    0.5 * (tau1 * tau1 + tau2 * tau2)
-}
+#[path = "common/pendulum.rs"]
+mod pendulum;
+use pendulum::TorqueCost;
 
 /// Cart-pole: cost 1/2 F^2 on the cart force
 /// F = (mc + mp) x'' + mp l cos(th) th'' - mp l sin(th) th'^2, q = (x, th), th from the
@@ -66,7 +44,7 @@ fn report(name: &str, t_end: f64, steps: usize, plan: &retract::bvp::Plan<2, 4>,
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "quick");
     let horizons: &[f64] = if quick { &[1.0] } else { &[2.0, 3.0, 4.0] };
-    let pendulum = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    let pendulum = TorqueCost::new(1.0, 1.0, 1.0, 1.0, 9.81);
     // the line reports the smallest eigenvalue, so compute it (the inertia alone certifies)
     let options = PlanOptions::default().with_min_eigenvalue(true);
     for &t_end in horizons {

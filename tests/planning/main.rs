@@ -10,5 +10,6 @@ mod common;
 mod bvp;
 mod extrapolate;
 mod inequalities;
+mod mpc;
 mod optimize;
 mod typed_data;

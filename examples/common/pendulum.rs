@@ -1,0 +1,174 @@
+//! The double pendulum: the planner's model (minimum torque), the plant (T - V), the torque,
+//! and receding-horizon control with the plant simulated in the loop. Shared by
+//! `examples/swing_up.rs`, `examples/mpc.rs` and `tests/planning/mpc.rs` (by path).
+//!
+//! Every control period h the planner re-plans from the plant's measured state (q, q') to the
+//! upright equilibrium over a fixed horizon T = N h: the minimum-torque problem
+//! L = 1/2 |tau|^2 on the lifted-midpoint transcription, warm-started from its last plan
+//! shifted by one step, with at most `ITERATIONS` SQP iterations (real-time iteration). The
+//! plant, the mechanical Lagrangian T - V, takes one forced-midpoint step (discrete
+//! Lagrange-d'Alembert) under the torque of the plan's first step at its midpoint. From the
+//! hanging rest state the loop swings the pendulum up, then holds it upright.
+#![allow(dead_code)] // each user takes a subset
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
+use retract::forced::forced_step;
+use retract::nalgebra::SVector;
+use retract::{Lagrangian, LiftedSystem, StepOptions, higher_order_lagrangian};
+
+/// Horizon steps.
+pub const STEPS: usize = 50;
+/// Horizon length (s); the control period is `HORIZON / STEPS`.
+pub const HORIZON: f64 = 1.0;
+/// SQP iterations per re-plan at most.
+pub const ITERATIONS: usize = 2;
+/// Masses, lengths and gravity of both models.
+const M1: f64 = 1.0;
+const M2: f64 = 1.0;
+const L1: f64 = 1.0;
+const L2: f64 = 1.0;
+const G: f64 = 9.81;
+
+/// The planner's model: L = 1/2 |tau|^2 with tau = M(q) q'' + C(q, q') q' + G(q), angles from
+/// the downward vertical, the second relative to the first (point masses at the rod ends).
+#[higher_order_lagrangian(order = 2)]
+pub fn torque_cost(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let m22 = m2 * l2 * l2;
+    let b = m2 * l1 * l2 * s2;
+    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
+    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
+    let tau1 = m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
+    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
+    0.5 * (tau1 * tau1 + tau2 * tau2)
+}
+
+/// The plant: L = T - V of the same pendulum, T = 1/2 q'^T M(q) q',
+/// V = -(m1 + m2) g l1 cos q0 - m2 g l2 cos(q0 + q1).
+#[higher_order_lagrangian(order = 1)]
+pub fn plant(q: [f64; 2], dq: [f64; 2], m1: f64, m2: f64, l1: f64, l2: f64, g: f64) -> f64 {
+    let c2 = q[1].cos();
+    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let m22 = m2 * l2 * l2;
+    let kinetic = 0.5 * (m11 * dq[0] * dq[0] + 2.0 * m12 * dq[0] * dq[1] + m22 * dq[1] * dq[1]);
+    let potential = -(m1 + m2) * g * l1 * q[0].cos() - m2 * g * l2 * (q[0] + q[1]).cos();
+    kinetic - potential
+}
+
+/// tau = M(q) q'' + C(q, q') q' + G(q): the body of [`torque_cost`] (a Lagrangian cannot yet
+/// call a helper, so the formula is written twice).
+pub fn torque(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> [f64; 2] {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let m11 = (M1 + M2) * L1 * L1 + M2 * L2 * L2 + 2.0 * M2 * L1 * L2 * c2;
+    let m12 = M2 * L2 * L2 + M2 * L1 * L2 * c2;
+    let m22 = M2 * L2 * L2;
+    let b = M2 * L1 * L2 * s2;
+    let g1 = (M1 + M2) * G * L1 * q[0].sin() + M2 * G * L2 * (q[0] + q[1]).sin();
+    let g2 = M2 * G * L2 * (q[0] + q[1]).sin();
+    [
+        m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1,
+        m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2,
+    ]
+}
+
+/// What a run of the loop measured.
+pub struct Summary {
+    /// Re-plans made.
+    pub replans: usize,
+    /// Re-plans that returned an error.
+    pub failures: usize,
+    /// Wall time of every re-plan (microseconds), in order.
+    pub times_us: Vec<f64>,
+    /// Re-plans whose plan was a certified minimum.
+    pub converged: usize,
+    /// The plant's jet (q, q') after the last step.
+    pub last: [f64; 4],
+    /// The largest |tau| applied.
+    pub max_torque: f64,
+}
+
+impl Summary {
+    /// The `p`-quantile (0..=1) of the re-plan times, nearest rank.
+    pub fn quantile_us(&self, p: f64) -> f64 {
+        let mut sorted = self.times_us.clone();
+        sorted.sort_by(f64::total_cmp);
+        let rank = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+        sorted[rank - 1]
+    }
+}
+
+/// The torque of a plan's first step, at its midpoint: tau(x_theta,0, u_0).
+fn first_torque(plan: &Plan<2, 4>) -> [f64; 2] {
+    let x = (plan.x[0] + plan.x[1]) * 0.5;
+    torque([x[0], x[1]], [x[2], x[3]], [plan.u[0][0], plan.u[0][1]])
+}
+
+/// Runs `replans` control periods from the hanging rest state.
+///
+/// # Errors
+/// A plant step that fails (the plant itself, not a re-plan: those are counted).
+pub fn run(replans: usize) -> Result<Summary, retract::Error> {
+    let model = TorqueCost::new(M1, M2, L1, L2, G);
+    let pendulum = Plant::new(M1, M2, L1, L2, G);
+    let h = HORIZON / STEPS as f64;
+    let goal = [PI, 0.0, 0.0, 0.0];
+    let options = StepOptions::default();
+    let mut jet = [0.0; 4];
+    let mut z = pendulum.legendre(&SVector::from(jet));
+    let mut plan: Option<Plan<2, 4>> = None;
+    let mut summary = Summary {
+        replans,
+        failures: 0,
+        times_us: Vec::with_capacity(replans),
+        converged: 0,
+        last: jet,
+        max_torque: 0.0,
+    };
+    for _ in 0..replans {
+        let problem = OptimalControlProblem::new(&model, &jet, &goal, HORIZON, STEPS);
+        let shifted = plan.as_ref().map(Plan::shifted);
+        let guess = shifted.as_ref().map_or(PlanGuess::Spline, PlanGuess::Plan);
+        let started = Instant::now();
+        let result = problem.solve_real_time(guess, ITERATIONS);
+        summary.times_us.push(started.elapsed().as_secs_f64() * 1e6);
+        match result {
+            Ok(real_time) => {
+                summary.converged += usize::from(real_time.converged);
+                plan = Some(real_time.plan);
+            }
+            Err(error) => {
+                summary.failures += 1;
+                // keep going on the last iterate (or the previous plan, shifted)
+                plan = error.last.map(|p| *p).or(shifted);
+            }
+        }
+        // the plant: one forced-midpoint step under the plan's first torque (zero without
+        // any plan)
+        let tau = plan.as_ref().map_or([0.0; 2], first_torque);
+        summary.max_torque = summary.max_torque.max(tau[0].abs()).max(tau[1].abs());
+        (z, _) = forced_step(&pendulum, &z, &SVector::from(tau), h, &options)?;
+        let q = SVector::<f64, 2>::from([z[0], z[1]]);
+        let p = SVector::<f64, 2>::from([z[2], z[3]]);
+        let dq = pendulum.top_derivative(&[q], &p, &SVector::from([jet[2], jet[3]]))?;
+        jet = [q[0], q[1], dq[0], dq[1]];
+    }
+    summary.last = jet;
+    Ok(summary)
+}
