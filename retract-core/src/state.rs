@@ -20,7 +20,7 @@
 //! ```
 //! use retract_core::models::PlanarBarrier;
 //! use retract_core::state::{Jet, State};
-//! use retract_core::{StepOptions, step};
+//! use retract_core::StepOptions;
 //!
 //! let system = PlanarBarrier { tau: 0.0, radius: 1.0, mass: 1.0 };
 //! // q, q', q'', q''' of a point in the plane
@@ -28,8 +28,7 @@
 //! let z0 = State::from_jet(&system, &jet)?;
 //! assert_eq!(z0.momentum(1), Some([0.2, 0.0].into())); // p_1 = q''
 //! assert_eq!(z0.momentum(0), Some([-0.1, 0.3].into())); // p_0 = -q'''
-//! let (z1, _) = step(&system, &z0.to_vector(), 0.1, &StepOptions::default())?;
-//! let z1: State<2, 2> = State::from_vector(&z1);
+//! let (z1, _) = z0.step(&system, 0.1, &StepOptions::default())?;
 //! // the midpoint step: q(h) = q + h q' + h^2/2 p_1 - h^3/4 p_0
 //! assert!((z1.q()[0] - (2.0 + 0.1 + 0.005 * 0.2 + 0.00025 * 0.1)).abs() < 1e-14);
 //! # Ok::<(), retract_core::Error>(())
@@ -38,7 +37,8 @@
 use nalgebra::SVector;
 
 use crate::lifted::{Blocks, join, split};
-use crate::{Error, Lagrangian};
+use crate::step::StepReport;
+use crate::{Error, Lagrangian, LiftedSystem, StepOptions};
 
 /// Derivative data $(q, q', \dots, q^{(2k-1)})$ of a curve at one time, $K = k$ blocks below
 /// the top derivative ([`Self::lower`]) and $K$ from it on ([`Self::upper`]).
@@ -193,6 +193,43 @@ impl<const N: usize, const K: usize> State<N, K> {
     {
         system.top_derivative(&self.x, &self.p[K - 1], &SVector::zeros())
     }
+
+    /// One step $z_0 \mapsto z_1$ of [`crate::step()`] from this state, as a state (`S`
+    /// $= 2nk$ and `M` $= S + n$ are those of the system's [`LiftedSystem`] implementation).
+    ///
+    /// # Errors
+    /// As [`crate::step()`].
+    pub fn step<Sys, const S: usize, const M: usize>(
+        &self,
+        system: &Sys,
+        h: f64,
+        options: &StepOptions,
+    ) -> Result<(Self, StepReport), Error>
+    where
+        Sys: LiftedSystem<S, M> + ?Sized,
+    {
+        crate::step::step(system, &self.to_vector::<S>(), h, options)
+            .map(|(z, report)| (Self::from_vector(&z), report))
+    }
+
+    /// `steps` steps of [`crate::trajectory`] from this state ([`crate::Trajectory::state`]
+    /// gives its states back as [`State`]s).
+    ///
+    /// # Errors
+    /// As [`crate::trajectory`]: the states computed before the failure, and the failure.
+    #[cfg(feature = "std")]
+    pub fn trajectory<Sys, const S: usize, const M: usize>(
+        &self,
+        system: &Sys,
+        h: f64,
+        steps: usize,
+        options: &StepOptions,
+    ) -> Result<crate::Trajectory<S>, crate::Interrupted<S>>
+    where
+        Sys: LiftedSystem<S, M> + ?Sized,
+    {
+        crate::step::trajectory(system, &self.to_vector::<S>(), h, steps, options)
+    }
 }
 
 /// [`Blocks`] as a list of $K$ blocks (serde implements arrays only up to a fixed length, not
@@ -287,6 +324,26 @@ mod tests {
         assert_eq!(state.derivative(1), Some([1.0, -0.5].into()));
         assert_eq!(state.derivative(2), None);
         assert_eq!(state.momentum(2), None);
+    }
+
+    /// The typed step and trajectory are the flat ones: the same numbers, bit for bit.
+    #[test]
+    fn typed_step_and_trajectory_are_the_flat_ones() {
+        let system = PlanarBarrier {
+            tau: 0.3,
+            radius: 1.0,
+            mass: 2.0,
+        };
+        let options = StepOptions::default();
+        let jet = Jet::<2, 2>::new(&[[2.0, 0.5], [1.0, -0.5], [0.2, 0.4], [0.1, -0.3]]).unwrap();
+        let z0 = State::from_jet(&system, &jet).unwrap();
+        let (typed, _) = z0.step(&system, 0.05, &options).unwrap();
+        let (flat, _) = crate::step(&system, &z0.to_vector::<8>(), 0.05, &options).unwrap();
+        assert_eq!(typed.to_vector::<8>(), flat);
+        assert_ne!(typed, z0);
+        let run = z0.trajectory(&system, 0.05, 3, &options).unwrap();
+        assert_eq!(run.state::<2, 2>(1), Some(typed));
+        assert_eq!(run.state::<2, 2>(0), Some(z0));
     }
 
     #[test]
