@@ -1,4 +1,5 @@
-#![doc = include_str!("../README.md")]
+// the README with its figures embedded as data URIs (build.rs), so they show on docs.rs
+#![doc = include_str!(concat!(env!("OUT_DIR"), "/README.md"))]
 #![cfg_attr(not(feature = "std"), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

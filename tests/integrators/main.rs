@@ -10,6 +10,7 @@ mod common;
 mod compositions;
 mod core_scheme;
 mod discretization_maps;
+mod docs_figures;
 mod forced;
 mod fuzz_corpus;
 mod guard;
