@@ -1,20 +1,23 @@
 //! Swing-up suite (`../shared/BENCHMARKS.md`): rest-to-rest minimum-torque swing-ups on the
 //! lifted-midpoint transcription with N = 100 T steps from the smoothstep guess, solved by the
-//! optimizer (`OptimalControlProblem`). One line per problem:
+//! optimizer (`OptimalControlProblem`): the double pendulum and the cart-pole of the suite, and
+//! the acrobot (the double pendulum with a passive shoulder: cost on the elbow torque, the
+//! shoulder torque constrained to zero; T = 3 and 4 start from the previous horizon's plan).
+//! One line per problem:
 //! `<problem> T=<T> N=<N> J=<J> iterations=<n> time_ms=<t> min_reduced_hessian_eig=<e>`.
 //!
-//! Run: `cargo run --release --example swing_up` (add `-- quick` for T = 1 only, as the tests
-//! do).
+//! Run: `cargo run --release --example swing_up` (add `-- quick` for T = 1 only, the acrobot
+//! at T = 2).
 
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use retract::bvp::{OptimalControlProblem, PlanGuess, PlanOptions};
+use retract::bvp::{Curve, OptimalControlProblem, PlanGuess, PlanOptions};
 use retract::{higher_order_lagrangian, jet_function};
 
 #[path = "common/pendulum.rs"]
 mod pendulum;
-use pendulum::TorqueCost;
+use pendulum::{ElbowCost, ShoulderTorque, TorqueCost};
 
 /// Cart-pole: cost 1/2 F^2 on the cart force
 /// F = (mc + mp) x'' + mp l cos(th) th'' - mp l sin(th) th'^2, q = (x, th), th from the
@@ -79,6 +82,43 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             &plan,
             start.elapsed().as_secs_f64() * 1e3,
         );
+    }
+    let acrobot = ElbowCost::new(1.0, 1.0, 1.0, 9.81);
+    let passive = ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    // each horizon after the first starts from the previous plan stretched in time (from the
+    // smoothstep guess T = 4 does not converge)
+    let mut previous: Option<(f64, retract::bvp::Plan<2, 4>)> = None;
+    // (at T = 1 the one actuator needs torques of hundreds of N m and the solve stalls near
+    // the tolerance: the quick run takes T = 2)
+    let acrobot_horizons: &[f64] = if quick { &[2.0] } else { horizons };
+    for &t_end in acrobot_horizons {
+        let steps = (100.0 * t_end) as usize;
+        let problem =
+            OptimalControlProblem::new(&acrobot, &[0.0; 4], &[PI, 0.0, 0.0, 0.0], t_end, steps)
+                .with_equality(&passive)
+                .with_options(options);
+        let last = previous.take();
+        let stretched = last.as_ref().map(|(t_last, plan)| {
+            Curve::from_fn(move |t| {
+                let x = plan.evaluate((t * t_last / t_end).clamp(0.0, *t_last));
+                x.map_or([f64::NAN; 2], |x| [x[0], x[1]])
+            })
+        });
+        let start = Instant::now();
+        let plan = problem.solve(
+            stretched
+                .as_ref()
+                .map_or(PlanGuess::Spline, PlanGuess::Curve),
+        )?;
+        report(
+            "acrobot",
+            t_end,
+            steps,
+            &plan,
+            start.elapsed().as_secs_f64() * 1e3,
+        );
+        drop(stretched);
+        previous = Some((t_end, plan));
     }
     Ok(())
 }

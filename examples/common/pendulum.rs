@@ -17,7 +17,7 @@ use std::time::Instant;
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
 use retract::forced::forced_step;
 use retract::nalgebra::SVector;
-use retract::{Lagrangian, LiftedSystem, StepOptions, higher_order_lagrangian};
+use retract::{Lagrangian, LiftedSystem, StepOptions, higher_order_lagrangian, jet_function};
 
 /// Horizon steps.
 pub const STEPS: usize = 50;
@@ -56,6 +56,47 @@ pub fn torque_cost(
     let tau1 = m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
     let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
     0.5 * (tau1 * tau1 + tau2 * tau2)
+}
+
+/// The acrobot's cost: only the elbow is actuated, L = 1/2 tau_2^2 (tau as in
+/// [`torque_cost`]); the shoulder's torque is constrained to zero by [`shoulder_torque`].
+#[higher_order_lagrangian(order = 2)]
+pub fn elbow_cost(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+) -> f64 {
+    let c2 = q[1].cos();
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let m22 = m2 * l2 * l2;
+    let b = m2 * l1 * l2 * q[1].sin();
+    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
+    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
+    0.5 * tau2 * tau2
+}
+
+/// The acrobot's passive shoulder: tau_1 = 0 at every step (tau_1 as in [`torque_cost`]).
+#[jet_function(order = 2)]
+pub fn shoulder_torque(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+) -> f64 {
+    let c2 = q[1].cos();
+    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let b = m2 * l1 * l2 * q[1].sin();
+    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
+    m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1
 }
 
 /// The plant: L = T - V of the same pendulum, T = 1/2 q'^T M(q) q',

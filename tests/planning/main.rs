@@ -12,4 +12,8 @@ mod extrapolate;
 mod inequalities;
 mod mpc;
 mod optimize;
+
+// the double pendulum's models and receding-horizon loop, shared with the examples
+#[path = "../../examples/common/pendulum.rs"]
+mod pendulum;
 mod typed_data;

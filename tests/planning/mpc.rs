@@ -3,10 +3,7 @@
 
 use std::f64::consts::PI;
 
-#[path = "../../examples/common/pendulum.rs"]
-mod pendulum;
-
-use pendulum::TorqueCost;
+use crate::pendulum::{self, TorqueCost};
 use retract::Lagrangian;
 use retract::nalgebra::SVector;
 

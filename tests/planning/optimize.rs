@@ -268,6 +268,51 @@ fn swing_ups_converge_to_certified_minima() {
     }
 }
 
+/// The acrobot (only the elbow actuated: cost 1/2 tau_2^2, tau_1 = 0 as an equality) swings up
+/// to a certified minimum with the shoulder torque zero at every step, and costs at least the
+/// fully actuated swing-up (1/2 |tau|^2) of the same horizon: its plan is a candidate there.
+#[test]
+fn the_acrobot_swings_up_with_a_passive_shoulder() {
+    use crate::pendulum::{ElbowCost, ShoulderTorque, TorqueCost};
+    use retract::JetFunction;
+    let (t_end, steps) = (2.0, 50);
+    let goal = [PI, 0.0, 0.0, 0.0];
+    let passive = ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    let plan = OptimalControlProblem::new(
+        &ElbowCost::new(1.0, 1.0, 1.0, 9.81),
+        &[0.0; 4],
+        &goal,
+        t_end,
+        steps,
+    )
+    .with_equality(&passive)
+    .solve(PlanGuess::Spline)
+    .unwrap();
+    assert_eq!(plan.certificate.negative_directions, 0);
+    // (stationarity at the acceptable level, 1e-6: the line search stalls at rounding near
+    // 5e-9 here, the torques being ~100 N m)
+    assert!(plan.certificate.stationarity <= 1e-6 && plan.certificate.feasibility <= 1e-9);
+    for (i, u) in plan.u.iter().enumerate() {
+        let xt = (plan.x[i] + plan.x[i + 1]) * 0.5;
+        let blocks = [
+            xt.fixed_rows::<2>(0).into_owned(),
+            xt.fixed_rows::<2>(2).into_owned(),
+        ];
+        let torque = passive.value(&blocks, u);
+        assert!(torque.abs() < 1e-9, "step {i}: shoulder torque {torque:e}");
+    }
+    let full = TorqueCost::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    let actuated = OptimalControlProblem::new(&full, &[0.0; 4], &goal, t_end, steps)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    assert!(
+        plan.cost > actuated.cost,
+        "acrobot {} vs fully actuated {}",
+        plan.cost,
+        actuated.cost
+    );
+}
+
 /// At any N the plan keeps out of the disc along every chord (checked here at 200 points per
 /// chord), and N <= 300 converges from the scene's feasible guess.
 #[test]
