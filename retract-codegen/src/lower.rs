@@ -4,8 +4,8 @@
 //! unary minus, parentheses; the f64 methods of [`METHODS`]; `let`, `let mut` with `=`,
 //! `+=`, `-=`, `*=`, `/=`; `const` items; `for` over integer ranges (unrolled) and over
 //! slice parameters (a run-time sum: the body may only accumulate into outer variables with
-//! `+=` / `-=`). Everything else is a `syn::Error` at its span; errors are collected so the
-//! user sees all of them.
+//! `+=` / `-=`); local arrays, tuples and helper `fn`s ([`values`]). Everything else is a
+//! `syn::Error` at its span; errors are collected so the user sees all of them.
 //!
 //! Limits, each an error at its span beyond it: integers known at compile time (indices, loop
 //! bounds, `powi` exponents) are computed in i64 with overflow checks, `powi` exponents must
@@ -21,8 +21,11 @@ use syn::spanned::Spanned;
 use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
 use crate::graph::{Func, Graph, Id, Node, Var};
+
+mod values;
 use crate::signature::{Attribute, Kind, Signature};
 use crate::util::tidy;
+use values::Value;
 
 /// The supported f64 methods.
 pub const METHODS: &str = "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, \
@@ -52,6 +55,10 @@ enum Binding {
     Element {
         param: u32,
         len: usize,
+    },
+    /// A local array: its components are `arrays[slot]`.
+    Array {
+        slot: u32,
     },
     /// A binding whose initialiser was already reported as an error: later uses are silent.
     Poisoned,
@@ -158,6 +165,14 @@ pub struct Lower<'a> {
     unrolled: usize,
     /// Whether "loop too long to unroll" was reported (once, not per outer iteration).
     too_long: bool,
+    /// The components of the local arrays ([`Binding::Array`]).
+    arrays: Vec<Vec<Id>>,
+    /// The helper functions defined in the body, by name.
+    helpers: HashMap<String, syn::ItemFn>,
+    /// Helper calls being inlined, innermost last (their count).
+    inlining: usize,
+    /// Names are looked up in `scopes[barrier..]` only: inside a helper, its own scopes.
+    barrier: usize,
 }
 
 impl<'a> Lower<'a> {
@@ -196,6 +211,10 @@ impl<'a> Lower<'a> {
             guards: Vec::new(),
             unrolled: 0,
             too_long: false,
+            arrays: Vec::new(),
+            helpers: HashMap::new(),
+            inlining: 0,
+            barrier: 0,
         }
     }
 
@@ -223,6 +242,7 @@ impl<'a> Lower<'a> {
         self.scopes
             .iter()
             .enumerate()
+            .skip(self.barrier)
             .rev()
             .find_map(|(depth, s)| s.get(name).map(|b| (depth, *b)))
     }
@@ -241,6 +261,7 @@ impl<'a> Lower<'a> {
                 "the Lagrangian body is empty: return an f64 expression",
             );
         };
+        self.register_helpers(&block.stmts);
         for stmt in init {
             self.stmt(stmt);
         }
@@ -263,6 +284,7 @@ impl<'a> Lower<'a> {
     /// Statements before the tail expression of a body (for a body whose tail is not one
     /// value: the points of a discretization map).
     pub fn statements(&mut self, stmts: &[Stmt]) {
+        self.register_helpers(stmts);
         for stmt in stmts {
             self.stmt(stmt);
         }
@@ -270,6 +292,7 @@ impl<'a> Lower<'a> {
 
     fn block(&mut self, block: &Block) {
         self.scopes.push(HashMap::new());
+        self.register_helpers(&block.stmts);
         for stmt in &block.stmts {
             match stmt {
                 Stmt::Expr(e, None) if !matches!(e, Expr::ForLoop(_)) => {
@@ -287,36 +310,20 @@ impl<'a> Lower<'a> {
     fn stmt(&mut self, stmt: &Stmt) {
         match stmt {
             Stmt::Local(local) => {
-                let (name, mutable) = match &local.pat {
-                    Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
-                        (p.ident.to_string(), p.mutability.is_some())
-                    }
-                    Pat::Type(t) => match &*t.pat {
-                        Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
-                            (p.ident.to_string(), p.mutability.is_some())
-                        }
-                        other => {
-                            self.error(other.span(), "unsupported pattern: bind a plain name");
-                            return;
-                        }
-                    },
-                    other => {
-                        self.error(other.span(), "unsupported pattern: bind a plain name");
-                        return;
-                    }
-                };
                 let before = self.errors.len();
-                let id = match &local.init {
-                    Some(init) if init.diverge.is_none() => self.expr(&init.expr),
-                    Some(init) => self.error(init.expr.span(), "`let ... else` is not supported"),
-                    None => self.error(local.span(), "a `let` needs an initial value"),
+                let value = match &local.init {
+                    Some(init) if init.diverge.is_none() => Some(self.value(&init.expr)),
+                    Some(init) => {
+                        self.error(init.expr.span(), "`let ... else` is not supported");
+                        None
+                    }
+                    None => {
+                        self.error(local.span(), "a `let` needs an initial value");
+                        None
+                    }
                 };
-                let binding = if self.errors.len() > before {
-                    Binding::Poisoned
-                } else {
-                    Binding::Value { id, mutable }
-                };
-                self.bind(name, binding);
+                let value = value.filter(|_| self.errors.len() == before);
+                self.bind_pattern(&local.pat, value);
             }
             Stmt::Item(syn::Item::Const(c)) => {
                 let name = c.ident.to_string();
@@ -336,10 +343,13 @@ impl<'a> Lower<'a> {
                     },
                 }
             }
+            // (registered when its block began)
+            Stmt::Item(syn::Item::Fn(_)) => {}
             Stmt::Item(item) => {
                 self.error(
                     item.span(),
-                    "items inside a Lagrangian are not supported, except `const` values",
+                    "items inside a Lagrangian are not supported, except `const` values and \
+                     helper `fn`s",
                 );
             }
             Stmt::Macro(m) => {
@@ -796,7 +806,7 @@ impl<'a> Lower<'a> {
                     format!("`{name}` is an array: use its components `{name}[i]`"),
                 ),
             },
-            Some((_, Binding::Element { .. })) => self.error(
+            Some((_, Binding::Element { .. } | Binding::Array { .. })) => self.error(
                 ident.span(),
                 format!("`{name}` is an array: use its components `{name}[i]`"),
             ),
@@ -816,8 +826,20 @@ impl<'a> Lower<'a> {
 
     fn index(&mut self, ix: &syn::ExprIndex) -> Id {
         let Expr::Path(p) = &*ix.expr else {
-            return self.error(ix.expr.span(), "only arguments can be indexed, as `q[i]`");
+            // a helper's result or an array literal (a helper that failed was reported)
+            let before = self.errors.len();
+            return match self.value(&ix.expr) {
+                Value::Array(ids) => self.component(&ids, ix, "the array"),
+                _ if self.errors.len() > before => self.g.constant(0.0),
+                _ => self.error(ix.expr.span(), "only arrays can be indexed, as `q[i]`"),
+            };
         };
+        if let Some(ident) = p.path.get_ident()
+            && let Some((_, Binding::Array { slot })) = self.lookup(&ident.to_string())
+        {
+            let ids = self.arrays[slot as usize].clone();
+            return self.component(&ids, ix, &format!("`{ident}`"));
+        }
         let Some(ident) = p.path.get_ident() else {
             return self.error(p.span(), "only arguments can be indexed, as `q[i]`");
         };
@@ -886,6 +908,23 @@ impl<'a> Lower<'a> {
         self.g.var(var)
     }
 
+    /// Component `ix.index` (an integer known at compile time) of the array `ids`.
+    fn component(&mut self, ids: &[Id], ix: &syn::ExprIndex, what: &str) -> Id {
+        let Some(i) = self.int(&ix.index) else {
+            return self.g.constant(0.0);
+        };
+        match usize::try_from(i).ok().and_then(|at| ids.get(at)) {
+            Some(&id) => id,
+            None => self.error(
+                ix.index.span(),
+                format!(
+                    "index {i} out of range for {what}, which has {} components",
+                    ids.len()
+                ),
+            ),
+        }
+    }
+
     fn method(&mut self, m: &syn::ExprMethodCall) -> Id {
         if m.turbofish.is_some() {
             return self.error(m.span(), "turbofish is not supported");
@@ -904,6 +943,18 @@ impl<'a> Lower<'a> {
 
     /// `f64::sqrt(x)` and friends: the method form with the receiver as first argument.
     fn call(&mut self, c: &syn::ExprCall) -> Id {
+        if let Some(f) = self.helper_of(c) {
+            return match self.inline(&f, c) {
+                Value::Scalar(id) => id,
+                _ => self.error(
+                    c.span(),
+                    format!(
+                        "`{}` returns an array or a tuple: bind it with `let` or index it",
+                        f.sig.ident
+                    ),
+                ),
+            };
+        }
         let Expr::Path(p) = &*c.func else {
             return self.unsupported(&c.func);
         };
@@ -942,7 +993,8 @@ impl<'a> Lower<'a> {
             c.func.span(),
             format!(
                 "call to unknown function `{}`: a Lagrangian can only call the f64 methods \
-                 {METHODS}; inline helper functions into the Lagrangian",
+                 {METHODS} and helper functions defined in its body (`fn name(x: f64) -> f64 \
+                 {{ ... }}`, inlined)",
                 p.path.to_token_stream().to_string().replace(' ', "")
             ),
         )

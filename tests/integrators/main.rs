@@ -16,6 +16,7 @@ mod fuzz_corpus;
 mod guard;
 mod guard_singular;
 mod hard_cases;
+mod helpers;
 mod item_6_deep_nesting;
 mod macro_robustness;
 mod macro_vs_handwritten;

@@ -1,0 +1,397 @@
+//! Values that are not one number: local arrays `[a, b]`, tuples `(a, b)` destructured by
+//! `let`, and helper functions written inside the Lagrangian (`fn torque(...) -> [f64; 2]`),
+//! inlined at every call.
+//!
+//! A helper sees only its own arguments (as a nested `fn` in Rust: not the Lagrangian's
+//! arguments or locals), the consts by path and the other helpers; its arguments are numbers
+//! (`f64`) or arrays (`[f64; n]`: a local array, a jet argument, a parameter array or a slice
+//! element), and it returns a number, an array or a tuple of those. Arrays are immutable:
+//! build them with `[e0, e1, ...]` or `[e; n]`.
+
+use std::collections::hash_map::Entry;
+
+use syn::spanned::Spanned;
+use syn::{Expr, Pat, Stmt};
+
+use super::{Binding, Lower};
+use crate::graph::{Id, Var};
+use crate::signature::Kind;
+
+/// Helper calls nested deeper than this are an error (recursion is not supported).
+const MAX_INLINE_DEPTH: usize = 16;
+
+/// The value of an expression that may not be a number.
+pub(super) enum Value {
+    Scalar(Id),
+    /// The components of an array.
+    Array(Vec<Id>),
+    Tuple(Vec<Value>),
+}
+
+/// The shape a helper's argument or result must have.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    Number,
+    Array(usize),
+}
+
+impl Shape {
+    fn of(ty: &syn::Type) -> Option<Self> {
+        match ty {
+            syn::Type::Path(p) if p.path.is_ident("f64") => Some(Self::Number),
+            syn::Type::Array(a) => {
+                let syn::Type::Path(p) = &*a.elem else {
+                    return None;
+                };
+                let syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(len),
+                    ..
+                }) = &a.len
+                else {
+                    return None;
+                };
+                (p.path.is_ident("f64"))
+                    .then(|| len.base10_parse().ok().map(Self::Array))
+                    .flatten()
+            }
+            syn::Type::Paren(p) => Self::of(&p.elem),
+            syn::Type::Group(g) => Self::of(&g.elem),
+            _ => None,
+        }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Self::Number => "an f64".into(),
+            Self::Array(n) => format!("an array of {n} f64"),
+        }
+    }
+}
+
+impl Lower<'_> {
+    /// Registers the helper `fn`s among `stmts` (before the statements run: Rust items are
+    /// visible in their whole block).
+    pub(super) fn register_helpers(&mut self, stmts: &[Stmt]) {
+        for stmt in stmts {
+            let Stmt::Item(syn::Item::Fn(f)) = stmt else {
+                continue;
+            };
+            let name = f.sig.ident.to_string();
+            if let Some(problem) = unsupported_signature(&f.sig) {
+                self.error(problem.0, problem.1);
+                continue;
+            }
+            // (a helper's own helpers are registered again each time it is inlined)
+            let text = |f: &syn::ItemFn| quote::ToTokens::to_token_stream(f).to_string();
+            match self.helpers.entry(name) {
+                Entry::Vacant(slot) => {
+                    slot.insert(f.clone());
+                }
+                Entry::Occupied(existing) if text(existing.get()) == text(f) => {}
+                Entry::Occupied(existing) => {
+                    let message = format!("the helper `{}` is defined twice", existing.key());
+                    self.error(f.sig.ident.span(), message);
+                }
+            }
+        }
+    }
+
+    /// The value of `e`: an array or tuple literal, a local array, a helper call, or a number.
+    pub(super) fn value(&mut self, e: &Expr) -> Value {
+        match e {
+            Expr::Array(a) => Value::Array(a.elems.iter().map(|x| self.expr(x)).collect()),
+            Expr::Repeat(r) => {
+                let element = self.expr(&r.expr);
+                match self.int(&r.len) {
+                    Some(n) if (0..=4096).contains(&n) => Value::Array(vec![element; n as usize]),
+                    Some(_) => Value::Scalar(self.error(
+                        r.len.span(),
+                        "an array `[e; n]` in a Lagrangian has at most 4096 components",
+                    )),
+                    None => Value::Scalar(element),
+                }
+            }
+            Expr::Tuple(t) => Value::Tuple(t.elems.iter().map(|x| self.value(x)).collect()),
+            Expr::Paren(p) => self.value(&p.expr),
+            Expr::Group(g) => self.value(&g.expr),
+            Expr::Path(p) => match p.path.get_ident().map(|i| self.lookup(&i.to_string())) {
+                Some(Some((_, binding))) => match self.components(binding) {
+                    Some(ids) => Value::Array(ids),
+                    None => Value::Scalar(self.expr(e)),
+                },
+                _ => Value::Scalar(self.expr(e)),
+            },
+            Expr::Call(c) => match self.helper_of(c) {
+                Some(f) => self.inline(&f, c),
+                None => Value::Scalar(self.expr(e)),
+            },
+            other => Value::Scalar(self.expr(other)),
+        }
+    }
+
+    /// The components of an array binding (a local array, a jet argument, a parameter array
+    /// or a slice element), as graph nodes; `None` for a binding that is not an array.
+    pub(super) fn components(&mut self, binding: Binding) -> Option<Vec<Id>> {
+        let vars: Vec<Var> = match binding {
+            Binding::Array { slot } => return Some(self.arrays[slot as usize].clone()),
+            Binding::Jet { order, offset } if !self.sig.scalar_jet => (0..self.sig.dim as u32)
+                .map(|i| Var::Jet {
+                    order,
+                    index: offset + i,
+                })
+                .collect(),
+            Binding::Param {
+                param,
+                kind: Kind::Array(len),
+            } => (0..len as u32)
+                .map(|index| Var::Param { param, index })
+                .collect(),
+            Binding::Element { param, len } => (0..len as u32)
+                .map(|index| Var::Elem { param, index })
+                .collect(),
+            _ => return None,
+        };
+        Some(vars.into_iter().map(|v| self.g.var(v)).collect())
+    }
+
+    /// Binds the names of a `let` pattern to `value` (a name, or a tuple of names and `_`);
+    /// `Poisoned` if the initialiser had errors.
+    pub(super) fn bind_pattern(&mut self, pat: &Pat, value: Option<Value>) {
+        let pat = match pat {
+            Pat::Type(t) => &*t.pat,
+            other => other,
+        };
+        match pat {
+            Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none() => {
+                let name = p.ident.to_string();
+                let mutable = p.mutability.is_some();
+                let binding = match value {
+                    None => Binding::Poisoned,
+                    Some(Value::Scalar(id)) => Binding::Value { id, mutable },
+                    Some(Value::Array(ids)) => {
+                        if mutable {
+                            self.error(
+                                p.ident.span(),
+                                "local arrays are immutable: build a new one with `[e0, e1, ...]`",
+                            );
+                        }
+                        self.arrays.push(ids);
+                        Binding::Array {
+                            slot: (self.arrays.len() - 1) as u32,
+                        }
+                    }
+                    Some(Value::Tuple(_)) => {
+                        self.error(
+                            p.ident.span(),
+                            "bind a tuple by destructuring it: `let (a, b) = ...`",
+                        );
+                        Binding::Poisoned
+                    }
+                };
+                self.bind(name, binding);
+            }
+            Pat::Wild(_) => {}
+            Pat::Tuple(t) => {
+                let parts = match value {
+                    None => None,
+                    Some(Value::Tuple(parts)) if parts.len() == t.elems.len() => Some(parts),
+                    Some(_) => {
+                        self.error(
+                            t.span(),
+                            format!(
+                                "this pattern takes a tuple of {} values, and the value is not one",
+                                t.elems.len()
+                            ),
+                        );
+                        None
+                    }
+                };
+                match parts {
+                    Some(parts) => {
+                        for (p, v) in t.elems.iter().zip(parts) {
+                            self.bind_pattern(p, Some(v));
+                        }
+                    }
+                    None => {
+                        for p in &t.elems {
+                            self.bind_pattern(p, None);
+                        }
+                    }
+                }
+            }
+            other => {
+                self.error(
+                    other.span(),
+                    "unsupported pattern: bind a plain name or a tuple of names",
+                );
+            }
+        }
+    }
+
+    /// The helper that `c` calls, if it calls one by its bare name.
+    pub(super) fn helper_of(&self, c: &syn::ExprCall) -> Option<syn::ItemFn> {
+        let Expr::Path(p) = &*c.func else {
+            return None;
+        };
+        let name = p.path.get_ident()?.to_string();
+        self.helpers.get(&name).cloned()
+    }
+
+    /// The call `c` of the helper `f`, inlined: its arguments bound to its parameters in a
+    /// scope that sees nothing of the caller's, its statements lowered, its tail the value.
+    pub(super) fn inline(&mut self, f: &syn::ItemFn, c: &syn::ExprCall) -> Value {
+        let name = f.sig.ident.to_string();
+        if self.inlining >= MAX_INLINE_DEPTH {
+            return Value::Scalar(self.error(
+                c.span(),
+                format!(
+                    "helper calls nest deeper than {MAX_INLINE_DEPTH} at `{name}`: recursion is \
+                     not supported"
+                ),
+            ));
+        }
+        if f.sig.inputs.len() != c.args.len() {
+            return Value::Scalar(self.error(
+                c.span(),
+                format!(
+                    "`{name}` takes {} argument{}, given {}",
+                    f.sig.inputs.len(),
+                    if f.sig.inputs.len() == 1 { "" } else { "s" },
+                    c.args.len()
+                ),
+            ));
+        }
+        let mut scope = std::collections::HashMap::new();
+        for (input, arg) in f.sig.inputs.iter().zip(&c.args) {
+            let syn::FnArg::Typed(typed) = input else {
+                continue; // (rejected at registration)
+            };
+            let (Pat::Ident(param), Some(shape)) = (&*typed.pat, Shape::of(&typed.ty)) else {
+                continue;
+            };
+            let value = self.value(arg);
+            let binding = match (shape, value) {
+                (Shape::Number, Value::Scalar(id)) => Binding::Value {
+                    id,
+                    mutable: param.mutability.is_some(),
+                },
+                (Shape::Array(n), Value::Array(ids)) if ids.len() == n => {
+                    self.arrays.push(ids);
+                    Binding::Array {
+                        slot: (self.arrays.len() - 1) as u32,
+                    }
+                }
+                (shape, _) => {
+                    self.error(
+                        arg.span(),
+                        format!("`{name}` takes {} as `{}`", shape.describe(), param.ident),
+                    );
+                    Binding::Poisoned
+                }
+            };
+            scope.insert(param.ident.to_string(), binding);
+        }
+        let barrier = std::mem::replace(&mut self.barrier, self.scopes.len());
+        self.scopes.push(scope);
+        self.inlining += 1;
+        let value = self.helper_body(f);
+        self.inlining -= 1;
+        self.scopes.pop();
+        self.barrier = barrier;
+        value
+    }
+
+    /// The statements of a helper's body, then its tail value (checked against its return
+    /// type).
+    fn helper_body(&mut self, f: &syn::ItemFn) -> Value {
+        let stmts = &f.block.stmts;
+        self.register_helpers(stmts);
+        let Some((Stmt::Expr(tail, None), init)) = stmts.split_last() else {
+            return Value::Scalar(self.error(
+                f.block.span(),
+                "a helper must end with its value (an expression without `;`); `return` is \
+                 not supported",
+            ));
+        };
+        for stmt in init {
+            self.stmt(stmt);
+        }
+        let value = self.value(tail);
+        let syn::ReturnType::Type(_, ty) = &f.sig.output else {
+            return value; // (rejected at registration)
+        };
+        match (ty.as_ref(), &value) {
+            (syn::Type::Tuple(t), Value::Tuple(parts)) if t.elems.len() == parts.len() => value,
+            (ty, _) => match (Shape::of(ty), &value) {
+                (Some(Shape::Number), Value::Scalar(_)) => value,
+                (Some(Shape::Array(n)), Value::Array(ids)) if ids.len() == n => value,
+                _ => Value::Scalar(self.error(
+                    tail.span(),
+                    format!(
+                        "the value of `{}` does not have its return type `{}`",
+                        f.sig.ident,
+                        ty.to_token_stream_string()
+                    ),
+                )),
+            },
+        }
+    }
+}
+
+/// Why a helper's signature is not supported (at its span), if it is not.
+fn unsupported_signature(sig: &syn::Signature) -> Option<(proc_macro2::Span, String)> {
+    if !sig.generics.params.is_empty() || sig.asyncness.is_some() || sig.variadic.is_some() {
+        return Some((
+            sig.span(),
+            "a helper is a plain `fn` without generics: `fn name(x: f64, q: [f64; 2]) -> f64`"
+                .into(),
+        ));
+    }
+    for input in &sig.inputs {
+        let ok = match input {
+            syn::FnArg::Typed(t) => {
+                matches!(&*t.pat, Pat::Ident(p) if p.by_ref.is_none() && p.subpat.is_none())
+                    && Shape::of(&t.ty).is_some()
+            }
+            syn::FnArg::Receiver(_) => false,
+        };
+        if !ok {
+            return Some((
+                input.span(),
+                "a helper's arguments are named `f64` numbers or `[f64; n]` arrays".into(),
+            ));
+        }
+    }
+    let returns_ok = match &sig.output {
+        syn::ReturnType::Default => false,
+        syn::ReturnType::Type(_, ty) => match ty.as_ref() {
+            syn::Type::Tuple(t) => {
+                !t.elems.is_empty() && t.elems.iter().all(|e| Shape::of(e).is_some())
+            }
+            other => Shape::of(other).is_some(),
+        },
+    };
+    let span = match &sig.output {
+        syn::ReturnType::Default => sig.ident.span(),
+        syn::ReturnType::Type(_, ty) => ty.span(),
+    };
+    (!returns_ok).then(|| {
+        (
+            span,
+            "a helper returns an `f64`, an array `[f64; n]` or a tuple of them".into(),
+        )
+    })
+}
+
+/// `to_string` of a type's tokens without the spaces `quote` puts between them.
+trait TokenString {
+    fn to_token_stream_string(&self) -> String;
+}
+
+impl TokenString for syn::Type {
+    fn to_token_stream_string(&self) -> String {
+        quote::ToTokens::to_token_stream(self)
+            .to_string()
+            .replace(' ', "")
+    }
+}
