@@ -1,5 +1,6 @@
-//! The double pendulum: the planner's model (minimum torque), the plant (T - V), the torque,
-//! and receding-horizon control with the plant simulated in the loop. Shared by
+//! The double pendulum: the planner's model (minimum torque, with its torque as the named
+//! output `tau`), the acrobot's cost and constraint, the plant (T - V), and receding-horizon
+//! control with the plant simulated in the loop. Shared by
 //! `examples/swing_up.rs`, `examples/mpc.rs` and `tests/planning/mpc.rs` (by path).
 //!
 //! Every control period h the planner re-plans from the plant's measured state (q, q') to the
@@ -53,9 +54,13 @@ pub fn torque_cost(
     let b = m2 * l1 * l2 * s2;
     let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
     let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
-    let tau1 = m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
-    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
-    0.5 * (tau1 * tau1 + tau2 * tau2)
+    // (also a method, `TorqueCost::tau(&self, x, u)`: the torque a plan asks of the plant)
+    #[output]
+    let tau = [
+        m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1,
+        m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2,
+    ];
+    0.5 * (tau[0] * tau[0] + tau[1] * tau[1])
 }
 
 /// The acrobot's cost: only the elbow is actuated, L = 1/2 tau_2^2 (tau as in
@@ -112,23 +117,6 @@ pub fn plant(q: [f64; 2], dq: [f64; 2], m1: f64, m2: f64, l1: f64, l2: f64, g: f
     kinetic - potential
 }
 
-/// tau = M(q) q'' + C(q, q') q' + G(q): the body of [`torque_cost`] (a Lagrangian cannot yet
-/// call a helper, so the formula is written twice).
-pub fn torque(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> [f64; 2] {
-    let c2 = q[1].cos();
-    let s2 = q[1].sin();
-    let m11 = (M1 + M2) * L1 * L1 + M2 * L2 * L2 + 2.0 * M2 * L1 * L2 * c2;
-    let m12 = M2 * L2 * L2 + M2 * L1 * L2 * c2;
-    let m22 = M2 * L2 * L2;
-    let b = M2 * L1 * L2 * s2;
-    let g1 = (M1 + M2) * G * L1 * q[0].sin() + M2 * G * L2 * (q[0] + q[1]).sin();
-    let g2 = M2 * G * L2 * (q[0] + q[1]).sin();
-    [
-        m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1,
-        m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2,
-    ]
-}
-
 /// What a run of the loop measured.
 pub struct Summary {
     /// Re-plans made.
@@ -156,9 +144,13 @@ impl Summary {
 }
 
 /// The torque of a plan's first step, at its midpoint: tau(x_theta,0, u_0).
-fn first_torque(plan: &Plan<2, 4>) -> [f64; 2] {
+fn first_torque(model: &TorqueCost, plan: &Plan<2, 4>) -> [f64; 2] {
     let x = (plan.x[0] + plan.x[1]) * 0.5;
-    torque([x[0], x[1]], [x[2], x[3]], [plan.u[0][0], plan.u[0][1]])
+    let jet = [
+        x.fixed_rows::<2>(0).into_owned(),
+        x.fixed_rows::<2>(2).into_owned(),
+    ];
+    model.tau(&jet, &plan.u[0])
 }
 
 /// Runs `replans` control periods from the hanging rest state.
@@ -202,7 +194,9 @@ pub fn run(replans: usize) -> Result<Summary, retract::Error> {
         }
         // the plant: one forced-midpoint step under the plan's first torque (zero without
         // any plan)
-        let tau = plan.as_ref().map_or([0.0; 2], first_torque);
+        let tau = plan
+            .as_ref()
+            .map_or([0.0; 2], |plan| first_torque(&model, plan));
         summary.max_torque = summary.max_torque.max(tau[0].abs()).max(tau[1].abs());
         (z, _) = forced_step(&pendulum, &z, &SVector::from(tau), h, &options)?;
         let q = SVector::<f64, 2>::from([z[0], z[1]]);

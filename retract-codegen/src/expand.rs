@@ -9,10 +9,11 @@ use syn::ItemFn;
 use crate::emit::Emission;
 use crate::emit::lagrangian::lagrangian_impl;
 use crate::emit::lifted::lifted_system_impl;
+use crate::emit::outputs::outputs_impl;
 use crate::emit::reduced::reduced_scheme_impl;
 use crate::emit::ty::type_and_constructor;
 use crate::graph::{Graph, Id};
-use crate::lower::{Guard, Lower};
+use crate::lower::{Guard, Lower, without_output_marks};
 use crate::mechanics::{self, Degenerate};
 use crate::signature::{self, Attribute, Signature};
 use crate::sphere;
@@ -25,6 +26,7 @@ pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
+            let item = crate::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }
@@ -65,17 +67,27 @@ fn expand_counted(
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;
     let mut graph = Graph::default();
-    let (root, guards) = {
+    let (root, guards, outputs) = {
         let mut lower = Lower::new(&mut graph, &sig);
         let root = lower.body(&function.block);
         stats.lowered_nodes = lower.g.len();
         stats.graph_nodes = lower.g.len();
         stats.guards = lower.guards.len();
+        if let Some(output) = lower.outputs.first().filter(|_| sig.sphere) {
+            let span = output.name.span();
+            lower.errors.push(syn::Error::new(
+                span,
+                "named outputs are not supported with `sphere` (the generated system works in \
+                 a chart)",
+            ));
+        }
         if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
             return Err(e);
         }
-        (root, std::mem::take(&mut lower.guards))
+        let outputs = std::mem::take(&mut lower.outputs);
+        (root, std::mem::take(&mut lower.guards), outputs)
     };
+    let function = without_output_marks(&function);
     let (sig, root, guards) = if sig.sphere {
         on_sphere(&mut graph, &sig, root, guards)
     } else {
@@ -119,7 +131,9 @@ fn expand_counted(
     let reduced = mechanics::reduce(&mut graph, &mech.gradient, &flat, sig.dim, sig.order);
     stats.graph_nodes = graph.len();
     let emission = Emission::new(&function, &sig, &graph, &mech, &guards, reduced.as_ref());
-    Ok(generate(&emission))
+    let mut out = generate(&emission);
+    out.extend(outputs_impl(&emission, &outputs));
+    Ok(out)
 }
 
 /// L and its guards composed with the gnomonic chart of the sphere (`sphere`), with the
@@ -144,7 +158,8 @@ fn on_sphere(
 
 /// The generated items, in order: the function and its type (`emit::ty`), the `Lagrangian`
 /// impl (`emit::lagrangian`), the `LiftedSystem` impl with its domain check (`emit::lifted`,
-/// `emit::domain`) and, where the step reduces, the `ReducedScheme` impl (`emit::reduced`).
+/// `emit::domain`) and, where the step reduces, the `ReducedScheme` impl (`emit::reduced`);
+/// then the methods of the named outputs (`emit::outputs`).
 fn generate(e: &Emission<'_>) -> TokenStream {
     let mut out = type_and_constructor(e);
     out.extend(lagrangian_impl(e));

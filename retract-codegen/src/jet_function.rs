@@ -28,6 +28,7 @@ pub fn expand_jet_function(attr: TokenStream, item: TokenStream) -> TokenStream 
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
+            let item = crate::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }

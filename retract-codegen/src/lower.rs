@@ -4,7 +4,8 @@
 //! unary minus, parentheses; the f64 methods of [`METHODS`]; `let`, `let mut` with `=`,
 //! `+=`, `-=`, `*=`, `/=`; `const` items; `for` over integer ranges (unrolled) and over
 //! slice parameters (a run-time sum: the body may only accumulate into outer variables with
-//! `+=` / `-=`); local arrays, tuples and helper `fn`s ([`values`]). Everything else is a
+//! `+=` / `-=`); local arrays, tuples and helper `fn`s ([`values`]); named outputs
+//! ([`outputs`]). Everything else is a
 //! `syn::Error` at its span; errors are collected so the user sees all of them.
 //!
 //! Limits, each an error at its span beyond it: integers known at compile time (indices, loop
@@ -21,10 +22,12 @@ use syn::spanned::Spanned;
 use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
 use crate::graph::{Func, Graph, Id, Node, Var};
-
-mod values;
 use crate::signature::{Attribute, Kind, Signature};
 use crate::util::tidy;
+
+mod outputs;
+mod values;
+pub use outputs::{item_without_output_marks, without_output_marks};
 use values::Value;
 
 /// The supported f64 methods.
@@ -62,6 +65,17 @@ enum Binding {
     },
     /// A binding whose initialiser was already reported as an error: later uses are silent.
     Poisoned,
+}
+
+/// A named output of a Lagrangian: `#[output] let name = ...;` at the top level of its body,
+/// a number or an array, emitted as a method of the generated type.
+pub struct Output {
+    /// The name (and the method's).
+    pub name: syn::Ident,
+    /// Its components (one for a number).
+    pub ids: Vec<Id>,
+    /// Whether it is an array (`[f64; len]`) rather than a number.
+    pub array: bool,
 }
 
 /// What a guarded expression must satisfy along a trajectory.
@@ -173,6 +187,10 @@ pub struct Lower<'a> {
     inlining: usize,
     /// Names are looked up in `scopes[barrier..]` only: inside a helper, its own scopes.
     barrier: usize,
+    /// The named outputs (`#[output] let`), in order.
+    pub outputs: Vec<Output>,
+    /// Whether the statement being lowered is at the top level of the body.
+    top_level: bool,
 }
 
 impl<'a> Lower<'a> {
@@ -215,6 +233,8 @@ impl<'a> Lower<'a> {
             helpers: HashMap::new(),
             inlining: 0,
             barrier: 0,
+            outputs: Vec::new(),
+            top_level: false,
         }
     }
 
@@ -263,7 +283,14 @@ impl<'a> Lower<'a> {
         };
         self.register_helpers(&block.stmts);
         for stmt in init {
+            self.top_level = true;
             self.stmt(stmt);
+            self.top_level = false;
+            if let Stmt::Local(local) = stmt
+                && outputs::is_output(local)
+            {
+                self.record_output(local);
+            }
         }
         match last {
             Stmt::Expr(e, None) => self.expr(e),
@@ -291,6 +318,7 @@ impl<'a> Lower<'a> {
     }
 
     fn block(&mut self, block: &Block) {
+        let top_level = std::mem::replace(&mut self.top_level, false);
         self.scopes.push(HashMap::new());
         self.register_helpers(&block.stmts);
         for stmt in &block.stmts {
@@ -305,11 +333,19 @@ impl<'a> Lower<'a> {
             }
         }
         self.scopes.pop();
+        self.top_level = top_level;
     }
 
     fn stmt(&mut self, stmt: &Stmt) {
         match stmt {
             Stmt::Local(local) => {
+                if outputs::is_output(local) && !self.top_level {
+                    self.error(
+                        local.span(),
+                        "a named output is a `let` at the top level of the body, outside \
+                         loops and helpers",
+                    );
+                }
                 let before = self.errors.len();
                 let value = match &local.init {
                     Some(init) if init.diverge.is_none() => Some(self.value(&init.expr)),

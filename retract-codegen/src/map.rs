@@ -28,6 +28,7 @@ pub fn expand_discretization_map(attr: TokenStream, item: TokenStream) -> TokenS
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
+            let item = crate::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }

@@ -25,9 +25,12 @@ fn with_helpers(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
             m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + gravity[1],
         ]
     }
+    #[output]
     let tau = torque(q, dq, ddq, g);
+    #[output]
+    let kinetic_hint = 0.5 * (dq[0] * dq[0] + dq[1] * dq[1]);
     let zero = [0.0; 1];
-    0.5 * (tau[0] * tau[0] + torque(q, dq, ddq, g)[1].powi(2)) + zero[0]
+    0.5 * (tau[0] * tau[0] + torque(q, dq, ddq, g)[1].powi(2)) + zero[0] + 0.0 * kinetic_hint
 }
 
 /// The same, written out.
@@ -67,6 +70,12 @@ fn helpers_arrays_and_tuples_lower_like_inline_code() {
         for j in 0..2 {
             assert!((ga.x[j] - gb.x[j]).amax() < 1e-12 * scale);
         }
+        // the named outputs: L = 1/2 |tau|^2, and the number output
+        let tau = a.tau(&x, &u);
+        let l = 0.5 * (tau[0] * tau[0] + tau[1] * tau[1]);
+        assert!((l - b.lagrangian(&x, &u)).abs() < 1e-12 * scale);
+        let hint = 0.5 * x[1].norm_squared();
+        assert!((a.kinetic_hint(&x, &u) - hint).abs() < 1e-15 * (1.0 + hint));
         let (ha, hb) = (a.hessian(&x, &u), b.hessian(&x, &u));
         assert!((ha.uu - hb.uu).amax() < 1e-12 * scale);
         for j in 0..2 {

@@ -7,8 +7,8 @@ use crate::pendulum::{self, TorqueCost};
 use retract::Lagrangian;
 use retract::nalgebra::SVector;
 
-/// The torque the plant receives is the one the planner's cost penalises:
-/// L = 1/2 |tau|^2 at random jets (the formula is written twice).
+/// The torque the plant receives (the named output `tau` of the planner's Lagrangian) is the
+/// one the planner's cost penalises: L = 1/2 |tau|^2 at random jets.
 #[test]
 fn the_applied_torque_is_the_planned_one() {
     let model = TorqueCost::new(1.0, 1.0, 1.0, 1.0, 9.81);
@@ -20,20 +20,26 @@ fn the_applied_torque_is_the_planned_one() {
         (seed % 2_000_001) as f64 / 1e6 - 1.0
     };
     for _ in 0..50 {
-        let (q, dq, ddq) = (
-            [3.0 * noise(), 3.0 * noise()],
-            [2.0 * noise(), 2.0 * noise()],
-            [5.0 * noise(), 5.0 * noise()],
-        );
-        let tau = pendulum::torque(q, dq, ddq);
-        let x = [SVector::from(q), SVector::from(dq)];
-        let l = model.lagrangian(&x, &SVector::from(ddq));
+        let x = [
+            SVector::from([3.0 * noise(), 3.0 * noise()]),
+            SVector::from([2.0 * noise(), 2.0 * noise()]),
+        ];
+        let u = SVector::from([5.0 * noise(), 5.0 * noise()]);
+        let tau = model.tau(&x, &u);
+        let l = model.lagrangian(&x, &u);
         let expected = 0.5 * (tau[0] * tau[0] + tau[1] * tau[1]);
         assert!(
             (l - expected).abs() <= 1e-12 * expected.max(1.0),
             "{l} vs {expected}"
         );
     }
+    // and it is the torque, by hand for unit masses and lengths: holding the arm horizontal
+    // takes G = (3 g, g); from rest at q = 0, q'' = (1, 0) takes M's first column (5, 2)
+    let zero = SVector::zeros();
+    let held = model.tau(&[SVector::from([PI / 2.0, 0.0]), zero], &zero);
+    assert!((held[0] - 3.0 * 9.81).abs() < 1e-12 && (held[1] - 9.81).abs() < 1e-12);
+    let pushed = model.tau(&[zero, zero], &SVector::from([1.0, 0.0]));
+    assert!((pushed[0] - 5.0).abs() < 1e-12 && (pushed[1] - 2.0).abs() < 1e-12);
 }
 
 /// 300 re-plans (6 s): no re-plan fails, the pendulum ends upright at rest (to 1e-6; it

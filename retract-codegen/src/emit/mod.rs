@@ -7,7 +7,8 @@
 //! - `lifted`: the `LiftedSystem` impl (residual and Jacobians of the lifted theta-scheme);
 //! - `domain`: its `check_domain` method (the singularity guard);
 //! - `reduced`: the `ReducedScheme` impl, where the Hessian of L depends on a few jet
-//!   components only.
+//!   components only;
+//! - `outputs`: a method per named output (`#[output] let`) of the Lagrangian.
 //!
 //! `map` emits the items of `#[discretization_map]` (its own type and `DiscretizationMap`
 //! impl, from the stages `map_lift` and `map_check`).
@@ -32,6 +33,7 @@ pub(crate) mod helpers;
 pub(crate) mod lagrangian;
 pub(crate) mod lifted;
 pub(crate) mod map;
+pub(crate) mod outputs;
 pub(crate) mod reduced;
 pub(crate) mod scalar;
 pub(crate) mod ty;

@@ -292,12 +292,14 @@ impl Lower<'_> {
             scope.insert(param.ident.to_string(), binding);
         }
         let barrier = std::mem::replace(&mut self.barrier, self.scopes.len());
+        let top_level = std::mem::replace(&mut self.top_level, false);
         self.scopes.push(scope);
         self.inlining += 1;
         let value = self.helper_body(f);
         self.inlining -= 1;
         self.scopes.pop();
         self.barrier = barrier;
+        self.top_level = top_level;
         value
     }
 

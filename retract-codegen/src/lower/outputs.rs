@@ -1,0 +1,86 @@
+//! Named outputs: `#[output] let tau = ...;` at the top level of a Lagrangian's body binds a
+//! number or an array that `emit::outputs` emits as a method of the generated type. The mark
+//! is removed from the function emitted again as written (rustc does not know it).
+
+use syn::spanned::Spanned;
+use syn::{Expr, Pat, Stmt};
+
+use super::{Binding, Lower, Output};
+use crate::signature::Attribute;
+
+/// Whether a `let` is marked `#[output]`.
+pub(super) fn is_output(local: &syn::Local) -> bool {
+    local.attrs.iter().any(|a| a.path().is_ident("output"))
+}
+
+/// `function` without the `#[output]` marks of its `let`s (rustc does not know the
+/// attribute: the function is emitted again as written, without them), in its body, its
+/// loops, blocks and helpers.
+pub fn without_output_marks(function: &syn::ItemFn) -> syn::ItemFn {
+    let mut out = function.clone();
+    strip_block(&mut out.block);
+    out
+}
+
+/// `item` without the `#[output]` marks if it is a function (else as it is): the original
+/// item emitted beside the errors of a failed expansion.
+pub fn item_without_output_marks(item: proc_macro2::TokenStream) -> proc_macro2::TokenStream {
+    match syn::parse2::<syn::ItemFn>(item.clone()) {
+        Ok(function) => quote::ToTokens::into_token_stream(without_output_marks(&function)),
+        Err(_) => item,
+    }
+}
+
+fn strip_block(block: &mut syn::Block) {
+    for stmt in &mut block.stmts {
+        match stmt {
+            Stmt::Local(local) => local.attrs.retain(|a| !a.path().is_ident("output")),
+            Stmt::Item(syn::Item::Fn(f)) => strip_block(&mut f.block),
+            Stmt::Expr(Expr::ForLoop(l), _) => strip_block(&mut l.body),
+            Stmt::Expr(Expr::Block(b), _) => strip_block(&mut b.block),
+            _ => {}
+        }
+    }
+}
+
+impl Lower<'_> {
+    /// Records the named output bound by the top-level `let` `local` (just lowered).
+    pub(super) fn record_output(&mut self, local: &syn::Local) {
+        if self.sig.attribute != Attribute::Lagrangian {
+            self.error(
+                local.span(),
+                "named outputs are for `#[higher_order_lagrangian]`",
+            );
+            return;
+        }
+        let pat = match &local.pat {
+            Pat::Type(t) => &*t.pat,
+            other => other,
+        };
+        let Pat::Ident(p) = pat else {
+            self.error(
+                pat.span(),
+                "a named output binds one name: `#[output] let tau = ...;`",
+            );
+            return;
+        };
+        let (ids, array) = match self.lookup(&p.ident.to_string()) {
+            Some((_, Binding::Value { id, .. })) => (vec![id], false),
+            Some((_, Binding::Array { slot })) => (self.arrays[slot as usize].clone(), true),
+            // an error was reported where it was bound
+            _ => return,
+        };
+        if self.outputs.iter().any(|o| o.name == p.ident) {
+            self.error(
+                p.ident.span(),
+                format!("the output `{}` is named twice", p.ident),
+            );
+            return;
+        }
+        self.outputs.push(Output {
+            name: p.ident.clone(),
+            ids,
+            array,
+        });
+    }
+}

@@ -1,0 +1,31 @@
+#![allow(unused)]
+use retract::{higher_order_lagrangian, jet_function};
+
+#[higher_order_lagrangian(order = 2)]
+fn nested(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    let mut l = 0.0;
+    for i in 0..2 {
+        #[output]
+        let square = ddq[i] * ddq[i];
+        l += square;
+    }
+    #[output]
+    let (a, b) = (q[0], q[1]);
+    0.5 * l + a * b
+}
+
+#[jet_function(order = 2)]
+fn constraint(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    #[output]
+    let x = q[0];
+    x
+}
+
+#[higher_order_lagrangian(order = 2, sphere)]
+fn on_sphere(q: [f64; 3], dq: [f64; 3], ddq: [f64; 3]) -> f64 {
+    #[output]
+    let speed = dq[0] * dq[0] + dq[1] * dq[1] + dq[2] * dq[2];
+    0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1] + ddq[2] * ddq[2]) + speed
+}
+
+fn main() {}
