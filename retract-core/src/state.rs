@@ -92,7 +92,7 @@ impl<const N: usize, const K: usize> Jet<N, K> {
     }
 
     /// The jet whose flat layout is `v` $= (q, q', \dots, q^{(2k-1)})$ in blocks of $n$ (the
-    /// argument of [`LiftedSystem::legendre`](crate::LiftedSystem::legendre)); `S` $= 2nk$ is
+    /// argument of [`LiftedSystem::legendre`]); `S` $= 2nk$ is
     /// checked at compile time.
     pub fn from_vector<const S: usize>(v: &SVector<f64, S>) -> Self {
         let (lower, upper) = split::<N, K, S>(v);
