@@ -8,12 +8,17 @@
 mod common;
 
 mod bvp;
+mod car;
 mod extrapolate;
 mod inequalities;
 mod mpc;
 mod optimize;
+mod typed_data;
+
+// the car's models and U-turn, shared with the example
+#[path = "../../examples/common/car.rs"]
+mod car_models;
 
 // the double pendulum's models and receding-horizon loop, shared with the examples
 #[path = "../../examples/common/pendulum.rs"]
 mod pendulum;
-mod typed_data;

@@ -394,6 +394,61 @@ fn pole_torque(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
     0.15 * q[1].cos() * ddq[0] + 0.075 * ddq[1] + 0.15 * 9.81 * q[1].sin()
 }
 
+/// A bound on the cart force F of [`cart_pole`]: `limit - sign F >= 0`.
+#[jet_function(order = 2)]
+fn force_margin(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], limit: f64, sign: f64) -> f64 {
+    let force = 1.3 * ddq[0] + 0.15 * q[1].cos() * ddq[1] - 0.15 * q[1].sin() * dq[1] * dq[1];
+    limit - sign * force
+}
+
+/// The cart-pole swing-up (T = 2, N = 50) with its cart force bounded, |F| <= 14: the free
+/// plan exceeds the bound, the bounded one keeps it at every evaluation point (to 1e-9), still
+/// with the pole unactuated, at a higher cost, certified.
+#[test]
+fn the_cart_force_bound_holds_and_is_active() {
+    let (t_end, steps, limit) = (2.0, 50, 14.0);
+    let force = |plan: &Plan<2, 4>, i: usize| {
+        let xt = (plan.x[i] + plan.x[i + 1]) * 0.5;
+        let blocks = [
+            xt.fixed_rows::<2>(0).into_owned(),
+            xt.fixed_rows::<2>(2).into_owned(),
+        ];
+        let f = limit - ForceMargin::new(limit, 1.0).value(&blocks, &plan.u[i]);
+        (f, PoleTorque::new().value(&blocks, &plan.u[i]))
+    };
+    let (system, unactuated) = (CartPole::new(), PoleTorque::new());
+    let problem = OptimalControlProblem::new(&system, &[0.0; 4], &UPRIGHT, t_end, steps)
+        .with_equality(&unactuated);
+    let free = problem.clone().solve(PlanGuess::Spline).unwrap();
+    let (upper, lower) = (ForceMargin::new(limit, 1.0), ForceMargin::new(limit, -1.0));
+    let bounded = problem
+        .with_inequality(&upper)
+        .with_inequality(&lower)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let peak = |plan: &Plan<2, 4>| {
+        (0..steps)
+            .map(|i| force(plan, i).0.abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(peak(&free) > limit + 0.5, "free peak {}", peak(&free));
+    assert!(
+        peak(&bounded) <= limit + 1e-9,
+        "bounded peak {}",
+        peak(&bounded)
+    );
+    for i in 0..steps {
+        assert!(force(&bounded, i).1.abs() < 1e-9, "step {i}: pole torque");
+    }
+    assert!(
+        bounded.cost > free.cost,
+        "{} vs {}",
+        bounded.cost,
+        free.cost
+    );
+    assert_eq!(bounded.certificate.negative_directions, 0);
+}
+
 /// The same cart-pole with the constraint as a quadratic penalty rho/2 tau_p^2 in the cost.
 #[higher_order_lagrangian(order = 2)]
 fn penalised_cart_pole(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], rho: f64) -> f64 {
