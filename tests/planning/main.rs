@@ -13,6 +13,7 @@ mod extrapolate;
 mod inequalities;
 mod mpc;
 mod optimize;
+mod stage_systems;
 mod typed_data;
 
 // the car's models and U-turn, shared with the example

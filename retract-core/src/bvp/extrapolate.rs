@@ -257,6 +257,16 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
+        if self.stage_systems.is_some() {
+            return Err(PlanError {
+                failure: Failure::Invalid(Error::InvalidArgument {
+                    name: "stage systems",
+                    requirement: "Richardson extrapolation changes the number of steps: one \
+                                  system for all",
+                }),
+                last: None,
+            });
+        }
         let coarse = self.solve::<S, M>(guess)?;
         let steps = self.steps;
         let x2 = refine(&coarse.x, 0.0, 2 * steps + 1);

@@ -448,6 +448,8 @@ impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 /// `M` are those of the system's [`LiftedSystem`] (used for its singularity guard).
 pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize> {
     pub(super) system: &'a Sys,
+    /// One system per step ([`Self::with_stage_systems`]), else `system` at every step.
+    pub(super) stage_systems: Option<&'a [&'a Sys]>,
     pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
     pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
     pub(super) start: SVector<f64, X>,
@@ -463,6 +465,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
     fn clone(&self) -> Self {
         Self {
             system: self.system,
+            stage_systems: self.stage_systems,
             equalities: self.equalities.clone(),
             inequalities: self.inequalities.clone(),
             start: self.start,
@@ -485,6 +488,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     {
         Self {
             system,
+            stage_systems: None,
             equalities: Vec::new(),
             inequalities: Vec::new(),
             start: SVector::from_column_slice(start),
@@ -493,6 +497,23 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             steps,
             options: PlanOptions::default(),
         }
+    }
+
+    /// A Lagrangian per step: step $i$ costs $h L_i(x_{\theta,i}, u_i)$ with $L_i$ =
+    /// `systems[i]`, so its parameters can vary along the horizon (a reference $r_i$ of a
+    /// tracking cost $\tfrac12|q - r(t_{\theta,i})|^2$, a moving obstacle), one per step
+    /// (checked by [`Self::solve`]). The system given to [`Self::new`] stays the one of the
+    /// boundary checks. For a receding horizon, shift the systems with the plan
+    /// ([`Plan::shifted`]): build them for the new window. Not with
+    /// [`Self::solve_extrapolated`] (the number of steps changes there).
+    pub fn with_stage_systems(mut self, systems: &'a [&'a Sys]) -> Self {
+        self.stage_systems = Some(systems);
+        self
+    }
+
+    /// The Lagrangian of step `i`.
+    pub(super) fn system_at(&self, i: usize) -> &'a Sys {
+        self.stage_systems.map_or(self.system, |systems| systems[i])
     }
 
     /// Sets the options.
@@ -646,6 +667,17 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }));
         }
         self.system.check_parameters().map_err(invalid)?;
+        if let Some(systems) = self.stage_systems {
+            if systems.len() != self.steps {
+                return Err(invalid(Error::InvalidArgument {
+                    name: "stage systems",
+                    requirement: "one system per step",
+                }));
+            }
+            for system in systems {
+                system.check_parameters().map_err(invalid)?;
+            }
+        }
         let iterate = self.initial(guess).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {
@@ -799,7 +831,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     0.0
                 }
             });
-            crate::step::check_step_domain(self.system, &z0, &w, &options).map_err(|v| (i, v))?;
+            crate::step::check_step_domain(self.system_at(i), &z0, &w, &options)
+                .map_err(|v| (i, v))?;
         }
         Ok(())
     }

@@ -88,10 +88,11 @@ where
         ds: &[f64],
         alpha: f64,
     ) -> Option<(f64, f64)> {
-        let (h, system) = (self.dynamics.h, self.problem.system);
+        let h = self.dynamics.h;
         let (mut cost, mut violation) = (0.0, 0.0);
         let mut values = Vec::with_capacity(ds.len());
         for (i, u) in iterate.u.iter().enumerate() {
+            let system = self.problem.system_at(i);
             let xt = self.x_theta(iterate, i);
             let xb = blocks::<N, K, X>(&xt);
             cost += h * system.lagrangian(&xb, u);
@@ -120,7 +121,7 @@ where
         y: &SVector<f64, N>,
         barrier: &Barrier,
     ) -> StageModel<N, X> {
-        let (h, system) = (self.dynamics.h, self.problem.system);
+        let (h, system) = (self.dynamics.h, self.problem.system_at(i));
         let u = &iterate.u[i];
         let xt = self.x_theta(iterate, i);
         let xb = blocks::<N, K, X>(&xt);
@@ -174,12 +175,13 @@ where
         y: &[SVector<f64, N>],
         barrier: &Barrier,
     ) -> Option<Models<N, X>> {
-        let (h, system) = (self.dynamics.h, self.problem.system);
+        let h = self.dynamics.h;
         let mut stages = Vec::with_capacity(iterate.u.len());
         let inequalities = self.inequalities(iterate);
         let mut cost_gradient = Vec::with_capacity(iterate.u.len());
         let mut cost = 0.0;
         for (i, u) in iterate.u.iter().enumerate() {
+            let system = self.problem.system_at(i);
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
