@@ -10,6 +10,7 @@ mod common;
 mod bvp;
 mod car;
 mod extrapolate;
+mod free_end;
 mod inequalities;
 mod mpc;
 mod optimize;

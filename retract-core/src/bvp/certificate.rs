@@ -17,13 +17,16 @@ use crate::newton::max_abs;
 /// in $x_i$ ($0 < i < N$), $r_{x,i} = (1-\theta) d_i + \theta d_{i-1} - (\mu_i - \mu_{i-1})$
 /// with $d_i = g_{x,i} - h A^T \mu_i$; the momenta are $p_i = \mu_i - (1-\theta) d_i$ and
 /// $p_N = \mu_{N-1} + \theta d_{N-1}$ (so that $\mu_i = \theta p_i + (1-\theta) p_{i+1}$ and
-/// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). Returns the momenta and the relative
-/// stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla L|_\infty))$.
+/// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). At the components of $x_N$ that are
+/// free (`fixed` 0) the residual is $p_N + \nabla\Phi(x_N)$. Returns the momenta and the
+/// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla
+/// L|_\infty))$ (the terminal residual without the $h$).
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stages: &[StageModel<N, X>],
     gradients: &[(SVector<f64, X>, SVector<f64, N>)],
     direction: &Direction<N, X>,
+    (terminal_gradient, fixed): (&SVector<f64, X>, &SVector<f64, X>),
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
     let wt = &dynamics.poly_w;
@@ -59,10 +62,19 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         momenta.push(mu - d * (1.0 - theta));
         (mu_prev, d_prev) = (mu, d);
     }
+    // at the free components of x_N: p_N + grad Phi = 0 (a residual of size O(1), not O(h))
+    let mut terminal: f64 = 0.0;
     if steps > 0 {
-        momenta.push(mu_prev + d_prev * theta);
+        let p_end = mu_prev + d_prev * theta;
+        for r in 0..X {
+            if fixed[r] == 0.0 {
+                terminal = terminal.max((p_end[r] + terminal_gradient[r]).abs());
+            }
+        }
+        momenta.push(p_end);
     }
-    (momenta, worst / (h * (largest / h).max(1.0)))
+    let scale = (largest / h).max(1.0);
+    (momenta, (worst / (h * scale)).max(terminal / scale))
 }
 
 /// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\thinspace Z$ ($Z$ orthonormal) of
@@ -93,7 +105,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
             }
         };
         let zero = SVector::<f64, X>::zeros();
-        let d = riccati.solve_linear(dynamics, &linear, &zero, &zero);
+        let d = riccati.solve_linear(dynamics, &linear, &zero, (&zero, &zero));
         let mut out = Vec::with_capacity(dim);
         for dx in &d.dx[1..steps] {
             out.extend_from_slice(dx.as_slice());

@@ -450,6 +450,13 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     pub(super) system: &'a Sys,
     /// One system per step ([`Self::with_stage_systems`]), else `system` at every step.
     pub(super) stage_systems: Option<&'a [&'a Sys]>,
+    /// The terminal cost $\Phi(x_N)$ ([`Self::with_terminal_cost`]).
+    pub(super) terminal_cost: Option<&'a (dyn JetFunction<N, K> + Sync)>,
+    /// 1 for the components of $x_N$ the goal fixes, 0 for the free ones
+    /// ([`Self::with_free_end`]).
+    pub(super) fixed_end: SVector<f64, X>,
+    /// Components given to [`Self::with_free_end`] that are out of range (an error at solve).
+    pub(super) bad_free_end: bool,
     pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
     pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
     pub(super) start: SVector<f64, X>,
@@ -466,6 +473,9 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
         Self {
             system: self.system,
             stage_systems: self.stage_systems,
+            terminal_cost: self.terminal_cost,
+            fixed_end: self.fixed_end,
+            bad_free_end: self.bad_free_end,
             equalities: self.equalities.clone(),
             inequalities: self.inequalities.clone(),
             start: self.start,
@@ -489,6 +499,9 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Self {
             system,
             stage_systems: None,
+            terminal_cost: None,
+            fixed_end: SVector::repeat(1.0),
+            bad_free_end: false,
             equalities: Vec::new(),
             inequalities: Vec::new(),
             start: SVector::from_column_slice(start),
@@ -508,6 +521,30 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// [`Self::solve_extrapolated`] (the number of steps changes there).
     pub fn with_stage_systems(mut self, systems: &'a [&'a Sys]) -> Self {
         self.stage_systems = Some(systems);
+        self
+    }
+
+    /// Adds the terminal cost $\Phi(x_N)$ to $J$, written under `#[jet_function]` as a
+    /// function of the jet $x = (q, \dots, q^{(k-1)})$ only (its argument $q^{(k)}$ unused:
+    /// [`Self::solve`] refuses a $\Phi$ whose derivatives in it are not zero). With a goal that
+    /// fixes all of $x_N$ it is a constant; it acts on the components freed by
+    /// [`Self::with_free_end`], where the plan then satisfies $p_N = -\nabla\Phi$.
+    pub fn with_terminal_cost(mut self, phi: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
+        self.terminal_cost = Some(phi);
+        self
+    }
+
+    /// Frees the components `components` of $x_N$ (indices into the jet, blocks of $n$: $q_i$
+    /// is $i$, $q'_i$ is $n + i$, ...): the goal's values there are ignored and the plan
+    /// chooses them (with [`Self::with_terminal_cost`], to minimise $J + \Phi$; without, the
+    /// natural boundary condition $p_N = 0$ there).
+    pub fn with_free_end(mut self, components: &[usize]) -> Self {
+        for &c in components {
+            match self.fixed_end.get_mut(c) {
+                Some(f) => *f = 0.0,
+                None => self.bad_free_end = true,
+            }
+        }
         self
     }
 
@@ -667,6 +704,12 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }));
         }
         self.system.check_parameters().map_err(invalid)?;
+        if self.bad_free_end {
+            return Err(invalid(Error::InvalidArgument {
+                name: "free end",
+                requirement: "components of the jet x_N: indices below n k",
+            }));
+        }
         if let Some(systems) = self.stage_systems {
             if systems.len() != self.steps {
                 return Err(invalid(Error::InvalidArgument {
@@ -679,6 +722,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }
         }
         let iterate = self.initial(guess).map_err(invalid)?;
+        self.check_terminal_cost(&iterate).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {
             return Err(PlanError {
@@ -806,6 +850,27 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             first.as_slice(),
             last.as_slice(),
         )
+    }
+
+    /// A terminal cost must not depend on $q^{(k)}$: its derivatives in it vanish (checked at
+    /// the guess's last jet) and its value is finite there.
+    fn check_terminal_cost(&self, iterate: &Iterate<N, X>) -> Result<(), Error> {
+        let (Some(phi), Some(last)) = (self.terminal_cost, iterate.x.last()) else {
+            return Ok(());
+        };
+        let x = blocks::<N, K, X>(last);
+        let u = SVector::<f64, N>::zeros();
+        let (gradient, hessian) = (phi.gradient(&x, &u), phi.hessian(&x, &u));
+        let on_u = gradient.u.amax()
+            + hessian.uu.amax()
+            + hessian.xu.iter().map(|m| m.amax()).fold(0.0, f64::max);
+        if on_u != 0.0 || !phi.value(&x, &u).is_finite() {
+            return Err(Error::InvalidArgument {
+                name: "terminal cost",
+                requirement: "a finite function of x_N = (q, ..., q^(k-1)) only, not of q^(k)",
+            });
+        }
+        Ok(())
     }
 
     /// The singularity guard on every step ([`crate::step::check_step_domain`]): at its ends,

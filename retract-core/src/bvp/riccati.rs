@@ -13,7 +13,8 @@
 //! $h\,L(x_{\theta,i}, u_i)$ and $c_i$ the dynamics defect. The terminal constraint enters
 //! through its multiplier $\nu$: the cost-to-go is
 //! $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$ with
-//! $P_N = 0$, $s_N = 0$, $S_N = I$, over the last steps only (the tail, from step $b$): with
+//! $P_N = \nabla^2\Phi$, $s_N = \nabla\Phi$ (a terminal cost, else 0), $S_N = I$ (on the
+//! components of $x_N$ the goal fixes), over the last steps only (the tail, from step $b$): with
 //! $D = \partial \delta x_N / \partial \nu$ of the tail, $\nu = D^{-1}(r_N - S_b^T \delta
 //! x_b - e)$ is eliminated at $x_b$ (constraint-to-go) and the steps before are plain Riccati
 //! steps. $D$ is invertible from $k$ steps on (the controllability index of the chain of
@@ -215,6 +216,8 @@ pub(crate) struct Riccati<const N: usize, const X: usize> {
     sens_boundary: SMatrix<f64, X, X>,
     /// $D^{-1}$ of the tail.
     d_inv: SMatrix<f64, X, X>,
+    /// The fixed components of $x_N$ ([`Terminal::fixed`]): the terminal constraint's rows.
+    fixed: SVector<f64, X>,
     /// Negative eigenvalues of the reduced Hessian.
     pub negative: usize,
     /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
@@ -402,6 +405,30 @@ fn terminal_inverse<const X: usize>(d: &SMatrix<f64, X, X>) -> Option<(SMatrix<f
     Some((inv, negative))
 }
 
+/// The end of the horizon: the Hessian of the terminal cost $\Phi(x_N)$ (the cost-to-go
+/// $P_N$) and which components of $x_N$ are fixed by the goal (1) or free (0).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Terminal<const X: usize> {
+    pub hessian: SMatrix<f64, X, X>,
+    pub fixed: SVector<f64, X>,
+}
+
+impl<const X: usize> Terminal<X> {
+    /// A goal fixing all of $x_N$, no terminal cost.
+    #[cfg(test)]
+    pub fn fixed_end() -> Self {
+        Self {
+            hessian: SMatrix::zeros(),
+            fixed: SVector::repeat(1.0),
+        }
+    }
+
+    /// The number of fixed components (rows of the terminal constraint).
+    fn rows(&self) -> usize {
+        self.fixed.iter().filter(|f| **f != 0.0).count()
+    }
+}
+
 /// The largest condition number $\|D\|_{\max} \|D^{-1}\|_{\max}$ at which a tail's terminal
 /// system is eliminated before the first step (a longer tail is better conditioned).
 const TAIL_CONDITION: f64 = 1e6;
@@ -410,16 +437,30 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     /// The backward pass over `stages` with $\rho$ added to the diagonal of every $H_i$
     /// (inertia correction). Over the tail the cost-to-go carries $\nu$:
     /// $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$,
-    /// $S_N = I$, $S_i = (\bar A + \bar B K_i)^T S_{i+1}$, and
+    /// $S_N = I$ (on the fixed components), $S_i = (\bar A + \bar B K_i)^T S_{i+1}$, and
     /// $D = \partial \delta x_N / \partial \nu = \sum_i (\bar B^T S_{i+1})^T K_{\nu,i}$. The tail
     /// ends at the first $b \le N - k$ where $D$ is well conditioned (else at 0); there
     /// $P_b \leftarrow P_b - S_b D^{-1} S_b^T$ (the maximum over $\nu$ of the parametric
     /// cost-to-go), and the steps before are plain Riccati steps.
-    pub fn factor(dynamics: &Dynamics<N, X>, stages: &[StageModel<N, X>], rho: f64) -> Self {
+    ///
+    /// The end is `terminal`: $P_N$ its Hessian (plus $\rho$ on the diagonal), $S_N$ the
+    /// identity on the fixed components only, so that $D$ has zero rows and columns at the
+    /// free ones; there the pivot is $\tilde D = D + I_{\rm free}$, whose extra eigenvalues
+    /// are positive, and the inertia subtracts one per fixed component.
+    pub fn factor_with(
+        dynamics: &Dynamics<N, X>,
+        stages: &[StageModel<N, X>],
+        rho: f64,
+        terminal: &Terminal<X>,
+    ) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = stages.len();
-        let mut p = SMatrix::<f64, X, X>::zeros();
-        let mut sens = SMatrix::<f64, X, X>::identity();
+        let mut p = (terminal.hessian + terminal.hessian.transpose()) * 0.5;
+        for r in 0..X {
+            p[(r, r)] += rho;
+        }
+        let mut sens = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed);
+        let free = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed.map(|f| 1.0 - f));
         let mut factors = Vec::with_capacity(steps);
         let mut tail = Vec::with_capacity(X / N);
         let mut negative = 0;
@@ -454,8 +495,9 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 // vanishes: Pi (Q_ux + Q_uu K) = 0)
                 sens = a.left_t(&sens) + k.transpose() * bts;
                 if j + 1 >= X / N && j + 1 < steps {
-                    let conditioned = terminal_inverse(&d)
-                        .filter(|(inv, _)| d.amax() * inv.amax() <= TAIL_CONDITION);
+                    let pivot = d + free;
+                    let conditioned = terminal_inverse(&pivot)
+                        .filter(|(inv, _)| pivot.amax() * inv.amax() <= TAIL_CONDITION);
                     if let Some((d_inv, neg_d)) = conditioned {
                         negative += neg_d;
                         let p_new = p - sens * d_inv * sens.transpose();
@@ -466,7 +508,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             }
             factors.push(factor);
         }
-        let d_inv = eliminated.unwrap_or_else(|| match terminal_inverse(&d) {
+        let d_inv = eliminated.unwrap_or_else(|| match terminal_inverse(&(d + free)) {
             Some((d_inv, neg_d)) => {
                 negative += neg_d;
                 d_inv
@@ -481,7 +523,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             tail,
             sens_boundary: sens,
             d_inv,
-            negative: negative.saturating_sub(X),
+            fixed: terminal.fixed,
+            negative: negative.saturating_sub(terminal.rows()),
             singular,
         }
     }
@@ -507,14 +550,15 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// Solves the subproblem for the model `stages` (the same Hessians as in
-    /// [`Self::factor`]), with $\delta x_0 = $ `r0`, $\delta x_N = $ `r_end`.
+    /// [`Self::factor_with`]), with $\delta x_0 = $ `r0`, $\delta x_N = $ `r_end` on the fixed
+    /// components and the terminal cost's gradient `s_end` $= \nabla\Phi(x_N)$.
     pub fn solve(
         &self,
         dynamics: &Dynamics<N, X>,
         stages: &[StageModel<N, X>],
         rho: f64,
         r0: &SVector<f64, X>,
-        r_end: &SVector<f64, X>,
+        (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
     ) -> Direction<N, X> {
         let theta = dynamics.theta;
         let linear = |i: usize| {
@@ -529,7 +573,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 constraint: stage.value + stage.cx * offset,
             }
         };
-        self.solve_linear(dynamics, &linear, r0, r_end)
+        self.solve_linear(dynamics, &linear, r0, (r_end, s_end))
     }
 
     /// The subproblem's solution for the stage linear terms, defects and constraint offsets
@@ -543,12 +587,12 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         dynamics: &Dynamics<N, X>,
         linear: &impl Fn(usize) -> StageLinear<N, X>,
         r0: &SVector<f64, X>,
-        r_end: &SVector<f64, X>,
+        (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let backward = self.backward(dynamics, linear, r_end);
+        let backward = self.backward(dynamics, linear, r_end, s_end);
         let mut d = Direction {
             dx: Vec::with_capacity(steps + 1),
             du: Vec::with_capacity(steps),
@@ -567,9 +611,10 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         {
             let tail = (i >= boundary).then(|| self.tail_factor(i));
             if i == boundary {
-                nu = self.d_inv * (r_end - self.terminal(dynamics, &backward, &x, None));
+                let gap = r_end - self.terminal(dynamics, &backward, &x, None);
+                nu = self.d_inv * gap.component_mul(&self.fixed);
                 let x_end = self.terminal(dynamics, &backward, &x, Some(&nu));
-                let miss = r_end - x_end;
+                let miss = (r_end - x_end).component_mul(&self.fixed);
                 if miss.amax() > 1e-12 * (1.0 + r_end.amax() + x_end.amax()) {
                     nu += self.d_inv * miss;
                 }
@@ -608,12 +653,13 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         dynamics: &Dynamics<N, X>,
         linear: &impl Fn(usize) -> StageLinear<N, X>,
         r_end: &SVector<f64, X>,
+        s_end: &SVector<f64, X>,
     ) -> Vec<Backward<N, X>> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
         let mut out = Vec::with_capacity(steps);
-        let mut s = SVector::<f64, X>::zeros();
+        let mut s = *s_end;
         for i in (0..steps).rev() {
             let f = self.step_factor(i);
             let l = linear(i);
@@ -640,7 +686,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             if i == boundary && i > 0 {
                 // the tail's entries are the ones pushed so far, last step first
                 let x_end = self.tail_terminal(dynamics, out.iter().rev(), i);
-                s += self.sens_boundary * (self.d_inv * (r_end - x_end));
+                let gap = (r_end - x_end).component_mul(&self.fixed);
+                s += self.sens_boundary * (self.d_inv * gap);
             }
         }
         out
@@ -749,83 +796,114 @@ mod tests {
                 .collect();
             let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
             let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-            let riccati = Riccati::factor(&dynamics, &stages, 0.0);
-            assert!(!riccati.singular);
-            assert_eq!(riccati.boundary() > 0, steps > 2);
-            let d = riccati.solve(&dynamics, &stages, 0.0, &r0, &r_end);
-            // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
-            let nv = (steps + 1) * X + steps * N;
-            let nc = (steps + 2) * X;
-            let xc = |i: usize| i * X;
-            let uc = |i: usize| (steps + 1) * X + i * N;
-            let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
-            let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
-            let theta = dynamics.theta;
-            for (i, s) in stages.iter().enumerate() {
-                let mut t = DMatrix::<f64>::zeros(6, nv);
-                for r in 0..X {
-                    t[(r, xc(i) + r)] = 1.0 - theta;
-                    t[(r, xc(i + 1) + r)] = theta;
-                }
-                for a in 0..N {
-                    t[(4 + a, uc(i) + a)] = 1.0;
-                }
-                let mut h = DMatrix::<f64>::zeros(6, 6);
-                h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
-                h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
-                h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
-                h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
-                let g =
-                    nalgebra::DVector::from_iterator(6, s.gx.iter().chain(s.gu.iter()).copied());
-                let block = t.transpose() * h * &t;
-                let mut view = kkt.view_mut((0, 0), (nv, nv));
-                view += block;
-                let mut top = rhs.rows_mut(0, nv);
-                top -= t.transpose() * g;
-                // x_{i+1} - A x_i - B u_i = c_i
-                let row = nv + (i + 1) * X;
-                for r in 0..X {
-                    kkt[(row + r, xc(i + 1) + r)] = 1.0;
-                    for c in 0..X {
-                        kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+            // the goal fixing all of x_N; then q' free with a terminal cost
+            for free_end in [false, true] {
+                let (terminal, s_end) = if free_end {
+                    let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
+                    let terminal = Terminal {
+                        hessian: m * m.transpose() + SMatrix::<f64, X, X>::identity() * shift,
+                        fixed: SVector::from([1.0, 1.0, 0.0, 0.0]),
+                    };
+                    (
+                        terminal,
+                        SVector::<f64, X>::from_fn(|_, _| noise(&mut seed)),
+                    )
+                } else {
+                    (Terminal::fixed_end(), SVector::zeros())
+                };
+                let free = X - terminal.rows();
+                let riccati = Riccati::factor_with(&dynamics, &stages, 0.0, &terminal);
+                assert!(!riccati.singular);
+                assert_eq!(riccati.boundary() > 0, steps > 2);
+                let d = riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end));
+                // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
+                let nv = (steps + 1) * X + steps * N;
+                let nc = (steps + 2) * X;
+                let xc = |i: usize| i * X;
+                let uc = |i: usize| (steps + 1) * X + i * N;
+                let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
+                let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
+                let theta = dynamics.theta;
+                for (i, s) in stages.iter().enumerate() {
+                    let mut t = DMatrix::<f64>::zeros(6, nv);
+                    for r in 0..X {
+                        t[(r, xc(i) + r)] = 1.0 - theta;
+                        t[(r, xc(i + 1) + r)] = theta;
                     }
                     for a in 0..N {
-                        kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                        t[(4 + a, uc(i) + a)] = 1.0;
                     }
-                    rhs[row + r] = s.defect[r];
+                    let mut h = DMatrix::<f64>::zeros(6, 6);
+                    h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
+                    h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
+                    h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
+                    h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
+                    let g = nalgebra::DVector::from_iterator(
+                        6,
+                        s.gx.iter().chain(s.gu.iter()).copied(),
+                    );
+                    let block = t.transpose() * h * &t;
+                    let mut view = kkt.view_mut((0, 0), (nv, nv));
+                    view += block;
+                    let mut top = rhs.rows_mut(0, nv);
+                    top -= t.transpose() * g;
+                    // x_{i+1} - A x_i - B u_i = c_i
+                    let row = nv + (i + 1) * X;
+                    for r in 0..X {
+                        kkt[(row + r, xc(i + 1) + r)] = 1.0;
+                        for c in 0..X {
+                            kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+                        }
+                        for a in 0..N {
+                            kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                        }
+                        rhs[row + r] = s.defect[r];
+                    }
                 }
-            }
-            for r in 0..X {
-                kkt[(nv + r, xc(0) + r)] = 1.0;
-                rhs[nv + r] = r0[r];
-                kkt[(nv + (steps + 1) * X + r, xc(steps) + r)] = 1.0;
-                rhs[nv + (steps + 1) * X + r] = r_end[r];
-            }
-            for r in nv..nv + nc {
-                for c in 0..nv {
-                    kkt[(c, r)] = kkt[(r, c)];
-                }
-            }
-            // the KKT matrix has nc + neg(Z^T H Z) negative eigenvalues
-            let eigenvalues = SymmetricEigen::new(kkt.clone()).eigenvalues;
-            let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
-            assert_eq!(
-                riccati.negative,
-                negative - nc,
-                "{steps} steps, shift {shift}"
-            );
-            if shift > 0.0 {
-                assert!(riccati.positive_definite());
-            }
-            let sol = kkt.lu().solve(&rhs).unwrap();
-            for i in 0..=steps {
+                // the terminal cost on x_N; a free component's row pins its multiplier to 0
                 for r in 0..X {
-                    assert!((d.dx[i][r] - sol[xc(i) + r]).abs() < 1e-9, "dx[{i}][{r}]");
+                    for c in 0..X {
+                        kkt[(xc(steps) + r, xc(steps) + c)] += terminal.hessian[(r, c)];
+                    }
+                    rhs[xc(steps) + r] -= s_end[r];
                 }
-            }
-            for i in 0..steps {
-                for a in 0..N {
-                    assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
+                for r in 0..X {
+                    kkt[(nv + r, xc(0) + r)] = 1.0;
+                    rhs[nv + r] = r0[r];
+                    let row = nv + (steps + 1) * X + r;
+                    if terminal.fixed[r] == 0.0 {
+                        kkt[(row, row)] = 1.0;
+                    } else {
+                        kkt[(row, xc(steps) + r)] = 1.0;
+                        rhs[row] = r_end[r];
+                    }
+                }
+                for r in nv..nv + nc {
+                    for c in 0..nv {
+                        kkt[(c, r)] = kkt[(r, c)];
+                    }
+                }
+                // the KKT matrix has nc + neg(Z^T H Z) negative eigenvalues
+                let eigenvalues = SymmetricEigen::new(kkt.clone()).eigenvalues;
+                let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
+                assert_eq!(
+                    riccati.negative,
+                    negative - (nc - free),
+                    "{steps} steps, shift {shift}, free end {free_end}"
+                );
+                if shift > 0.0 {
+                    assert!(riccati.positive_definite());
+                }
+                let sol = kkt.lu().solve(&rhs).unwrap();
+                for i in 0..=steps {
+                    for r in 0..X {
+                        assert!((d.dx[i][r] - sol[xc(i) + r]).abs() < 1e-9, "dx[{i}][{r}]");
+                    }
+                }
+                for i in 0..steps {
+                    for a in 0..N {
+                        assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
+                    }
                 }
             }
         }

@@ -11,7 +11,8 @@ use super::constraints::{Linearized, flat_hessian};
 use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
-use super::riccati::{Direction, Dynamics, Riccati, StageModel};
+use super::riccati::{Direction, Dynamics, Riccati, StageModel, Terminal};
+use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
 
 /// One run of the SQP iteration.
@@ -45,6 +46,10 @@ struct Models<const N: usize, const X: usize> {
     cost_gradient: Vec<(SVector<f64, X>, SVector<f64, N>)>,
     /// $\sum |g - s|$ and $\max |g - s|$ over the inequalities.
     slack_violation: (f64, f64),
+    /// The end: the terminal cost's Hessian and the fixed components of $x_N$.
+    terminal: Terminal<X>,
+    /// $\nabla\Phi(x_N)$ (zero without a terminal cost).
+    terminal_gradient: SVector<f64, X>,
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
@@ -103,10 +108,13 @@ where
             values.extend(self.problem.inequalities.iter().map(|c| c.value(&xt, u)));
         }
         let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
+        let last = &iterate.x[iterate.x.len() - 1];
         violation += slack
             + (self.problem.start - iterate.x[0]).lp_norm(1)
-            + (self.problem.goal - iterate.x[iterate.x.len() - 1]).lp_norm(1);
-        let cost = cost + log;
+            + (self.problem.goal - last)
+                .component_mul(&self.problem.fixed_end)
+                .lp_norm(1);
+        let cost = cost + log + self.terminal_value(last);
         (cost.is_finite() && violation.is_finite()).then_some((cost, violation))
     }
 
@@ -205,20 +213,46 @@ where
             }
         }
         let r0 = self.problem.start - iterate.x[0];
-        let r_end = self.problem.goal - iterate.x[iterate.x.len() - 1];
+        let last = &iterate.x[iterate.x.len() - 1];
+        let fixed = self.problem.fixed_end;
+        let r_end = (self.problem.goal - last).component_mul(&fixed);
         let (log, slack_l1) = barrier.current_terms(&inequalities, h);
         let slack_violation = (slack_l1, barrier.residual(&inequalities));
+        let (phi, terminal_gradient, hessian) = self.terminal_model(last);
+        let cost = cost + phi;
         let barrier_cost = cost + log;
-        barrier_cost.is_finite().then_some(Models {
-            stages,
-            cost,
-            barrier_cost,
-            r0,
-            r_end,
-            inequalities,
-            cost_gradient,
-            slack_violation,
+        (barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian))
+            .then_some(Models {
+                stages,
+                cost,
+                barrier_cost,
+                r0,
+                r_end,
+                inequalities,
+                cost_gradient,
+                slack_violation,
+                terminal: Terminal { hessian, fixed },
+                terminal_gradient,
+            })
+    }
+
+    /// $\Phi(x_N)$ (0 without a terminal cost).
+    fn terminal_value(&self, last: &SVector<f64, X>) -> f64 {
+        self.problem.terminal_cost.map_or(0.0, |phi| {
+            phi.value(&blocks::<N, K, X>(last), &SVector::zeros())
         })
+    }
+
+    /// $\Phi(x_N)$, its gradient and its Hessian in $x_N$ (zeros without a terminal cost).
+    fn terminal_model(&self, last: &SVector<f64, X>) -> (f64, SVector<f64, X>, SMatrix<f64, X, X>) {
+        let Some(phi) = self.problem.terminal_cost else {
+            return (0.0, SVector::zeros(), SMatrix::zeros());
+        };
+        let (x, u) = (blocks::<N, K, X>(last), SVector::<f64, N>::zeros());
+        let g = phi.gradient(&x, &u);
+        let (hxx, _, _) = flat_hessian::<N, K, X>(&phi.hessian(&x, &u), 1.0);
+        let gradient = SVector::from_fn(|r, _| g.x[r / N][r % N]);
+        (phi.value(&x, &u), gradient, hxx)
     }
 
     /// Every inequality linearised at every step (step-major).
@@ -247,14 +281,16 @@ where
     fn factor_corrected(&self, models: &Models<N, X>, last: f64) -> Option<(Riccati<N, X>, f64)> {
         let h = self.dynamics.h;
         if last < 1e-8 {
-            let riccati = Riccati::factor(&self.dynamics, &models.stages, 0.0);
+            let riccati =
+                Riccati::factor_with(&self.dynamics, &models.stages, 0.0, &models.terminal);
             if riccati.positive_definite() {
                 return Some((riccati, 0.0));
             }
         }
         let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
         while rho < 1e40 {
-            let riccati = Riccati::factor(&self.dynamics, &models.stages, h * rho);
+            let riccati =
+                Riccati::factor_with(&self.dynamics, &models.stages, h * rho, &models.terminal);
             if riccati.positive_definite() {
                 return Some((riccati, rho));
             }
@@ -284,8 +320,9 @@ where
         } else {
             &models.cost_gradient
         };
+        let end = (&models.terminal_gradient, &models.terminal.fixed);
         let (momenta, stationarity) =
-            kkt_residuals(&self.dynamics, &models.stages, gradients, direction);
+            kkt_residuals(&self.dynamics, &models.stages, gradients, direction, end);
         let certificate = Certificate {
             stationarity,
             feasibility: models.violation_max(),
@@ -385,7 +422,7 @@ where
                 &models.stages,
                 h * rho,
                 &models.r0,
-                &models.r_end,
+                (&models.r_end, &models.terminal_gradient),
             );
             let (momenta, certificate) =
                 self.residuals(&models, &barrier, riccati.negative, &direction);
@@ -493,16 +530,18 @@ where
         let refactored;
         let exact = if barrier.count > 0 {
             let stages = self.active_set_models(iterate, y, barrier, &models.inequalities);
-            refactored = Riccati::factor(
+            refactored = Riccati::factor_with(
                 &self.dynamics,
                 stages.as_deref().unwrap_or(&models.stages),
                 0.0,
+                &models.terminal,
             );
             &refactored
         } else if let Some(riccati) = factored {
             riccati
         } else {
-            refactored = Riccati::factor(&self.dynamics, &models.stages, 0.0);
+            refactored =
+                Riccati::factor_with(&self.dynamics, &models.stages, 0.0, &models.terminal);
             &refactored
         };
         certificate.negative_directions = exact.negative;
@@ -512,7 +551,8 @@ where
             };
             return Err((failure, certificate));
         }
-        if self.problem.options.min_eigenvalue {
+        // (the Lanczos operator takes x_N as fixed)
+        if self.problem.options.min_eigenvalue && models.terminal.fixed.iter().all(|f| *f != 0.0) {
             certificate.min_reduced_hessian_eig =
                 min_reduced_eigenvalue(exact, &self.dynamics, self.problem.steps);
         }
