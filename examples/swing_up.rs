@@ -117,7 +117,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let plan = problem.solve(PlanGuess::Spline)?;
     let ms = start.elapsed().as_secs_f64() * 1e3;
     report(&format!("cart-pole |F|<={limit}"), 2.0, 200, &plan, ms);
-    let acrobot = ElbowCost::new(1.0, 1.0, 1.0, 9.81);
+    let acrobot = ElbowCost::new(1.0, 1.0, 1.0, 1.0, 9.81);
     let passive = ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, 9.81);
     // each horizon after the first starts from the previous plan stretched in time (from the
     // smoothstep guess T = 4 does not converge)

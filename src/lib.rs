@@ -56,6 +56,38 @@ pub use retract_macros::higher_order_lagrangian;
 #[doc(inline)]
 pub use retract_macros::jet_function;
 
+/// A runnable example: one torque formula shared by a cost and a constraint.
+/// ```
+/// use retract::nalgebra::SVector;
+/// use retract::{JetFunction, Lagrangian, helper, higher_order_lagrangian, jet_function};
+///
+/// /// The torques of a point mass on two joints (a toy M(q) q'' + G(q)).
+/// #[helper]
+/// fn torque(q: [f64; 2], ddq: [f64; 2]) -> [f64; 2] {
+///     [2.0 * ddq[0] + q[1].cos() * ddq[1] + q[0].sin(), ddq[1] + q[1].sin()]
+/// }
+///
+/// /// The effort: L = 1/2 |tau|^2.
+/// #[higher_order_lagrangian(order = 2, helpers = [torque])]
+/// fn effort(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+///     let tau = torque(q, ddq);
+///     0.5 * (tau[0] * tau[0] + tau[1] * tau[1])
+/// }
+///
+/// /// The first joint passive.
+/// #[jet_function(order = 2, helpers = [torque])]
+/// fn shoulder(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+///     torque(q, ddq)[0]
+/// }
+///
+/// let (x, u) = ([SVector::from([0.3, 0.1]), SVector::zeros()], SVector::from([1.0, 2.0]));
+/// let t = torque([0.3, 0.1], [1.0, 2.0]); // still a plain function
+/// assert!((Effort.lagrangian(&x, &u) - 0.5 * (t[0] * t[0] + t[1] * t[1])).abs() < 1e-14);
+/// assert!((Shoulder.value(&x, &u) - t[0]).abs() < 1e-15);
+/// ```
+#[doc(inline)]
+pub use retract_macros::helper;
+
 /// A runnable example: the symmetric "bent midpoint" map lifted to order 2, stepping the
 /// Pais-Uhlenbeck oscillator with [`map::step`].
 ///
@@ -100,4 +132,5 @@ pub mod __private {
     pub use retract_core;
     pub use retract_core::Float;
     pub use retract_core::nalgebra;
+    pub use retract_macros::expand_with_helpers;
 }

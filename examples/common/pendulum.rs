@@ -18,7 +18,9 @@ use std::time::Instant;
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
 use retract::forced::forced_step;
 use retract::nalgebra::SVector;
-use retract::{Lagrangian, LiftedSystem, StepOptions, higher_order_lagrangian, jet_function};
+use retract::{
+    Lagrangian, LiftedSystem, StepOptions, helper, higher_order_lagrangian, jet_function,
+};
 
 /// Horizon steps.
 pub const STEPS: usize = 50;
@@ -33,9 +35,36 @@ const L1: f64 = 1.0;
 const L2: f64 = 1.0;
 const G: f64 = 9.81;
 
-/// The planner's model: L = 1/2 |tau|^2 with tau = M(q) q'' + C(q, q') q' + G(q), angles from
-/// the downward vertical, the second relative to the first (point masses at the rod ends).
-#[higher_order_lagrangian(order = 2)]
+/// The torques tau = M(q) q'' + C(q, q') q' + G(q) of the double pendulum, angles from the
+/// downward vertical, the second relative to the first (point masses at the rod ends): one
+/// formula for the planner's cost, the acrobot's cost and its constraint.
+#[helper]
+pub fn torque(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+) -> [f64; 2] {
+    let c2 = q[1].cos();
+    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
+    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
+    let m22 = m2 * l2 * l2;
+    let b = m2 * l1 * l2 * q[1].sin();
+    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
+    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
+    [
+        m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1,
+        m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2,
+    ]
+}
+
+/// The planner's model: L = 1/2 |tau|^2 ([`torque`]), with tau also a method
+/// (`TorqueCost::tau(&self, x, u)`: the torque a plan asks of the plant).
+#[higher_order_lagrangian(order = 2, helpers = [torque])]
 pub fn torque_cost(
     q: [f64; 2],
     dq: [f64; 2],
@@ -46,46 +75,29 @@ pub fn torque_cost(
     l2: f64,
     g: f64,
 ) -> f64 {
-    let c2 = q[1].cos();
-    let s2 = q[1].sin();
-    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
-    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
-    let m22 = m2 * l2 * l2;
-    let b = m2 * l1 * l2 * s2;
-    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
-    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
-    // (also a method, `TorqueCost::tau(&self, x, u)`: the torque a plan asks of the plant)
     #[output]
-    let tau = [
-        m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1,
-        m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2,
-    ];
+    let tau = torque(q, dq, ddq, m1, m2, l1, l2, g);
     0.5 * (tau[0] * tau[0] + tau[1] * tau[1])
 }
 
-/// The acrobot's cost: only the elbow is actuated, L = 1/2 tau_2^2 (tau as in
-/// [`torque_cost`]); the shoulder's torque is constrained to zero by [`shoulder_torque`].
-#[higher_order_lagrangian(order = 2)]
+/// The acrobot's cost: only the elbow is actuated, L = 1/2 tau_2^2; the shoulder's torque is
+/// constrained to zero by [`shoulder_torque`].
+#[higher_order_lagrangian(order = 2, helpers = [torque])]
 pub fn elbow_cost(
     q: [f64; 2],
     dq: [f64; 2],
     ddq: [f64; 2],
+    m1: f64,
     m2: f64,
     l1: f64,
     l2: f64,
     g: f64,
 ) -> f64 {
-    let c2 = q[1].cos();
-    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
-    let m22 = m2 * l2 * l2;
-    let b = m2 * l1 * l2 * q[1].sin();
-    let g2 = m2 * g * l2 * (q[0] + q[1]).sin();
-    let tau2 = m12 * ddq[0] + m22 * ddq[1] + b * dq[0] * dq[0] + g2;
-    0.5 * tau2 * tau2
+    0.5 * torque(q, dq, ddq, m1, m2, l1, l2, g)[1].powi(2)
 }
 
-/// The acrobot's passive shoulder: tau_1 = 0 at every step (tau_1 as in [`torque_cost`]).
-#[jet_function(order = 2)]
+/// The acrobot's passive shoulder: tau_1 = 0 at every step.
+#[jet_function(order = 2, helpers = [torque])]
 pub fn shoulder_torque(
     q: [f64; 2],
     dq: [f64; 2],
@@ -96,12 +108,7 @@ pub fn shoulder_torque(
     l2: f64,
     g: f64,
 ) -> f64 {
-    let c2 = q[1].cos();
-    let m11 = (m1 + m2) * l1 * l1 + m2 * l2 * l2 + 2.0 * m2 * l1 * l2 * c2;
-    let m12 = m2 * l2 * l2 + m2 * l1 * l2 * c2;
-    let b = m2 * l1 * l2 * q[1].sin();
-    let g1 = (m1 + m2) * g * l1 * q[0].sin() + m2 * g * l2 * (q[0] + q[1]).sin();
-    m11 * ddq[0] + m12 * ddq[1] - b * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1
+    torque(q, dq, ddq, m1, m2, l1, l2, g)[0]
 }
 
 /// The plant: L = T - V of the same pendulum, T = 1/2 q'^T M(q) q',

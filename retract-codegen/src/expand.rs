@@ -64,6 +64,10 @@ fn expand_counted(
     item: TokenStream,
     stats: &mut ExpansionStats,
 ) -> syn::Result<TokenStream> {
+    let helpers = crate::helper::helper_names(&attr)?;
+    if !helpers.is_empty() {
+        return Ok(crate::helper::chain(&helpers, "lagrangian", &attr, &item));
+    }
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;
     let mut graph = Graph::default();

@@ -37,6 +37,10 @@ pub fn expand_jet_function(attr: TokenStream, item: TokenStream) -> TokenStream 
 /// The expansion of `#[jet_function(attr)] item`, or the errors of the input combined into
 /// one `syn::Error`.
 pub fn try_expand_jet_function(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
+    let helpers = crate::helper::helper_names(&attr)?;
+    if !helpers.is_empty() {
+        return Ok(crate::helper::chain(&helpers, "jet_function", &attr, &item));
+    }
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::JetFunction)?;
     let mut graph = Graph::default();

@@ -21,6 +21,7 @@ mod diff;
 mod emit;
 mod expand;
 mod graph;
+mod helper;
 mod jet_function;
 mod lower;
 mod map;
@@ -35,5 +36,6 @@ mod util;
 pub mod samples;
 
 pub use expand::{ExpansionStats, expand, expansion_stats, try_expand};
+pub use helper::{expand_helper, expand_with_helpers};
 pub use jet_function::{expand_jet_function, try_expand_jet_function};
 pub use map::{expand_discretization_map, try_expand_discretization_map};

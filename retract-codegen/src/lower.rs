@@ -29,6 +29,7 @@ mod outputs;
 mod values;
 pub use outputs::{item_without_output_marks, without_output_marks};
 use values::Value;
+pub(crate) use values::helper_signature_problem;
 
 /// The supported f64 methods.
 pub const METHODS: &str = "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, \

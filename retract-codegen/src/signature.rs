@@ -150,6 +150,10 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         } else if meta.path.is_ident("name") {
             options.name = Some(meta.value()?.parse()?);
             Ok(())
+        } else if meta.path.is_ident("helpers") && attribute != Attribute::Map {
+            // (read by `helper::helper_names`; here only skipped)
+            let _: syn::Expr = meta.value()?.parse()?;
+            Ok(())
         } else if meta.path.is_ident("guard") && attribute == Attribute::Lagrangian {
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;

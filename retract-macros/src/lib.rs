@@ -85,3 +85,23 @@ pub fn jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
 pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand_discretization_map(attr.into(), item.into()).into()
 }
+
+/// Marks a helper function that Lagrangians and stage constraints of the same crate may call:
+/// `#[helper] fn torque(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> [f64; 2] { ... }`, then
+/// `#[higher_order_lagrangian(order = 2, helpers = [torque])]` (or `#[jet_function(...)]`) on
+/// each function that calls it. The helper's arguments are `f64` or `[f64; n]`, it returns an
+/// `f64`, an array or a tuple of them, and its body is what a Lagrangian may contain; each
+/// call is inlined, so the derivatives see through it. The function stays callable. A helper
+/// is visible to the items after it in its module (it travels as a `macro_rules!` of the same
+/// name).
+#[proc_macro_attribute]
+pub fn helper(attr: TokenStream, item: TokenStream) -> TokenStream {
+    retract_codegen::expand_helper(attr.into(), item.into()).into()
+}
+
+/// The end of a `helpers = [...]` chain (generated code only; see [`macro@helper`]).
+#[doc(hidden)]
+#[proc_macro]
+pub fn expand_with_helpers(input: TokenStream) -> TokenStream {
+    retract_codegen::expand_with_helpers(input.into()).into()
+}

@@ -279,7 +279,7 @@ fn the_acrobot_swings_up_with_a_passive_shoulder() {
     let goal = [PI, 0.0, 0.0, 0.0];
     let passive = ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, 9.81);
     let plan = OptimalControlProblem::new(
-        &ElbowCost::new(1.0, 1.0, 1.0, 9.81),
+        &ElbowCost::new(1.0, 1.0, 1.0, 1.0, 9.81),
         &[0.0; 4],
         &goal,
         t_end,

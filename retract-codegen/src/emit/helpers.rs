@@ -105,7 +105,7 @@ pub(crate) fn allow_generated() -> TokenStream {
 
 /// The annotated function as it is re-emitted: the generated code does not call it; it
 /// stays for users to call.
-fn callable(function: &ItemFn) -> ItemFn {
+pub(crate) fn callable(function: &ItemFn) -> ItemFn {
     let mut function = function.clone();
     function.block.stmts.insert(
         0,

@@ -77,7 +77,7 @@ impl Lower<'_> {
                 continue;
             };
             let name = f.sig.ident.to_string();
-            if let Some(problem) = unsupported_signature(&f.sig) {
+            if let Some(problem) = helper_signature_problem(&f.sig) {
                 self.error(problem.0, problem.1);
                 continue;
             }
@@ -341,7 +341,9 @@ impl Lower<'_> {
 }
 
 /// Why a helper's signature is not supported (at its span), if it is not.
-fn unsupported_signature(sig: &syn::Signature) -> Option<(proc_macro2::Span, String)> {
+pub(crate) fn helper_signature_problem(
+    sig: &syn::Signature,
+) -> Option<(proc_macro2::Span, String)> {
     if !sig.generics.params.is_empty() || sig.asyncness.is_some() || sig.variadic.is_some() {
         return Some((
             sig.span(),
