@@ -1,5 +1,5 @@
-//! Terminal costs and free end components, against closed-form optima of the double
-//! integrator (L = 1/2 q''^2, T = 1, from rest at 0).
+//! Terminal costs and free end and start components, against closed-form optima of the
+//! double integrator (L = 1/2 q''^2, T = 1).
 
 use retract::bvp::{Failure, OptimalControlProblem, PlanGuess};
 use retract::{higher_order_lagrangian, jet_function};
@@ -75,6 +75,27 @@ fn a_terminal_cost_on_a_free_end_balances_effort_and_miss() {
     }
     order_two(&cost_errors);
     order_two(&end_errors);
+}
+
+/// The time reversal of the natural cubic: q(0) = 0 with q'(0) free to q(1) = 1 at rest gives
+/// J = 3/2 again (at order 2), with p_1(0) = 0.
+#[test]
+fn a_free_start_velocity_gives_the_reversed_cubic() {
+    let mut errors = Vec::new();
+    for steps in [20, 40, 80] {
+        let plan = OptimalControlProblem::new(&Effort, &[0.0, -7.0], &[1.0, 0.0], 1.0, steps)
+            .with_free_start(&[1])
+            .solve(PlanGuess::Spline)
+            .unwrap();
+        assert!(plan.x[0][0].abs() < 1e-12, "q(0) = {}", plan.x[0][0]);
+        assert!(
+            plan.momenta[0][1].abs() < 1e-8,
+            "p_1(0) = {}",
+            plan.momenta[0][1]
+        );
+        errors.push((plan.cost - 1.5).abs());
+    }
+    order_two(&errors);
 }
 
 /// A terminal cost of the top derivative and a component out of range are invalid inputs.

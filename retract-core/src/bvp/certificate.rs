@@ -18,7 +18,8 @@ use crate::newton::max_abs;
 /// with $d_i = g_{x,i} - h A^T \mu_i$; the momenta are $p_i = \mu_i - (1-\theta) d_i$ and
 /// $p_N = \mu_{N-1} + \theta d_{N-1}$ (so that $\mu_i = \theta p_i + (1-\theta) p_{i+1}$ and
 /// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). At the components of $x_N$ that are
-/// free (`fixed` 0) the residual is $p_N + \nabla\Phi(x_N)$. Returns the momenta and the
+/// free (`fixed` 0) the residual is $p_N + \nabla\Phi(x_N)$, at the free ones of $x_0$
+/// (`start_fixed` 0) it is $p_0$. Returns the momenta and the
 /// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla
 /// L|_\infty))$ (the terminal residual without the $h$).
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
@@ -26,7 +27,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     stages: &[StageModel<N, X>],
     gradients: &[(SVector<f64, X>, SVector<f64, N>)],
     direction: &Direction<N, X>,
-    (terminal_gradient, fixed): (&SVector<f64, X>, &SVector<f64, X>),
+    (terminal_gradient, fixed, start_fixed): (&SVector<f64, X>, &SVector<f64, X>, &SVector<f64, X>),
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
     let wt = &dynamics.poly_w;
@@ -72,6 +73,14 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
             }
         }
         momenta.push(p_end);
+    }
+    // at the free components of x_0: p_0 = 0
+    if let Some(p_start) = momenta.first() {
+        for r in 0..X {
+            if start_fixed[r] == 0.0 {
+                terminal = terminal.max(p_start[r].abs());
+            }
+        }
     }
     let scale = (largest / h).max(1.0);
     (momenta, (worst / (h * scale)).max(terminal / scale))

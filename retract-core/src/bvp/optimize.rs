@@ -455,6 +455,9 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     /// 1 for the components of $x_N$ the goal fixes, 0 for the free ones
     /// ([`Self::with_free_end`]).
     pub(super) fixed_end: SVector<f64, X>,
+    /// 1 for the components of $x_0$ the start fixes, 0 for the free ones
+    /// ([`Self::with_free_start`]).
+    pub(super) fixed_start: SVector<f64, X>,
     /// Components given to [`Self::with_free_end`] that are out of range (an error at solve).
     pub(super) bad_free_end: bool,
     pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
@@ -475,6 +478,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
             stage_systems: self.stage_systems,
             terminal_cost: self.terminal_cost,
             fixed_end: self.fixed_end,
+            fixed_start: self.fixed_start,
             bad_free_end: self.bad_free_end,
             equalities: self.equalities.clone(),
             inequalities: self.inequalities.clone(),
@@ -501,6 +505,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             stage_systems: None,
             terminal_cost: None,
             fixed_end: SVector::repeat(1.0),
+            fixed_start: SVector::repeat(1.0),
             bad_free_end: false,
             equalities: Vec::new(),
             inequalities: Vec::new(),
@@ -541,6 +546,19 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     pub fn with_free_end(mut self, components: &[usize]) -> Self {
         for &c in components {
             match self.fixed_end.get_mut(c) {
+                Some(f) => *f = 0.0,
+                None => self.bad_free_end = true,
+            }
+        }
+        self
+    }
+
+    /// Frees the components `components` of $x_0$ (indices as in [`Self::with_free_end`]):
+    /// the start's values there are ignored and the plan chooses them, with the natural
+    /// boundary condition $p_0 = 0$ there.
+    pub fn with_free_start(mut self, components: &[usize]) -> Self {
+        for &c in components {
+            match self.fixed_start.get_mut(c) {
                 Some(f) => *f = 0.0,
                 None => self.bad_free_end = true,
             }
@@ -706,8 +724,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         self.system.check_parameters().map_err(invalid)?;
         if self.bad_free_end {
             return Err(invalid(Error::InvalidArgument {
-                name: "free end",
-                requirement: "components of the jet x_N: indices below n k",
+                name: "free end or start",
+                requirement: "components of the jet x_N or x_0: indices below n k",
             }));
         }
         if let Some(systems) = self.stage_systems {

@@ -218,6 +218,15 @@ pub(crate) struct Riccati<const N: usize, const X: usize> {
     d_inv: SMatrix<f64, X, X>,
     /// The fixed components of $x_N$ ([`Terminal::fixed`]): the terminal constraint's rows.
     fixed: SVector<f64, X>,
+    /// 1 at the free components of $x_0$.
+    start_free: SVector<f64, X>,
+    /// The inverse of $P_0$ on the free start components (the identity elsewhere).
+    start_inverse: SMatrix<f64, X, X>,
+    /// $P_0$.
+    p_start: SMatrix<f64, X, X>,
+    /// Whether the terminal multiplier was eliminated at $x_0$ (free start components and a
+    /// tail over the whole horizon).
+    eliminated_at_start: bool,
     /// Negative eigenvalues of the reduced Hessian.
     pub negative: usize,
     /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
@@ -405,12 +414,14 @@ fn terminal_inverse<const X: usize>(d: &SMatrix<f64, X, X>) -> Option<(SMatrix<f
     Some((inv, negative))
 }
 
-/// The end of the horizon: the Hessian of the terminal cost $\Phi(x_N)$ (the cost-to-go
-/// $P_N$) and which components of $x_N$ are fixed by the goal (1) or free (0).
+/// The ends of the horizon: the Hessian of the terminal cost $\Phi(x_N)$ (the cost-to-go
+/// $P_N$), which components of $x_N$ the goal fixes (1) or leaves free (0), and likewise of
+/// $x_0$ for the start.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Terminal<const X: usize> {
     pub hessian: SMatrix<f64, X, X>,
     pub fixed: SVector<f64, X>,
+    pub start_fixed: SVector<f64, X>,
 }
 
 impl<const X: usize> Terminal<X> {
@@ -420,6 +431,7 @@ impl<const X: usize> Terminal<X> {
         Self {
             hessian: SMatrix::zeros(),
             fixed: SVector::repeat(1.0),
+            start_fixed: SVector::repeat(1.0),
         }
     }
 
@@ -508,9 +520,17 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             }
             factors.push(factor);
         }
+        let start_free = terminal.start_fixed.map(|f| 1.0 - f);
+        let free_start = start_free.iter().any(|f| *f != 0.0);
+        // with free start components the tail spanning the horizon is eliminated at x_0 too
+        let eliminated_at_start = eliminated.is_none() && free_start;
         let d_inv = eliminated.unwrap_or_else(|| match terminal_inverse(&(d + free)) {
             Some((d_inv, neg_d)) => {
                 negative += neg_d;
+                if free_start {
+                    let p_new = p - sens * d_inv * sens.transpose();
+                    p = (p_new + p_new.transpose()) * 0.5;
+                }
                 d_inv
             }
             None => {
@@ -518,12 +538,34 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 SMatrix::zeros()
             }
         });
+        // the free start components minimise V_0: the pivot P_0 on them (I elsewhere)
+        let start_inverse = if free_start {
+            let fixed_part = SMatrix::<f64, X, X>::from_diagonal(&terminal.start_fixed);
+            let masked = SMatrix::<f64, X, X>::from_diagonal(&start_free);
+            let pivot = masked * p * masked + fixed_part;
+            match invert_counting(pivot) {
+                Some((inverse, neg)) => {
+                    negative += neg;
+                    inverse
+                }
+                None => {
+                    singular = true;
+                    SMatrix::zeros()
+                }
+            }
+        } else {
+            SMatrix::zeros()
+        };
         Self {
             stages: factors,
             tail,
             sens_boundary: sens,
             d_inv,
             fixed: terminal.fixed,
+            start_free,
+            start_inverse,
+            p_start: p,
+            eliminated_at_start,
             negative: negative.saturating_sub(terminal.rows()),
             singular,
         }
@@ -592,14 +634,19 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let backward = self.backward(dynamics, linear, r_end, s_end);
+        let (backward, s_start) = self.backward(dynamics, linear, r_end, s_end);
         let mut d = Direction {
             dx: Vec::with_capacity(steps + 1),
             du: Vec::with_capacity(steps),
             costate: Vec::with_capacity(steps),
             multipliers: Vec::with_capacity(steps),
         };
-        let mut x = *r0;
+        // fixed start components from r0, free ones minimise V_0
+        let mut x = r0.component_mul(&self.start_free.map(|f| 1.0 - f));
+        if self.start_free.iter().any(|f| *f != 0.0) {
+            let step = self.start_inverse * (s_start + self.p_start * x);
+            x -= step.component_mul(&self.start_free);
+        }
         let mut nu = SVector::<f64, X>::zeros();
         d.dx.push(x);
         for (i, (f, l)) in self
@@ -654,7 +701,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         linear: &impl Fn(usize) -> StageLinear<N, X>,
         r_end: &SVector<f64, X>,
         s_end: &SVector<f64, X>,
-    ) -> Vec<Backward<N, X>> {
+    ) -> (Vec<Backward<N, X>>, SVector<f64, X>) {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
@@ -683,14 +730,14 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 s_next,
                 defect: l.defect,
             });
-            if i == boundary && i > 0 {
+            if i == boundary && (i > 0 || self.eliminated_at_start) {
                 // the tail's entries are the ones pushed so far, last step first
                 let x_end = self.tail_terminal(dynamics, out.iter().rev(), i);
                 let gap = (r_end - x_end).component_mul(&self.fixed);
                 s += self.sens_boundary * (self.d_inv * gap);
             }
         }
-        out
+        (out, s)
     }
 
     /// $\delta x_N$ of the closed tail loop from $\delta x_b = 0$ with $\nu = 0$, for the
@@ -796,13 +843,15 @@ mod tests {
                 .collect();
             let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
             let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-            // the goal fixing all of x_N; then q' free with a terminal cost
+            // the ends fixed; then q' free at the end with a terminal cost and q'_1 free at the
+            // start
             for free_end in [false, true] {
                 let (terminal, s_end) = if free_end {
                     let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
                     let terminal = Terminal {
                         hessian: m * m.transpose() + SMatrix::<f64, X, X>::identity() * shift,
                         fixed: SVector::from([1.0, 1.0, 0.0, 0.0]),
+                        start_fixed: SVector::from([1.0, 0.0, 1.0, 1.0]),
                     };
                     (
                         terminal,
@@ -812,6 +861,7 @@ mod tests {
                     (Terminal::fixed_end(), SVector::zeros())
                 };
                 let free = X - terminal.rows();
+                let free_start = terminal.start_fixed.iter().filter(|f| **f == 0.0).count();
                 let riccati = Riccati::factor_with(&dynamics, &stages, 0.0, &terminal);
                 assert!(!riccati.singular);
                 assert_eq!(riccati.boundary() > 0, steps > 2);
@@ -868,8 +918,12 @@ mod tests {
                     rhs[xc(steps) + r] -= s_end[r];
                 }
                 for r in 0..X {
-                    kkt[(nv + r, xc(0) + r)] = 1.0;
-                    rhs[nv + r] = r0[r];
+                    if terminal.start_fixed[r] == 0.0 {
+                        kkt[(nv + r, nv + r)] = 1.0;
+                    } else {
+                        kkt[(nv + r, xc(0) + r)] = 1.0;
+                        rhs[nv + r] = r0[r];
+                    }
                     let row = nv + (steps + 1) * X + r;
                     if terminal.fixed[r] == 0.0 {
                         kkt[(row, row)] = 1.0;
@@ -888,7 +942,7 @@ mod tests {
                 let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
                 assert_eq!(
                     riccati.negative,
-                    negative - (nc - free),
+                    negative - (nc - free - free_start),
                     "{steps} steps, shift {shift}, free end {free_end}"
                 );
                 if shift > 0.0 {

@@ -110,7 +110,9 @@ where
         let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
         let last = &iterate.x[iterate.x.len() - 1];
         violation += slack
-            + (self.problem.start - iterate.x[0]).lp_norm(1)
+            + (self.problem.start - iterate.x[0])
+                .component_mul(&self.problem.fixed_start)
+                .lp_norm(1)
             + (self.problem.goal - last)
                 .component_mul(&self.problem.fixed_end)
                 .lp_norm(1);
@@ -212,7 +214,7 @@ where
                 return None;
             }
         }
-        let r0 = self.problem.start - iterate.x[0];
+        let r0 = (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start);
         let last = &iterate.x[iterate.x.len() - 1];
         let fixed = self.problem.fixed_end;
         let r_end = (self.problem.goal - last).component_mul(&fixed);
@@ -231,7 +233,11 @@ where
                 inequalities,
                 cost_gradient,
                 slack_violation,
-                terminal: Terminal { hessian, fixed },
+                terminal: Terminal {
+                    hessian,
+                    fixed,
+                    start_fixed: self.problem.fixed_start,
+                },
                 terminal_gradient,
             })
     }
@@ -320,7 +326,11 @@ where
         } else {
             &models.cost_gradient
         };
-        let end = (&models.terminal_gradient, &models.terminal.fixed);
+        let end = (
+            &models.terminal_gradient,
+            &models.terminal.fixed,
+            &models.terminal.start_fixed,
+        );
         let (momenta, stationarity) =
             kkt_residuals(&self.dynamics, &models.stages, gradients, direction, end);
         let certificate = Certificate {
