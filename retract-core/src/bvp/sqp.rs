@@ -613,13 +613,17 @@ where
     ) -> Option<(Iterate<N, X>, f64, bool)> {
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
-        // directional derivative of J and the curvature of the model along the direction
+        // directional derivative of J (stages and terminal cost) along the direction
         let mut slope = 0.0;
         for (i, (gx, gu)) in models.cost_gradient.iter().enumerate() {
             let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
             slope += gx.dot(&dxt) + gu.dot(&direction.du[i]);
         }
         slope += barrier.slope(ds, self.dynamics.h);
+        // and of the terminal cost
+        if let Some(dx_end) = direction.dx.last() {
+            slope += models.terminal_gradient.dot(dx_end);
+        }
         let violation = models.violation_l1();
         if violation > 0.0 {
             let needed = slope / (0.9 * violation);
