@@ -82,16 +82,17 @@ pub(crate) fn helper_names(attr: &TokenStream) -> syn::Result<Vec<Ident>> {
             return list
                 .elems
                 .iter()
-                .map(|e| match e {
-                    syn::Expr::Path(p) if p.path.get_ident().is_some() => Ok(p
-                        .path
-                        .get_ident()
-                        .cloned()
-                        .unwrap_or_else(|| unreachable!())),
-                    other => Err(syn::Error::new_spanned(
-                        other,
-                        "a helper is named by its function's name, as `torque`",
-                    )),
+                .map(|e| {
+                    let name = match e {
+                        syn::Expr::Path(p) => p.path.get_ident().cloned(),
+                        _ => None,
+                    };
+                    name.ok_or_else(|| {
+                        syn::Error::new_spanned(
+                            e,
+                            "a helper is named by its function's name, as `torque`",
+                        )
+                    })
                 })
                 .collect();
         }

@@ -64,6 +64,13 @@ impl Lower<'_> {
             );
             return;
         };
+        if p.mutability.is_some() {
+            self.error(
+                p.ident.span(),
+                "a named output is its value at the `let`: bind it without `mut`",
+            );
+            return;
+        }
         let (ids, array) = match self.lookup(&p.ident.to_string()) {
             Some((_, Binding::Value { id, .. })) => (vec![id], false),
             Some((_, Binding::Array { slot })) => (self.arrays[slot as usize].clone(), true),

@@ -458,8 +458,9 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     /// 1 for the components of $x_0$ the start fixes, 0 for the free ones
     /// ([`Self::with_free_start`]).
     pub(super) fixed_start: SVector<f64, X>,
-    /// Components given to [`Self::with_free_end`] that are out of range (an error at solve).
-    pub(super) bad_free_end: bool,
+    /// Components given to [`Self::with_free_end`] or [`Self::with_free_start`] that are out
+    /// of range (an error at solve).
+    pub(super) bad_free_component: bool,
     pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
     pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
     pub(super) start: SVector<f64, X>,
@@ -479,7 +480,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
             terminal_cost: self.terminal_cost,
             fixed_end: self.fixed_end,
             fixed_start: self.fixed_start,
-            bad_free_end: self.bad_free_end,
+            bad_free_component: self.bad_free_component,
             equalities: self.equalities.clone(),
             inequalities: self.inequalities.clone(),
             start: self.start,
@@ -506,7 +507,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             terminal_cost: None,
             fixed_end: SVector::repeat(1.0),
             fixed_start: SVector::repeat(1.0),
-            bad_free_end: false,
+            bad_free_component: false,
             equalities: Vec::new(),
             inequalities: Vec::new(),
             start: SVector::from_column_slice(start),
@@ -547,7 +548,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         for &c in components {
             match self.fixed_end.get_mut(c) {
                 Some(f) => *f = 0.0,
-                None => self.bad_free_end = true,
+                None => self.bad_free_component = true,
             }
         }
         self
@@ -560,7 +561,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         for &c in components {
             match self.fixed_start.get_mut(c) {
                 Some(f) => *f = 0.0,
-                None => self.bad_free_end = true,
+                None => self.bad_free_component = true,
             }
         }
         self
@@ -722,7 +723,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }));
         }
         self.system.check_parameters().map_err(invalid)?;
-        if self.bad_free_end {
+        if self.bad_free_component {
             return Err(invalid(Error::InvalidArgument {
                 name: "free end or start",
                 requirement: "components of the jet x_N or x_0: indices below n k",

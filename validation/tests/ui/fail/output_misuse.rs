@@ -11,7 +11,10 @@ fn nested(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
     }
     #[output]
     let (a, b) = (q[0], q[1]);
-    0.5 * l + a * b
+    #[output]
+    let mut c = q[0];
+    c += 1.0;
+    0.5 * l + a * b + c
 }
 
 #[jet_function(order = 2)]
