@@ -136,3 +136,21 @@ pub fn shifted<const N: usize, const K: usize>(
     }
     (x, u)
 }
+
+/// Deterministic pseudo-random numbers in [-1, 1] (xorshift64), for tests at "random" points.
+pub struct Noise(u64);
+
+impl Noise {
+    /// The sequence from `seed` (not 0).
+    pub fn new(seed: u64) -> Self {
+        Self(seed.max(1))
+    }
+
+    /// The next number, uniform on a grid of step 1e-6 in [-1, 1].
+    pub fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 % 2_000_001) as f64 / 1e6 - 1.0
+    }
+}

@@ -50,13 +50,8 @@ fn inline(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
 #[test]
 fn helpers_arrays_and_tuples_lower_like_inline_code() {
     let (a, b) = (WithHelpers { g: 9.81 }, Inline { g: 9.81 });
-    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut noise = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed % 2_000_001) as f64 / 1e6 - 1.0
-    };
+    let mut random = crate::common::Noise::new(0x9e37_79b9_7f4a_7c15_u64);
+    let mut noise = move || random.next();
     for _ in 0..20 {
         let x = [
             SVector::from([2.0 * noise(), 2.0 * noise()]),

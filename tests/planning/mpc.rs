@@ -12,13 +12,8 @@ use retract::nalgebra::SVector;
 #[test]
 fn the_applied_torque_is_the_planned_one() {
     let model = TorqueCost::new(1.0, 1.0, 1.0, 1.0, 9.81);
-    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-    let mut noise = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed % 2_000_001) as f64 / 1e6 - 1.0
-    };
+    let mut random = crate::common::Noise::new(0x2545_f491_4f6c_dd1d_u64);
+    let mut noise = move || random.next();
     for _ in 0..50 {
         let x = [
             SVector::from([3.0 * noise(), 3.0 * noise()]),

@@ -806,6 +806,89 @@ mod tests {
 
     /// The Riccati solve equals a dense solve of the same equality-constrained quadratic
     /// program, with the terminal multiplier eliminated before the first step or not.
+    /// The KKT matrix and right-hand side of the subproblem, dense: the variables
+    /// (x_0..x_N, u_0..u_{N-1}), then the multipliers of x_0 = r0, of the dynamics and of
+    /// x_N = r_end (a free component's row pins its multiplier to 0).
+    fn dense_kkt(
+        dynamics: &Dynamics<2, 4>,
+        stages: &[StageModel<2, 4>],
+        terminal: &Terminal<4>,
+        (r0, r_end): (&SVector<f64, 4>, &SVector<f64, 4>),
+        s_end: &SVector<f64, 4>,
+    ) -> (DMatrix<f64>, nalgebra::DVector<f64>) {
+        const N: usize = 2;
+        const X: usize = 4;
+        let steps = stages.len();
+        let nv = (steps + 1) * X + steps * N;
+        let nc = (steps + 2) * X;
+        let xc = |i: usize| i * X;
+        let uc = |i: usize| (steps + 1) * X + i * N;
+        let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
+        let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
+        let theta = dynamics.theta;
+        for (i, s) in stages.iter().enumerate() {
+            let mut t = DMatrix::<f64>::zeros(6, nv);
+            for r in 0..X {
+                t[(r, xc(i) + r)] = 1.0 - theta;
+                t[(r, xc(i + 1) + r)] = theta;
+            }
+            for a in 0..N {
+                t[(4 + a, uc(i) + a)] = 1.0;
+            }
+            let mut h = DMatrix::<f64>::zeros(6, 6);
+            h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
+            h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
+            h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
+            h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
+            let g = nalgebra::DVector::from_iterator(6, s.gx.iter().chain(s.gu.iter()).copied());
+            let block = t.transpose() * h * &t;
+            let mut view = kkt.view_mut((0, 0), (nv, nv));
+            view += block;
+            let mut top = rhs.rows_mut(0, nv);
+            top -= t.transpose() * g;
+            // x_{i+1} - A x_i - B u_i = c_i
+            let row = nv + (i + 1) * X;
+            for r in 0..X {
+                kkt[(row + r, xc(i + 1) + r)] = 1.0;
+                for c in 0..X {
+                    kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
+                }
+                for a in 0..N {
+                    kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
+                }
+                rhs[row + r] = s.defect[r];
+            }
+        }
+        // the terminal cost on x_N; a free component's row pins its multiplier to 0
+        for r in 0..X {
+            for c in 0..X {
+                kkt[(xc(steps) + r, xc(steps) + c)] += terminal.hessian[(r, c)];
+            }
+            rhs[xc(steps) + r] -= s_end[r];
+        }
+        for r in 0..X {
+            if terminal.start_fixed[r] == 0.0 {
+                kkt[(nv + r, nv + r)] = 1.0;
+            } else {
+                kkt[(nv + r, xc(0) + r)] = 1.0;
+                rhs[nv + r] = r0[r];
+            }
+            let row = nv + (steps + 1) * X + r;
+            if terminal.fixed[r] == 0.0 {
+                kkt[(row, row)] = 1.0;
+            } else {
+                kkt[(row, xc(steps) + r)] = 1.0;
+                rhs[row] = r_end[r];
+            }
+        }
+        for r in nv..nv + nc {
+            for c in 0..nv {
+                kkt[(c, r)] = kkt[(r, c)];
+            }
+        }
+        (kkt, rhs)
+    }
+
     #[test]
     fn riccati_equals_the_dense_kkt_solve() {
         const N: usize = 2;
@@ -866,77 +949,10 @@ mod tests {
                 assert!(!riccati.singular);
                 assert_eq!(riccati.boundary() > 0, steps > 2);
                 let d = riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end));
-                // dense: variables (x_0..x_N, u_0..u_{N-1}), then the multipliers
-                let nv = (steps + 1) * X + steps * N;
+                let (kkt, rhs) = dense_kkt(&dynamics, &stages, &terminal, (&r0, &r_end), &s_end);
                 let nc = (steps + 2) * X;
                 let xc = |i: usize| i * X;
                 let uc = |i: usize| (steps + 1) * X + i * N;
-                let mut kkt = DMatrix::<f64>::zeros(nv + nc, nv + nc);
-                let mut rhs = nalgebra::DVector::<f64>::zeros(nv + nc);
-                let theta = dynamics.theta;
-                for (i, s) in stages.iter().enumerate() {
-                    let mut t = DMatrix::<f64>::zeros(6, nv);
-                    for r in 0..X {
-                        t[(r, xc(i) + r)] = 1.0 - theta;
-                        t[(r, xc(i + 1) + r)] = theta;
-                    }
-                    for a in 0..N {
-                        t[(4 + a, uc(i) + a)] = 1.0;
-                    }
-                    let mut h = DMatrix::<f64>::zeros(6, 6);
-                    h.view_mut((0, 0), (4, 4)).copy_from(&s.hxx);
-                    h.view_mut((4, 0), (2, 4)).copy_from(&s.hux);
-                    h.view_mut((0, 4), (4, 2)).copy_from(&s.hux.transpose());
-                    h.view_mut((4, 4), (2, 2)).copy_from(&s.huu);
-                    let g = nalgebra::DVector::from_iterator(
-                        6,
-                        s.gx.iter().chain(s.gu.iter()).copied(),
-                    );
-                    let block = t.transpose() * h * &t;
-                    let mut view = kkt.view_mut((0, 0), (nv, nv));
-                    view += block;
-                    let mut top = rhs.rows_mut(0, nv);
-                    top -= t.transpose() * g;
-                    // x_{i+1} - A x_i - B u_i = c_i
-                    let row = nv + (i + 1) * X;
-                    for r in 0..X {
-                        kkt[(row + r, xc(i + 1) + r)] = 1.0;
-                        for c in 0..X {
-                            kkt[(row + r, xc(i) + c)] = -dynamics.a[(r, c)];
-                        }
-                        for a in 0..N {
-                            kkt[(row + r, uc(i) + a)] = -dynamics.b[(r, a)];
-                        }
-                        rhs[row + r] = s.defect[r];
-                    }
-                }
-                // the terminal cost on x_N; a free component's row pins its multiplier to 0
-                for r in 0..X {
-                    for c in 0..X {
-                        kkt[(xc(steps) + r, xc(steps) + c)] += terminal.hessian[(r, c)];
-                    }
-                    rhs[xc(steps) + r] -= s_end[r];
-                }
-                for r in 0..X {
-                    if terminal.start_fixed[r] == 0.0 {
-                        kkt[(nv + r, nv + r)] = 1.0;
-                    } else {
-                        kkt[(nv + r, xc(0) + r)] = 1.0;
-                        rhs[nv + r] = r0[r];
-                    }
-                    let row = nv + (steps + 1) * X + r;
-                    if terminal.fixed[r] == 0.0 {
-                        kkt[(row, row)] = 1.0;
-                    } else {
-                        kkt[(row, xc(steps) + r)] = 1.0;
-                        rhs[row] = r_end[r];
-                    }
-                }
-                for r in nv..nv + nc {
-                    for c in 0..nv {
-                        kkt[(c, r)] = kkt[(r, c)];
-                    }
-                }
                 // the KKT matrix has nc + neg(Z^T H Z) negative eigenvalues
                 let eigenvalues = SymmetricEigen::new(kkt.clone()).eigenvalues;
                 let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
