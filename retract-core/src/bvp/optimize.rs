@@ -545,12 +545,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// chooses them (with [`Self::with_terminal_cost`], to minimise $J + \Phi$; without, the
     /// natural boundary condition $p_N = 0$ there).
     pub fn with_free_end(mut self, components: &[usize]) -> Self {
-        for &c in components {
-            match self.fixed_end.get_mut(c) {
-                Some(f) => *f = 0.0,
-                None => self.bad_free_component = true,
-            }
-        }
+        self.bad_free_component |= !free_components(&mut self.fixed_end, components);
         self
     }
 
@@ -558,12 +553,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// the start's values there are ignored and the plan chooses them, with the natural
     /// boundary condition $p_0 = 0$ there.
     pub fn with_free_start(mut self, components: &[usize]) -> Self {
-        for &c in components {
-            match self.fixed_start.get_mut(c) {
-                Some(f) => *f = 0.0,
-                None => self.bad_free_component = true,
-            }
-        }
+        self.bad_free_component |= !free_components(&mut self.fixed_start, components);
         self
     }
 
@@ -676,6 +666,17 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         }
         Ok(())
     }
+}
+
+/// Sets `mask` to 0 at `components` (freed); false if one of them is out of range.
+fn free_components<const X: usize>(mask: &mut SVector<f64, X>, components: &[usize]) -> bool {
+    components.iter().all(|&c| match mask.get_mut(c) {
+        Some(f) => {
+            *f = 0.0;
+            true
+        }
+        None => false,
+    })
 }
 
 /// $x$ as blocks $(x_0, \dots, x_{k-1})$.
