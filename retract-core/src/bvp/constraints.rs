@@ -131,13 +131,29 @@ fn read<const N: usize, const X: usize>(
 
 /// `scale` times the Hessian blocks of a function of $(x, u)$ as $(H_{xx}, H_{ux}, H_{uu})$
 /// over the flat jet.
+#[inline(always)]
 pub(super) fn flat_hessian<const N: usize, const K: usize, const X: usize>(
     hs: &Hessian<N, K>,
     scale: f64,
 ) -> (SMatrix<f64, X, X>, SMatrix<f64, N, X>, SMatrix<f64, N, N>) {
-    (
-        SMatrix::from_fn(|r, c| scale * hs.xx[r / N][c / N][(r % N, c % N)]),
-        SMatrix::from_fn(|b, c| scale * hs.xu[c / N][(c % N, b)]),
-        hs.uu * scale,
-    )
+    let mut hxx = SMatrix::<f64, X, X>::zeros();
+    let mut hux = SMatrix::<f64, N, X>::zeros();
+    // block by block with constant bounds (the compiler unrolls the copies)
+    for (i, row) in hs.xx.iter().enumerate() {
+        for (j, block) in row.iter().enumerate() {
+            for b in 0..N {
+                for a in 0..N {
+                    hxx[(i * N + a, j * N + b)] = scale * block[(a, b)];
+                }
+            }
+        }
+    }
+    for (j, block) in hs.xu.iter().enumerate() {
+        for b in 0..N {
+            for a in 0..N {
+                hux[(b, j * N + a)] = scale * block[(a, b)];
+            }
+        }
+    }
+    (hxx, hux, hs.uu * scale)
 }
