@@ -22,10 +22,18 @@
 //!   $\theta^{16}$, exact to rounding for $|\xi| \le 2$ (a step that turns the point by less
 //!   than 2 rad).
 //!
-//! Each is a unit struct implementing [`SphereMap`] for orders $k = 1, 2$ (the generated code
-//! of a lifted map grows fast with the order: at $k = 3$ these maps take 1 to 7 MB of source).
+//! Each is a unit struct implementing [`SphereMap`] for orders $k = 1, \dots, 4$. At $k = 1, 2$
+//! the lifted map is generated (`in_chart::k1`, `in_chart::k2`): straight-line code, the
+//! fastest. Its size grows fast with the order (1 to 7 MB of source per map at $k = 3$), so
+//! at $k = 3, 4$ the same map text, compiled a second time over a
+//! [`Scalar`](retract_core::taylor::Scalar) (`in_chart::any`), is lifted at run time by
+//! [`TaylorLift`]: one evaluation on Taylor series of second-order dual numbers gives the
+//! lift, its Jacobians and its covector Hessian. The tests check that both agree at $k = 1,
+//! 2$.
 
 pub use retract_core::sphere::*;
+
+use retract_core::map::TaylorLift;
 
 use retract_macros::discretization_map;
 
@@ -33,7 +41,16 @@ use retract_macros::discretization_map;
 /// map as `Name, function => { body }` after the shared `prelude`. Every token of a body
 /// comes from the invocation, so its names and the signature's agree.
 macro_rules! sphere_maps {
-    (@orders [] $($rest:tt)*) => {};
+    (@orders [] $args:tt $prelude:tt $($rest:tt)*) => {
+        /// The maps at every order, written over a [`Scalar`](retract_core::taylor::Scalar)
+        /// and lifted at run time by [`TaylorLift`](retract_core::map::TaylorLift) (module
+        /// docs): what [`SphereMap`](retract_core::sphere::SphereMap) uses for $k \ge 3$.
+        pub mod any {
+            use retract_core::map::BaseMap;
+            use retract_core::taylor::Scalar;
+            sphere_maps!(@generic $args $prelude $($rest)*);
+        }
+    };
     (@orders [($module:ident $order:tt) $($more:tt)*] $($rest:tt)*) => {
         sphere_maps!(@one $module $order $($rest)*);
         sphere_maps!(@orders [$($more)*] $($rest)*);
@@ -44,6 +61,25 @@ macro_rules! sphere_maps {
             use super::discretization_map;
             $(sphere_maps!(@map $order $args $prelude $name, $function => $body);)*
         }
+    };
+    (@generic $args:tt $prelude:tt) => {};
+    (@generic ($q:ident, $v:ident, $chart:ident) { $($prelude:tt)* }
+        $name:ident, $function:ident => { $($body:tt)* } $($rest:tt)*) => {
+        /// A map of $S^2$ in the gnomonic chart with frame `chart` (module docs), over any
+        /// [`Scalar`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $name {
+            /// The chart frame $[c, e_1, e_2]$.
+            pub chart: [f64; 9],
+        }
+        impl BaseMap<2> for $name {
+            fn base<T: Scalar>(&self, $q: [T; 2], $v: [T; 2]) -> ([T; 2], [T; 2]) {
+                let $chart = self.chart;
+                $($prelude)*
+                $($body)*
+            }
+        }
+        sphere_maps!(@generic ($q, $v, $chart) { $($prelude)* } $($rest)*);
     };
     (@map $order:tt ($q:ident, $v:ident, $chart:ident) { $($prelude:tt)* }
         $name:ident, $function:ident => { $($body:tt)* }) => {
@@ -66,10 +102,12 @@ pub mod in_chart {
         @orders [(k1 1) (k2 2)]
         (q, v, chart)
         {
+            // (written with the variable on the left of every operation with a constant, so
+            // that the same text is a function over any Scalar, for module `any`)
             // s = c + q0 e1 + q1 e2 (the point times |s|) and t = v0 e1 + v1 e2
-            let s0 = chart[0] + q[0] * chart[3] + q[1] * chart[6];
-            let s1 = chart[1] + q[0] * chart[4] + q[1] * chart[7];
-            let s2 = chart[2] + q[0] * chart[5] + q[1] * chart[8];
+            let s0 = q[0] * chart[3] + q[1] * chart[6] + chart[0];
+            let s1 = q[0] * chart[4] + q[1] * chart[7] + chart[1];
+            let s2 = q[0] * chart[5] + q[1] * chart[8] + chart[2];
             let t0 = v[0] * chart[3] + v[1] * chart[6];
             let t1 = v[0] * chart[4] + v[1] * chart[7];
             let t2 = v[0] * chart[5] + v[1] * chart[8];
@@ -95,90 +133,78 @@ pub mod in_chart {
             let a0 = s0 + u0;
             let a1 = s1 + u1;
             let a2 = s2 + u2;
-            let d = g00 * a0 + g01 * a1 + g02 * a2;
+            let d = a0 * g00 + a1 * g01 + a2 * g02;
             (
                 [q[0], q[1]],
                 [
-                    (g10 * a0 + g11 * a1 + g12 * a2) / d,
-                    (g20 * a0 + g21 * a1 + g22 * a2) / d,
+                    (a0 * g10 + a1 * g11 + a2 * g12) / d,
+                    (a0 * g20 + a1 * g21 + a2 * g22) / d,
                 ],
             )
         }
         ProjectionMidpoint, projection_midpoint => {
             // |s| (p -+ xi / 2) = s -+ h
-            let h0 = 0.5 * u0;
-            let h1 = 0.5 * u1;
-            let h2 = 0.5 * u2;
-            let dm = g00 * (s0 - h0) + g01 * (s1 - h1) + g02 * (s2 - h2);
-            let dp = g00 * (s0 + h0) + g01 * (s1 + h1) + g02 * (s2 + h2);
+            let h0 = u0 * 0.5;
+            let h1 = u1 * 0.5;
+            let h2 = u2 * 0.5;
+            let dm = (s0 - h0) * g00 + (s1 - h1) * g01 + (s2 - h2) * g02;
+            let dp = (s0 + h0) * g00 + (s1 + h1) * g01 + (s2 + h2) * g02;
             (
                 [
-                    (g10 * (s0 - h0) + g11 * (s1 - h1) + g12 * (s2 - h2)) / dm,
-                    (g20 * (s0 - h0) + g21 * (s1 - h1) + g22 * (s2 - h2)) / dm,
+                    ((s0 - h0) * g10 + (s1 - h1) * g11 + (s2 - h2) * g12) / dm,
+                    ((s0 - h0) * g20 + (s1 - h1) * g21 + (s2 - h2) * g22) / dm,
                 ],
                 [
-                    (g10 * (s0 + h0) + g11 * (s1 + h1) + g12 * (s2 + h2)) / dp,
-                    (g20 * (s0 + h0) + g21 * (s1 + h1) + g22 * (s2 + h2)) / dp,
+                    ((s0 + h0) * g10 + (s1 + h1) * g11 + (s2 + h2) * g12) / dp,
+                    ((s0 + h0) * g20 + (s1 + h1) * g21 + (s2 + h2) * g22) / dp,
                 ],
             )
         }
         ExponentialMidpoint, exponential_midpoint => {
-            // th2 = |xi / 2|^2; cos(th) and sin(th) / th by their Taylor series in th^2
-            let th2 = 0.25 * (u0 * u0 + u1 * u1 + u2 * u2) / ss;
-            let c = 1.0
-                - th2 / 2.0
-                    * (1.0
-                        - th2 / 12.0
-                            * (1.0
-                                - th2 / 30.0
-                                    * (1.0
-                                        - th2 / 56.0
-                                            * (1.0
-                                                - th2 / 90.0
-                                                    * (1.0
-                                                        - th2 / 132.0
-                                                            * (1.0
-                                                                - th2 / 182.0
-                                                                    * (1.0 - th2 / 240.0)))))));
-            let sn = 1.0
-                - th2 / 6.0
-                    * (1.0
-                        - th2 / 20.0
-                            * (1.0
-                                - th2 / 42.0
-                                    * (1.0
-                                        - th2 / 72.0
-                                            * (1.0
-                                                - th2 / 110.0
-                                                    * (1.0
-                                                        - th2 / 156.0
-                                                            * (1.0
-                                                                - th2 / 210.0
-                                                                    * (1.0 - th2 / 272.0)))))));
+            // th2 = |xi / 2|^2; cos(th) = 1 - th2/2 (1 - th2/12 (1 - ...)) and
+            // sin(th) / th = 1 - th2/6 (1 - th2/20 (1 - ...)) by Horner, innermost factor first
+            let th2 = (u0 * u0 + u1 * u1 + u2 * u2) * 0.25 / ss;
+            let c = -(th2 / 240.0) + 1.0;
+            let c = -(th2 / 182.0 * c) + 1.0;
+            let c = -(th2 / 132.0 * c) + 1.0;
+            let c = -(th2 / 90.0 * c) + 1.0;
+            let c = -(th2 / 56.0 * c) + 1.0;
+            let c = -(th2 / 30.0 * c) + 1.0;
+            let c = -(th2 / 12.0 * c) + 1.0;
+            let c = -(th2 / 2.0 * c) + 1.0;
+            let sn = -(th2 / 272.0) + 1.0;
+            let sn = -(th2 / 210.0 * sn) + 1.0;
+            let sn = -(th2 / 156.0 * sn) + 1.0;
+            let sn = -(th2 / 110.0 * sn) + 1.0;
+            let sn = -(th2 / 72.0 * sn) + 1.0;
+            let sn = -(th2 / 42.0 * sn) + 1.0;
+            let sn = -(th2 / 20.0 * sn) + 1.0;
+            let sn = -(th2 / 6.0 * sn) + 1.0;
             // |s| exp_p(-+ xi / 2) = cos(th) s -+ sin(th) / th u / 2 = m -+ h
-            let h0 = 0.5 * sn * u0;
-            let h1 = 0.5 * sn * u1;
-            let h2 = 0.5 * sn * u2;
+            let h0 = sn * u0 * 0.5;
+            let h1 = sn * u1 * 0.5;
+            let h2 = sn * u2 * 0.5;
             let m0 = c * s0;
             let m1 = c * s1;
             let m2 = c * s2;
-            let dm = g00 * (m0 - h0) + g01 * (m1 - h1) + g02 * (m2 - h2);
-            let dp = g00 * (m0 + h0) + g01 * (m1 + h1) + g02 * (m2 + h2);
+            let dm = (m0 - h0) * g00 + (m1 - h1) * g01 + (m2 - h2) * g02;
+            let dp = (m0 + h0) * g00 + (m1 + h1) * g01 + (m2 + h2) * g02;
             (
                 [
-                    (g10 * (m0 - h0) + g11 * (m1 - h1) + g12 * (m2 - h2)) / dm,
-                    (g20 * (m0 - h0) + g21 * (m1 - h1) + g22 * (m2 - h2)) / dm,
+                    ((m0 - h0) * g10 + (m1 - h1) * g11 + (m2 - h2) * g12) / dm,
+                    ((m0 - h0) * g20 + (m1 - h1) * g21 + (m2 - h2) * g22) / dm,
                 ],
                 [
-                    (g10 * (m0 + h0) + g11 * (m1 + h1) + g12 * (m2 + h2)) / dp,
-                    (g20 * (m0 + h0) + g21 * (m1 + h1) + g22 * (m2 + h2)) / dp,
+                    ((m0 + h0) * g10 + (m1 + h1) * g11 + (m2 + h2) * g12) / dp,
+                    ((m0 + h0) * g20 + (m1 + h1) * g21 + (m2 + h2) * g22) / dp,
                 ],
             )
         }
     }
 }
 
-/// Implements [`SphereMap`] for a unit struct at each order by its generated map.
+/// Implements [`SphereMap`] for a unit struct: by its generated map at orders 1 and 2, by its
+/// lift at run time ([`TaylorLift`]) at orders 3 and 4.
 macro_rules! sphere_map_impls {
     ($name:ident) => {
         impl SphereMap<1> for $name {
@@ -191,6 +217,18 @@ macro_rules! sphere_map_impls {
             type InChart = in_chart::k2::$name;
             fn in_chart(&self, chart: [f64; 9]) -> Self::InChart {
                 in_chart::k2::$name::new(chart)
+            }
+        }
+        impl SphereMap<3> for $name {
+            type InChart = TaylorLift<in_chart::any::$name>;
+            fn in_chart(&self, chart: [f64; 9]) -> Self::InChart {
+                TaylorLift(in_chart::any::$name { chart })
+            }
+        }
+        impl SphereMap<4> for $name {
+            type InChart = TaylorLift<in_chart::any::$name>;
+            fn in_chart(&self, chart: [f64; 9]) -> Self::InChart {
+                TaylorLift(in_chart::any::$name { chart })
             }
         }
     };

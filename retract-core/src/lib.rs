@@ -19,7 +19,8 @@
 //!   step under an external force (plant simulation);
 //!   [`diagnostics`]: energy, symplecticity, drift, RK4.
 //! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
-//!   among them.
+//!   among them; [`map::TaylorLift`] lifts a map written over a [`taylor::Scalar`] at any
+//!   order by Taylor arithmetic ([`taylor`]).
 //! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
 //!   discretization map of $S^2$.
 //! - [`state`](mod@state): typed derivative data ([`Jet`]) and states ([`State`]), built by
@@ -67,6 +68,7 @@ pub mod sphere;
 pub mod state;
 pub mod step;
 pub mod system;
+pub mod taylor;
 
 #[cfg(feature = "std")]
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};

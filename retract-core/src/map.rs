@@ -39,6 +39,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
+mod taylor_lift;
+pub use taylor_lift::{BaseMap, TaylorLift};
+
 use crate::lifted::{Blocks, join, split};
 use crate::newton::{self, NewtonOptions, Problem};
 use crate::step::StepReport;

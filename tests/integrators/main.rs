@@ -25,4 +25,5 @@ mod messages_runtime;
 mod robustness_chord_invariant;
 mod robustness_runtime;
 mod sphere;
+mod sphere_order3;
 mod structure;
