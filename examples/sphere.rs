@@ -1,10 +1,12 @@
 //! Riemannian cubics on the sphere S^2: L = 1/2 |D_t q'|^2 written in ambient coordinates
-//! (`#[higher_order_lagrangian(order = 2, sphere)]`).
+//! (`#[higher_order_lagrangian(order = 2, sphere)]`), and Riemannian polynomials of order 3,
+//! L = 1/2 |D_t^2 q'|^2 (`order = 3`).
 //!
 //! 1. Initial-value problems: the paper's maps of S^2 in moving gnomonic charts
 //!    (`retract::sphere`) against the midpoint rule in one fixed chart (what a chart-based
 //!    code does), all against an RK4 solution of the embedded Euler-Lagrange equation
-//!    (`examples/common/sphere_cubic.rs`): error at T = 1, invariants and time per step.
+//!    (`examples/common/sphere_cubic.rs`, `sphere_poly3.rs`): error at T, invariants and time
+//!    per step, for k = 2 and k = 3.
 //! 2. Invariants over a long run: | |q| - 1 |, q . q', the Noether momentum and the energy.
 //! 3. A boundary-value problem with the optimizer: the cubic between two points of the
 //!    equator with given velocities, free and around a keep-out cap (a hard constraint
@@ -15,6 +17,8 @@
 mod common;
 #[path = "common/sphere_cubic.rs"]
 mod sphere_cubic;
+#[path = "common/sphere_poly3.rs"]
+mod sphere_poly3;
 
 use std::time::Instant;
 
@@ -25,22 +29,38 @@ use retract::sphere::{
     self, Chart, ExponentialMidpoint, ProjectionInitial, ProjectionMidpoint, SphereMap,
     SphereState, SphereSystem,
 };
-use retract::{LiftedSystem, NewtonOptions, StepOptions, step};
+use retract::{Lagrangian, LiftedSystem, NewtonOptions, StepOptions, step};
 use sphere_cubic::{Cubic, OutsideCap, on_equator};
+use sphere_poly3::Poly3;
 
-/// One run from the test cubic's data: the final point, the largest momentum change and
-/// the time per step in microseconds.
+/// One run: the final point, the largest momentum change and the time per step in
+/// microseconds.
 struct Run {
     point: Vector3<f64>,
     momentum_drift: f64,
     us_per_step: f64,
 }
 
-/// `steps` steps to T = 1 with a map of S^2 in moving charts (best time of 3 runs).
-fn moving<Map: SphereMap<2>>(map: &Map, steps: usize) -> Run {
-    let jet = sphere_cubic::jet(sphere_cubic::data());
-    let start = SphereState::<2, 8>::from_ambient(&Cubic::new(), &jet).expect("on the sphere");
-    let (h, options) = (1.0 / steps as f64, NewtonOptions::default());
+/// An initial-value problem on the sphere: the system, the ambient jet
+/// (q, ..., q^(2k-1)) at t = 0 and the final time.
+struct Ivp<'a, Sys> {
+    system: Sys,
+    jet: &'a [Vector3<f64>],
+    t: f64,
+}
+
+/// `steps` steps to T with a map of S^2 in moving charts (best time of 3 runs).
+fn moving<Sys, Map, const K: usize, const S: usize, const M: usize>(
+    ivp: &Ivp<'_, Sys>,
+    map: &Map,
+    steps: usize,
+) -> Run
+where
+    Sys: SphereSystem + Lagrangian<2, K> + LiftedSystem<S, M>,
+    Map: SphereMap<K>,
+{
+    let start = SphereState::<K, S>::from_ambient(&ivp.system, ivp.jet).expect("on the sphere");
+    let (h, options) = (ivp.t / steps as f64, NewtonOptions::default());
     let mut best = f64::INFINITY;
     let mut state = start;
     let mut drift: f64 = 0.0;
@@ -49,7 +69,7 @@ fn moving<Map: SphereMap<2>>(map: &Map, steps: usize) -> Run {
         state = start;
         drift = 0.0;
         for _ in 0..steps {
-            state = sphere::step(&Cubic::new(), map, &state, h, &options)
+            state = sphere::step(&ivp.system, map, &state, h, &options)
                 .expect("step")
                 .0;
             drift = drift.max((state.momentum() - start.momentum()).amax());
@@ -63,15 +83,19 @@ fn moving<Map: SphereMap<2>>(map: &Map, steps: usize) -> Run {
     }
 }
 
-/// `steps` steps to T = 1 with the built-in midpoint rule in the gnomonic chart centred at
-/// the start point (no chart change); the momentum is not a quantity of this scheme.
-fn fixed_chart(steps: usize) -> Run {
-    let jet = sphere_cubic::jet(sphere_cubic::data());
-    let chart = Chart::at(&jet[0]).expect("a point");
-    let system = Cubic::new().with_chart(chart.params());
+/// `steps` steps to T with the built-in midpoint rule in the gnomonic chart centred at the
+/// start point (no chart change); the momentum is not a quantity of this scheme.
+fn fixed_chart<Sys, const S: usize, const M: usize>(ivp: &Ivp<'_, Sys>, steps: usize) -> Run
+where
+    Sys: SphereSystem + LiftedSystem<S, M>,
+{
+    let chart = Chart::at(&ivp.jet[0]).expect("a point");
+    let system = ivp.system.with_chart(chart.params());
+    let mut jet = [Vector3::zeros(); 6];
+    jet[..S / 2].copy_from_slice(ivp.jet);
     let y = chart.coordinates(&jet).expect("in the chart");
-    let z0 = system.legendre(&SVector::<f64, 8>::from_fn(|r, _| y[r / 2][r % 2]));
-    let (h, options) = (1.0 / steps as f64, StepOptions::default());
+    let z0 = system.legendre(&SVector::<f64, S>::from_fn(|r, _| y[r / 2][r % 2]));
+    let (h, options) = (ivp.t / steps as f64, StepOptions::default());
     let mut best = f64::INFINITY;
     let mut z = z0;
     for _ in 0..3 {
@@ -89,25 +113,35 @@ fn fixed_chart(steps: usize) -> Run {
     }
 }
 
-fn print_ivp_table() {
-    let exact = sphere_cubic::reference(sphere_cubic::data(), 1.0, 100_000)[0];
-    println!("Riemannian cubic, T = 1, error |q(T) - q_ref(T)| (reference: RK4 of the embedded");
-    println!(
-        "Euler-Lagrange equation, 10^5 steps), momentum drift max|m_i - m_0|, time per step:\n"
-    );
+/// The table of one initial-value problem: every map in moving charts and the midpoint rule
+/// in one fixed chart, for each step count of `sweep`, against the point `exact` at T.
+fn print_ivp_table<Sys, const K: usize, const S: usize, const M: usize>(
+    ivp: &Ivp<'_, Sys>,
+    exact: &Vector3<f64>,
+    sweep: &[usize],
+) where
+    Sys: SphereSystem + Lagrangian<2, K> + LiftedSystem<S, M>,
+    ProjectionMidpoint: SphereMap<K>,
+    ExponentialMidpoint: SphereMap<K>,
+    ProjectionInitial: SphereMap<K>,
+{
     println!("| method | N | error | observed order | momentum drift | us/step |");
     println!("|---|---|---|---|---|---|");
     let methods: [(&str, &dyn Fn(usize) -> Run); 4] = [
-        ("projection midpoint", &|n| moving(&ProjectionMidpoint, n)),
-        ("exponential midpoint", &|n| moving(&ExponentialMidpoint, n)),
-        ("projection initial point", &|n| {
-            moving(&ProjectionInitial, n)
+        ("projection midpoint", &|n| {
+            moving(ivp, &ProjectionMidpoint, n)
         }),
-        ("midpoint in one fixed chart", &fixed_chart),
+        ("exponential midpoint", &|n| {
+            moving(ivp, &ExponentialMidpoint, n)
+        }),
+        ("projection initial point", &|n| {
+            moving(ivp, &ProjectionInitial, n)
+        }),
+        ("midpoint in one fixed chart", &|n| fixed_chart(ivp, n)),
     ];
     for (name, method) in methods {
         let mut previous: Option<f64> = None;
-        for steps in [10, 20, 40, 80, 160] {
+        for &steps in sweep {
             let run = method(steps);
             let error = (run.point - exact).norm();
             let order =
@@ -124,6 +158,35 @@ fn print_ivp_table() {
             previous = Some(error);
         }
     }
+}
+
+/// The IVP tables: the Riemannian cubic (k = 2) to T = 1 and the Riemannian polynomial of
+/// order 3 (k = 3, maps lifted at run time) to T = 0.5.
+fn print_ivp_tables() {
+    let cubic_jet = sphere_cubic::jet(sphere_cubic::data());
+    let exact = sphere_cubic::reference(sphere_cubic::data(), 1.0, 100_000)[0];
+    println!("Riemannian cubic, T = 1, error |q(T) - q_ref(T)| (reference: RK4 of the embedded");
+    println!(
+        "Euler-Lagrange equation, 10^5 steps), momentum drift max|m_i - m_0|, time per step:\n"
+    );
+    let cubic = Ivp {
+        system: Cubic::new(),
+        jet: &cubic_jet,
+        t: 1.0,
+    };
+    print_ivp_table(&cubic, &exact, &[10, 20, 40, 80, 160]);
+    let poly_jet = sphere_poly3::jet(sphere_poly3::data());
+    let exact = sphere_poly3::reference(sphere_poly3::data(), 0.5, 100_000)[0];
+    println!(
+        "\nRiemannian polynomial of order 3 (k = 3), T = 0.5, the same columns (reference: RK4"
+    );
+    println!("of D_t^5 V + R(D_t^3 V, V) V - R(D_t^2 V, D_t V) V = 0, 10^5 steps):\n");
+    let poly = Ivp {
+        system: Poly3::new(),
+        jet: &poly_jet,
+        t: 0.5,
+    };
+    print_ivp_table(&poly, &exact, &[10, 20, 40, 80]);
 }
 
 /// 10^6 steps of the geodesic flow-free cubic at h = 10^-4 (T = 100) with the projection
@@ -185,7 +248,7 @@ fn plan(chart: &Chart, cap: Option<&OutsideCap>) -> (Plan<2, 4>, f64) {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    print_ivp_table();
+    print_ivp_tables();
     print_invariants();
 
     let chart = Chart::at(&Vector3::x())?;
