@@ -1,9 +1,9 @@
 //! Order k = 3 on the sphere: the Riemannian polynomial L = 1/2 |D_t^2 q'|^2, stepped by the
 //! maps of S^2 lifted at run time (`map::TaylorLift`). The lift equals the generated one at
-//! orders 1 and 2; at order 3 the state stays on the sphere, the Noether momentum is
-//! conserved, the energy error is O(h^2), the step is symplectic, and the midpoint maps converge with order 2 (the
-//! initial-point map with order 1) to an RK4 solution of the embedded Euler-Lagrange
-//! equation D_t^5 V + R(D_t^3 V, V) V - R(D_t^2 V, D_t V) V = 0.
+//! orders 1 and 2. At order 3 the state stays on the sphere, the Noether momentum is
+//! conserved, the energy error is O(h^2), the step is symplectic, and the midpoint maps
+//! converge with order 2 (the initial-point map with order 1) to an RK4 solution of the
+//! embedded Euler-Lagrange equation D_t^5 V + R(D_t^3 V, V) V - R(D_t^2 V, D_t V) V = 0.
 
 use retract::diagnostics::canonical_structure;
 use retract::lifted::Blocks;
