@@ -11,6 +11,7 @@ use crate::emit::lagrangian::lagrangian_impl;
 use crate::emit::lifted::lifted_system_impl;
 use crate::emit::outputs::outputs_impl;
 use crate::emit::reduced::reduced_scheme_impl;
+use crate::emit::separable::separable_impl;
 use crate::emit::ty::type_and_constructor;
 use crate::graph::{Graph, Id};
 use crate::lower::{Guard, Lower, without_output_marks};
@@ -162,13 +163,15 @@ fn on_sphere(
 
 /// The generated items, in order: the function and its type (`emit::ty`), the `Lagrangian`
 /// impl (`emit::lagrangian`), the `LiftedSystem` impl with its domain check (`emit::lifted`,
-/// `emit::domain`) and, where the step reduces, the `ReducedScheme` impl (`emit::reduced`);
+/// `emit::domain`), where the step reduces, the `ReducedScheme` impl (`emit::reduced`) and,
+/// where L = c/2 |u|^2 + V(q), the `Separable` impl (`emit::separable`);
 /// then the methods of the named outputs (`emit::outputs`).
 fn generate(e: &Emission<'_>) -> TokenStream {
     let mut out = type_and_constructor(e);
     out.extend(lagrangian_impl(e));
     out.extend(lifted_system_impl(e));
     out.extend(reduced_scheme_impl(e));
+    out.extend(separable_impl(e));
     out
 }
 

@@ -29,6 +29,7 @@ mod map_check;
 mod map_lift;
 mod mechanics;
 mod scopes;
+mod separable;
 mod signature;
 mod sphere;
 mod util;

@@ -26,4 +26,5 @@ mod robustness_chord_invariant;
 mod robustness_runtime;
 mod sphere;
 mod sphere_order3;
+mod splitting;
 mod structure;

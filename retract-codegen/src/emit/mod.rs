@@ -8,6 +8,7 @@
 //! - `domain`: its `check_domain` method (the singularity guard);
 //! - `reduced`: the `ReducedScheme` impl, where the Hessian of L depends on a few jet
 //!   components only;
+//! - `separable`: the `Separable` impl, where L = c/2 |u|^2 + V(q) (explicit splitting);
 //! - `outputs`: a method per named output (`#[output] let`) of the Lagrangian.
 //!
 //! `map` emits the items of `#[discretization_map]` (its own type and `DiscretizationMap`
@@ -36,6 +37,7 @@ pub(crate) mod map;
 pub(crate) mod outputs;
 pub(crate) mod reduced;
 pub(crate) mod scalar;
+pub(crate) mod separable;
 pub(crate) mod ty;
 
 /// What the items generated for one Lagrangian share: the input, its mechanics, and the

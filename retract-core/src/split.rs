@@ -1,0 +1,208 @@
+//! An explicit symplectic splitting for Lagrangians $L = \tfrac{c}{2} |q^{(k)}|^2 + V(q)$.
+//!
+//! Their Ostrogradsky Hamiltonian splits as $H = H_0 + H_V$ with
+//!
+//! $$H_0 = \sum_{j < k-1} p_j \cdot x_{j+1} + \tfrac{1}{2c} |p_{k-1}|^2, \qquad
+//!   H_V = -V(x_0).$$
+//!
+//! The flow of $H_0$ is linear with a nilpotent generator $A$ ($x_j' = x_{j+1}$,
+//! $x_{k-1}' = p_{k-1}/c$, $p_0' = 0$, $p_j' = -p_{j-1}$; $A^{2k} = 0$), so
+//! $e^{tA} = \sum_{m < 2k} t^m A^m / m!$ is exact; the flow of $H_V$ is the kick
+//! $p_0 \mathrel{+}= t\, \nabla V(x_0)$. [`split_step`] is Strang's splitting
+//! $e^{hA/2} \circ \mathrm{kick}_h \circ e^{hA/2}$: explicit (one gradient of $V$ per step, no
+//! Newton solve), symplectic and symmetric, of order 2; compose it with
+//! [`crate::compose::compose`] for orders 4, 6 and 8.
+//!
+//! `#[higher_order_lagrangian]` implements [`Separable`] when it finds this form in $L$.
+//! Where it does not apply ($L$ not separable, such as $\tfrac12 |M(q) q'' + c|^2$), the
+//! implicit midpoint scheme ([`crate::step()`]) is needed; near a stiff barrier an explicit
+//! step also needs a step size that resolves the barrier, where the implicit one adapts by
+//! halving.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::lifted::{join, split};
+use crate::step::{StepOptions, StepReport, check_step_domain};
+use crate::{Error, Lagrangian, LiftedSystem};
+
+/// A Lagrangian $L(x, u) = \tfrac{c}{2} |u|^2 + V(x_0)$: quadratic in the top derivative
+/// $u = q^{(k)}$ with the constant weight $c > 0$, free of $q', \dots, q^{(k-1)}$, and no
+/// term coupling $u$ and $q$. Then $\partial L / \partial x_0 = \nabla V(x_0)$.
+pub trait Separable<const N: usize, const K: usize>: Lagrangian<N, K> {
+    /// The weight $c$ of $\tfrac{c}{2} |u|^2$.
+    fn kinetic_weight(&self) -> f64;
+}
+
+/// $A z$ for the generator of the free flow (module docs), $1/c$ = `inverse_weight`.
+fn generator<const N: usize, const K: usize, const S: usize>(
+    z: &SVector<f64, S>,
+    inverse_weight: f64,
+) -> SVector<f64, S> {
+    let (x, p) = split::<N, K, S>(z);
+    let dx = core::array::from_fn(|j| {
+        if j + 1 < K {
+            x[j + 1]
+        } else {
+            p[K - 1] * inverse_weight
+        }
+    });
+    let dp = core::array::from_fn(|j| if j == 0 { SVector::zeros() } else { -p[j - 1] });
+    join::<N, K, S>(&dx, &dp)
+}
+
+/// The exact free flow $e^{tA} z = \sum_{m < 2k} t^m A^m z / m!$.
+pub fn free_flow<const N: usize, const K: usize, const S: usize>(
+    z: &SVector<f64, S>,
+    t: f64,
+    weight: f64,
+) -> SVector<f64, S> {
+    let inverse = 1.0 / weight;
+    let (mut term, mut sum) = (*z, *z);
+    for m in 1..2 * K {
+        term = generator::<N, K, S>(&term, inverse) * (t / m as f64);
+        sum += term;
+    }
+    sum
+}
+
+/// $e^{tA}$ as a matrix (the free flow's derivative).
+fn free_flow_matrix<const N: usize, const K: usize, const S: usize>(
+    t: f64,
+    weight: f64,
+) -> SMatrix<f64, S, S> {
+    let mut m = SMatrix::<f64, S, S>::zeros();
+    for c in 0..S {
+        let mut unit = SVector::<f64, S>::zeros();
+        unit[c] = 1.0;
+        m.set_column(c, &free_flow::<N, K, S>(&unit, t, weight));
+    }
+    m
+}
+
+/// $(x, u)$ at state `z` with $u = p_{k-1}/c$ (the top derivative of the free flow).
+fn jet_of<const N: usize, const K: usize, const S: usize>(
+    z: &SVector<f64, S>,
+    weight: f64,
+) -> ([SVector<f64, N>; K], SVector<f64, N>) {
+    let (x, p) = split::<N, K, S>(z);
+    (x, p[K - 1] / weight)
+}
+
+/// The weight $c$ of `system`, checked: finite and positive.
+fn weight_of<Sys, const N: usize, const K: usize>(system: &Sys) -> Result<f64, Error>
+where
+    Sys: Separable<N, K> + ?Sized,
+{
+    let c = system.kinetic_weight();
+    if c.is_finite() && c > 0.0 {
+        Ok(c)
+    } else {
+        Err(Error::InvalidArgument {
+            name: "kinetic_weight",
+            requirement: "finite and positive (L = c/2 |u|^2 + V(q) with c > 0)",
+        })
+    }
+}
+
+/// One step of Strang's splitting $e^{hA/2} \circ \mathrm{kick}_h \circ e^{hA/2}$ (module
+/// docs), with the singularity guard of [`check_step_domain`] from `z0` to the result (its
+/// `options.theta` and chord settings; `u` the top derivative $p_{k-1}/c$ at the end).
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for a weight that is not finite and positive, or a step size
+/// that is not finite; [`Error::NonFinite`] if $\nabla V$ or the state is not finite;
+/// [`Error::Domain`] if the step leaves the domain of $L$.
+pub fn split_step<Sys, const N: usize, const K: usize, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+    options: &StepOptions,
+) -> Result<(SVector<f64, S>, StepReport), Error>
+where
+    Sys: Separable<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    const { assert!(M == S + N, "M must equal S + N") };
+    let weight = weight_of(system)?;
+    if !h.is_finite() {
+        return Err(Error::InvalidArgument {
+            name: "h",
+            requirement: "finite",
+        });
+    }
+    let mut z = free_flow::<N, K, S>(z0, 0.5 * h, weight);
+    let (x, u) = jet_of::<N, K, S>(&z, weight);
+    let grad = system.gradient(&x, &u).x[0];
+    for a in 0..N {
+        z[K * N + a] += h * grad[a];
+    }
+    let z1 = free_flow::<N, K, S>(&z, 0.5 * h, weight);
+    if !z1.iter().all(|v| v.is_finite()) {
+        return Err(Error::NonFinite {
+            iteration: 0,
+            location: "explicit splitting step (gradient of the potential)",
+        });
+    }
+    let (_, u1) = jet_of::<N, K, S>(&z1, weight);
+    let w = SVector::<f64, M>::from_fn(|r, _| if r < S { z1[r] } else { u1[r - S] });
+    check_step_domain(system, z0, &w, options).map_err(Error::Domain)?;
+    Ok((z1, StepReport::default()))
+}
+
+/// The derivative $\partial z_1 / \partial z_0$ of [`split_step`]: $e^{hA/2} (I + h\,
+/// \partial^2 V) e^{hA/2}$, the kick's block $\partial p_0 / \partial x_0 = h \nabla^2 V$
+/// (for the symplecticity check $D^T J D = J$).
+///
+/// # Errors
+/// As the weight check of [`split_step`]; [`Error::NonFinite`] for a Hessian of $V$ that is
+/// not finite.
+pub fn split_step_derivative<Sys, const N: usize, const K: usize, const S: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    h: f64,
+) -> Result<SMatrix<f64, S, S>, Error>
+where
+    Sys: Separable<N, K> + ?Sized,
+{
+    let weight = weight_of(system)?;
+    let half = free_flow_matrix::<N, K, S>(0.5 * h, weight);
+    let (x, u) = jet_of::<N, K, S>(&free_flow::<N, K, S>(z0, 0.5 * h, weight), weight);
+    let hessian = system.hessian(&x, &u).xx[0][0];
+    let mut kick = SMatrix::<f64, S, S>::identity();
+    for a in 0..N {
+        for b in 0..N {
+            kick[(K * N + a, b)] = h * hessian[(a, b)];
+        }
+    }
+    let d = half * kick * half;
+    if d.iter().all(|v| v.is_finite()) {
+        Ok(d)
+    } else {
+        Err(Error::NonFinite {
+            iteration: 0,
+            location: "derivative of the explicit splitting step",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without a potential the flow of L = 1/2 |q'''|^2 (k = 3) is the quintic through the
+    /// jet: the free flow reproduces it exactly.
+    #[test]
+    fn the_free_flow_is_the_polynomial_through_the_jet() {
+        // k = 3, n = 1: q^(6) = 0, with p_2 = q''' (c = 1), p_1 = -q'''' , p_0 = q^(5)
+        let d = [0.3, -1.2, 0.7, 2.0, -0.5, 1.5]; // q, q', ..., q^(5) at 0
+        let z = SVector::<f64, 6>::from([d[0], d[1], d[2], d[5], -d[4], d[3]]);
+        let t = 0.8;
+        let q = (0..6).fold((0.0, 1.0), |(s, term), m| {
+            (s + d[m] * term, term * t / (m + 1) as f64)
+        });
+        let flowed = free_flow::<1, 3, 6>(&z, t, 1.0);
+        assert!((flowed[0] - q.0).abs() < 1e-15, "{} {}", flowed[0], q.0);
+        // and it is a flow: e^{(s+t)A} = e^{sA} e^{tA}
+        let twice = free_flow::<1, 3, 6>(&free_flow::<1, 3, 6>(&z, 0.3, 1.0), 0.5, 1.0);
+        assert!((twice - flowed).amax() < 1e-15);
+    }
+}
