@@ -24,6 +24,7 @@ use retract::diagnostics::rk4_step;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::plot::{self, Scale};
+use retract::split::{Separable, split_step};
 use retract::{LiftedSystem, ReducedScheme, ReducedStepper, StepOptions};
 
 #[higher_order_lagrangian(order = 2)]
@@ -62,10 +63,11 @@ impl<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>
     }
 }
 
-/// DOP853 (ode_solvers' defaults: safety 0.9, step factors in [1/3, 6]) with
-/// rtol = atol = `tol` and steps at most `h_max`: the states after every accepted step (its
-/// dense output is not used: in ode_solvers 0.6.2 it is inaccurate for coarse output
-/// intervals), and the number of accepted steps.
+/// DOP853 (ode_solvers' defaults: safety 0.9, step factors in [1/3, 6]) on the state of a
+/// generated system (its Hamilton equations, [`Hamilton`]) with rtol = atol = `tol` and steps
+/// at most `h_max`: the states after every accepted step (its dense output is not used: in
+/// ode_solvers 0.6.2 it is inaccurate for coarse output intervals), and the number of
+/// accepted steps.
 #[allow(clippy::type_complexity)]
 fn dop853<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>(
     system: &Sys,
@@ -74,9 +76,21 @@ fn dop853<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>(
     tol: f64,
     h_max: f64,
 ) -> Result<(Vec<(f64, SVector<f64, S>)>, u32), Box<dyn std::error::Error>> {
-    let y0 = ode_solvers::SVector::<f64, S>::from_column_slice(z0.as_slice());
+    dop853_on(Hamilton::<Sys, M>(system), z0, t_end, tol, h_max)
+}
+
+/// [`dop853`] on any right-hand side `f`.
+#[allow(clippy::type_complexity)]
+fn dop853_on<F: System<f64, ode_solvers::SVector<f64, S>>, const S: usize>(
+    f: F,
+    y0: &SVector<f64, S>,
+    t_end: f64,
+    tol: f64,
+    h_max: f64,
+) -> Result<(Vec<(f64, SVector<f64, S>)>, u32), Box<dyn std::error::Error>> {
+    let y0 = ode_solvers::SVector::<f64, S>::from_column_slice(y0.as_slice());
     let mut solver = Dop853::from_param(
-        Hamilton::<Sys, M>(system),
+        f,
         0.0,
         t_end,
         t_end,
@@ -101,6 +115,51 @@ fn dop853<Sys: LiftedSystem<S, M>, const S: usize, const M: usize>(
         .map(|(t, y)| (*t, SVector::from_column_slice(y.as_slice())))
         .collect();
     Ok((states, stats.accepted_steps))
+}
+
+/// The obstacle model's Euler-Lagrange equation as a plain first-order system, the peers'
+/// best form: y = (q, q', q'', q'''), y' = (q', q'', q''', -grad V(q)) with
+/// V = tau / (q_0^2 + q_1^2 - r^2), so -grad V = 2 tau (q_0, q_1, 0) / d^2.
+#[derive(Clone, Copy)]
+struct Plain {
+    tau: f64,
+    r: f64,
+}
+
+impl Plain {
+    fn rhs(&self, y: &SVector<f64, 12>) -> SVector<f64, 12> {
+        let d = y[0] * y[0] + y[1] * y[1] - self.r * self.r;
+        let c = 2.0 * self.tau / (d * d);
+        let mut dy = SVector::<f64, 12>::zeros();
+        dy.fixed_rows_mut::<9>(0).copy_from(&y.fixed_rows::<9>(3));
+        dy[9] = c * y[0];
+        dy[10] = c * y[1];
+        dy
+    }
+
+    /// Classical RK4 with `steps` steps to `t_end`.
+    fn rk4(&self, y0: &SVector<f64, 12>, t_end: f64, steps: usize) -> SVector<f64, 12> {
+        let h = t_end / steps as f64;
+        (0..steps).fold(*y0, |y, _| {
+            let k1 = self.rhs(&y);
+            let k2 = self.rhs(&(y + k1 * (h / 2.0)));
+            let k3 = self.rhs(&(y + k2 * (h / 2.0)));
+            let k4 = self.rhs(&(y + k3 * h));
+            y + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0)
+        })
+    }
+}
+
+impl System<f64, ode_solvers::SVector<f64, 12>> for Plain {
+    fn system(
+        &self,
+        _t: f64,
+        y: &ode_solvers::SVector<f64, 12>,
+        dy: &mut ode_solvers::SVector<f64, 12>,
+    ) {
+        let f = self.rhs(&SVector::from_column_slice(y.as_slice()));
+        dy.as_mut_slice().copy_from_slice(f.as_slice());
+    }
 }
 
 /// The state at `t_end` from [`dop853`].
@@ -152,10 +211,63 @@ where
     Ok(z)
 }
 
+/// `steps` steps of the explicit splitting composed to `order` (2: Strang itself).
+fn split<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    t_end: f64,
+    steps: usize,
+    order: u32,
+) -> Result<SVector<f64, S>, retract::Error>
+where
+    Sys: Separable<3, 2> + LiftedSystem<S, M>,
+{
+    let options = StepOptions::default();
+    let h = t_end / steps as f64;
+    let mut z = *z0;
+    for _ in 0..steps {
+        z = compose(|z, h| split_step(system, z, h, &options), &z, h, order)?.0;
+    }
+    Ok(z)
+}
+
+/// One method's sweep: a table row per point (final error against `reference`, best wall
+/// time of 5 runs) and its curve.
+fn sweep<T: Copy>(
+    name: &str,
+    points: &[T],
+    label: impl Fn(T) -> String,
+    run: impl Fn(T) -> Result<SVector<f64, 12>, String>,
+    reference: &SVector<f64, 12>,
+) -> plot::Curve {
+    let mut curve = Vec::new();
+    for &point in points {
+        let (time, end) = timed(5, || run(point));
+        match end {
+            Ok(end) => {
+                let error = (end - reference).amax();
+                println!(
+                    "| {name} | {} | {error:.2e} | {:.1} us |",
+                    label(point),
+                    time * 1e6
+                );
+                curve.push((time, error.max(1e-16)));
+            }
+            Err(e) => println!("| {name} | {} | stopped: {e} | - |", label(point)),
+        }
+    }
+    plot::Curve::new(name, curve)
+}
+
+/// The obstacle IVP: the implicit midpoint compositions (reduced step), the explicit
+/// splitting and its compositions, and RK4 and DOP853 on the plain first-order system
+/// ([`Plain`]), their final states mapped to (x, p) by the Legendre map.
 fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
     let system = RigidBody { tau: 1e-2, r: 1.0 };
-    let jet = [-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-    let z0 = system.legendre(&SVector::from_column_slice(&jet));
+    let plain = Plain { tau: 1e-2, r: 1.0 };
+    let jet =
+        SVector::<f64, 12>::from([-2.0, 1.05, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let z0 = system.legendre(&jet);
     let t_end = 4.0;
     let reference = composed(&system, &z0, t_end, 4000, 8)?;
     let (dop_reference, _) = dop853_end(&system, &z0, t_end, 1e-14, t_end)?;
@@ -166,62 +278,65 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!("| method | steps / tol | final error | wall time |");
     println!("|---|---|---|---|");
+    let steps = |n: usize| n.to_string();
     let mut curves = Vec::new();
-    let methods: [(&str, u32, &[usize]); 4] = [
+    let implicit: [(&str, u32, &[usize]); 4] = [
         ("midpoint", 2, &[100, 200, 400, 800, 1600, 3200, 6400]),
         ("composition, order 4", 4, &[20, 40, 80, 160, 320, 640]),
         ("composition, order 6", 6, &[10, 20, 40, 80, 160]),
         ("composition, order 8", 8, &[5, 10, 20, 40, 80]),
     ];
-    for (name, order, sweep) in methods {
-        let mut points = Vec::new();
-        for &n in sweep {
-            let (time, end) = timed(5, || composed(&system, &z0, t_end, n, order));
-            match end {
-                Ok(end) => {
-                    let error = (end - reference).amax();
-                    println!("| {name} | {n} | {error:.2e} | {:.1} us |", time * 1e6);
-                    points.push((time, error.max(1e-16)));
-                }
-                Err(e) => println!("| {name} | {n} | stopped: {e} | - |"),
-            }
-        }
-        curves.push(plot::Curve::new(name, points));
+    for (name, order, points) in implicit {
+        let run = |n| composed(&system, &z0, t_end, n, order).map_err(|e| e.to_string());
+        curves.push(sweep(name, points, steps, run, &reference));
     }
-    let mut points = Vec::new();
-    for n in [50, 100, 200, 400, 800, 1600, 3200] {
-        let h = t_end / n as f64;
-        let (time, end) = timed(5, || {
-            let mut z = z0;
-            for _ in 0..n {
-                z = rk4_step(&system, &z, h)?;
-            }
-            Ok::<_, retract::Error>(z)
-        });
-        match end {
-            Ok(end) => {
-                let error = (end - reference).amax();
-                println!("| RK4 | {n} | {error:.2e} | {:.1} us |", time * 1e6);
-                points.push((time, error.max(1e-16)));
-            }
-            Err(e) => println!("| RK4 | {n} | stopped: {e} | - |"),
-        }
+    let explicit: [(&str, u32, &[usize]); 4] = [
+        ("splitting", 2, &[200, 400, 800, 1600, 3200, 6400, 12800]),
+        ("splitting, order 4", 4, &[40, 80, 160, 320, 640, 1280]),
+        ("splitting, order 6", 6, &[20, 40, 80, 160, 320]),
+        ("splitting, order 8", 8, &[10, 20, 40, 80, 160]),
+    ];
+    for (name, order, points) in explicit {
+        let run = |n| split(&system, &z0, t_end, n, order).map_err(|e| e.to_string());
+        curves.push(sweep(name, points, steps, run, &reference));
     }
-    curves.push(plot::Curve::new("RK4", points));
-    for (label, h_max) in [("DOP853", t_end)] {
-        let mut points = Vec::new();
-        for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
-            let (time, result) = timed(5, || dop853_end(&system, &z0, t_end, tol, h_max));
-            let (end, steps) = result?;
-            let error = (end - reference).amax();
-            println!(
-                "| {label} | tol {tol:.0e} ({steps} steps) | {error:.2e} | {:.1} us |",
-                time * 1e6
-            );
-            points.push((time, error.max(1e-16)));
-        }
-        curves.push(plot::Curve::new(label, points));
-    }
+    let rk4 = |n| Ok(system.legendre(&plain.rk4(&jet, t_end, n)));
+    curves.push(sweep(
+        "RK4",
+        &[100, 200, 400, 800, 1600, 3200],
+        steps,
+        rk4,
+        &reference,
+    ));
+    let dop = |tol: f64| {
+        let (states, _) = dop853_on(plain, &jet, t_end, tol, t_end).map_err(|e| e.to_string())?;
+        let end = states.last().ok_or("DOP853 returned no state")?.1;
+        Ok(system.legendre(&end))
+    };
+    let tolerances = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
+    curves.push(sweep(
+        "DOP853",
+        &tolerances,
+        |t| format!("tol {t:.0e}"),
+        dop,
+        &reference,
+    ));
+    print_at_target(&curves);
+    let figure = common::docs_path("work_precision.svg");
+    plot::panels(
+        &figure,
+        "Obstacle IVP to T = 4: final error against wall time",
+        "wall time [s]",
+        &[("max-norm error at T", curves)],
+        Scale::Log,
+    )?;
+    println!("\nfigure: {}", figure.display());
+    Ok(())
+}
+
+/// The wall time of every method at a final error of 1e-8, and the line
+/// `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <best/DOP853>`.
+fn print_at_target(curves: &[plot::Curve]) {
     println!("\nWall time at a final error of 1e-8 (log-log interpolation between sweep points):");
     let at_target: Vec<(&str, f64)> = curves
         .iter()
@@ -233,21 +348,16 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
     let dop = at_target.iter().find(|(label, _)| *label == "DOP853");
     let best = at_target
         .iter()
-        .filter(|(label, _)| label.starts_with("composition"))
+        .filter(|(label, _)| label.starts_with("composition") || label.starts_with("splitting"))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     if let (Some((_, dop)), Some((label, best))) = (dop, best) {
-        println!("  best composition ({label}) / DOP853: {:.1}x", best / dop);
+        println!(
+            "work-precision 1e-8: best={label} {:.1} us, DOP853 {:.1} us, ratio {:.2}",
+            best * 1e6,
+            dop * 1e6,
+            best / dop
+        );
     }
-    let figure = common::docs_path("work_precision.svg");
-    plot::panels(
-        &figure,
-        "Obstacle IVP to T = 4: final error against wall time",
-        "wall time [s]",
-        &[("max-norm error at T", curves)],
-        Scale::Log,
-    )?;
-    println!("\nfigure: {}", figure.display());
-    Ok(())
 }
 
 /// The wall time at which a sweep of (time, error) points reaches `target`, interpolating
