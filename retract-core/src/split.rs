@@ -59,7 +59,11 @@ pub fn free_flow<const N: usize, const K: usize, const S: usize>(
             z.fixed_rows::<N>(m * N).into_owned()
         } else {
             let i = m - K;
-            let sign = if i.is_multiple_of(2) { inverse } else { -inverse };
+            let sign = if i.is_multiple_of(2) {
+                inverse
+            } else {
+                -inverse
+            };
             z.fixed_rows::<N>((2 * K - 1 - i) * N) * sign
         };
     }

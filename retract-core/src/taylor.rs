@@ -1,5 +1,6 @@
 //! Numbers for differentiating a rational function at run time: truncated Taylor series
-//! ([`Taylor`]) and second-order dual numbers ([`Hyper`]), both without heap.
+//! ([`Taylor`]), first- and second-order dual numbers ([`Dual`], [`Hyper`]), all without
+//! heap.
 //!
 //! A function written once over a [`Scalar`] and evaluated on `Taylor<Hyper<V>, D>` gives, in
 //! one pass, the Taylor coefficients along a curve of its value, its gradient and its Hessian
@@ -70,12 +71,17 @@ impl<const V: usize> Hyper<V> {
     /// gradient $\phi' g$, Hessian $\phi' H + \phi'' g g^T$.
     #[inline(always)]
     fn chain(self, value: f64, d1: f64, d2: f64) -> Self {
+        let mut h = [[0.0; V]; V];
+        for a in 0..V {
+            for b in a..V {
+                let v = d1 * self.h[a][b] + d2 * self.g[a] * self.g[b];
+                (h[a][b], h[b][a]) = (v, v);
+            }
+        }
         Self {
             f: value,
             g: self.g.map(|g| d1 * g),
-            h: core::array::from_fn(|a| {
-                core::array::from_fn(|b| d1 * self.h[a][b] + d2 * self.g[a] * self.g[b])
-            }),
+            h,
         }
     }
 
@@ -138,17 +144,21 @@ impl<const V: usize> Mul for Hyper<V> {
     /// $(fg, f g' + g f', f g'' + g f'' + f' g'^T + g' f'^T)$.
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
+        // the Hessian is symmetric: the upper triangle, mirrored
+        let mut h = [[0.0; V]; V];
+        for a in 0..V {
+            for b in a..V {
+                let v = self.f * o.h[a][b]
+                    + o.f * self.h[a][b]
+                    + self.g[a] * o.g[b]
+                    + o.g[a] * self.g[b];
+                (h[a][b], h[b][a]) = (v, v);
+            }
+        }
         Self {
             f: self.f * o.f,
             g: core::array::from_fn(|a| self.f * o.g[a] + o.f * self.g[a]),
-            h: core::array::from_fn(|a| {
-                core::array::from_fn(|b| {
-                    self.f * o.h[a][b]
-                        + o.f * self.h[a][b]
-                        + self.g[a] * o.g[b]
-                        + o.g[a] * self.g[b]
-                })
-            }),
+            h,
         }
     }
 }
@@ -162,6 +172,100 @@ impl<const V: usize> Div for Hyper<V> {
 }
 
 impl<const V: usize> Neg for Hyper<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self.scaled(-1.0)
+    }
+}
+
+/// A first-order dual number in $V$ variables: $f$ and its gradient $g$ (what
+/// [`Hyper`] computes without the Hessian).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dual<const V: usize> {
+    /// The value $f$.
+    pub f: f64,
+    /// $\partial f / \partial z_a$.
+    pub g: [f64; V],
+}
+
+impl<const V: usize> Dual<V> {
+    /// The variable $z_a$ with value `value`: gradient $e_a$.
+    pub fn variable(value: f64, a: usize) -> Self {
+        let mut x = Self::constant(value);
+        x.g[a] = 1.0;
+        x
+    }
+
+    /// Every component scaled by $c$.
+    #[inline(always)]
+    fn scaled(self, c: f64) -> Self {
+        Self {
+            f: self.f * c,
+            g: self.g.map(|g| g * c),
+        }
+    }
+}
+
+impl<const V: usize> Scalar for Dual<V> {
+    #[inline(always)]
+    fn constant(c: f64) -> Self {
+        Self { f: c, g: [0.0; V] }
+    }
+    /// $1/f$ with gradient $-g/f^2$.
+    #[inline(always)]
+    fn recip(self) -> Self {
+        let r = 1.0 / self.f;
+        Self {
+            f: r,
+            g: self.g.map(|g| -r * r * g),
+        }
+    }
+}
+
+impl<const V: usize> Add for Dual<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self {
+            f: self.f + o.f,
+            g: core::array::from_fn(|a| self.g[a] + o.g[a]),
+        }
+    }
+}
+
+impl<const V: usize> Sub for Dual<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self {
+            f: self.f - o.f,
+            g: core::array::from_fn(|a| self.g[a] - o.g[a]),
+        }
+    }
+}
+
+impl<const V: usize> Mul for Dual<V> {
+    type Output = Self;
+    /// $(fg, f g' + g f')$.
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Self {
+            f: self.f * o.f,
+            g: core::array::from_fn(|a| self.f * o.g[a] + o.f * self.g[a]),
+        }
+    }
+}
+
+impl<const V: usize> Div for Dual<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self * o.recip()
+    }
+}
+
+impl<const V: usize> Neg for Dual<V> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
@@ -280,7 +384,7 @@ impl<T: Scalar, const D: usize> Neg for Taylor<T, D> {
 }
 
 /// The operations with an `f64` on the right (on the constant term for $+$ and $-$), for
-/// [`Hyper`] and [`Taylor`].
+/// [`Dual`], [`Hyper`] and [`Taylor`].
 macro_rules! mixed_ops {
     ($ty:ty, [$($generics:tt)*], $add:expr, $scale:expr) => {
         impl<$($generics)*> Add<f64> for $ty {
@@ -319,6 +423,12 @@ mixed_ops!(
     [const V: usize],
     |x: Hyper<V>, c: f64| Hyper { f: x.f + c, ..x },
     |x: Hyper<V>, c: f64| x.scaled(c)
+);
+mixed_ops!(
+    Dual<V>,
+    [const V: usize],
+    |x: Dual<V>, c: f64| Dual { f: x.f + c, ..x },
+    |x: Dual<V>, c: f64| x.scaled(c)
 );
 mixed_ops!(
     Taylor<T, D>,
@@ -365,6 +475,17 @@ mod tests {
             assert!((v.h[1][b] - dy).abs() < 1e-5, "{b}: {} {dy}", v.h[1][b]);
         }
         assert_eq!(v.h[0][1], v.h[1][0]);
+    }
+
+    #[test]
+    fn dual_numbers_give_the_gradient_of_hyper_numbers() {
+        let (x0, y0) = (0.7, -0.4);
+        let d = f(Dual::<2>::variable(x0, 0), Dual::variable(y0, 1));
+        let h = f(Hyper::<2>::variable(x0, 0), Hyper::variable(y0, 1));
+        assert_eq!(d.f, h.f);
+        for a in 0..2 {
+            assert!((d.g[a] - h.g[a]).abs() < 1e-15, "{a}");
+        }
     }
 
     #[test]

@@ -18,7 +18,7 @@ use nalgebra::SVector;
 
 use super::{BlockMatrix, CovectorHessian, DiscretizationMap, MapJacobians};
 use crate::lifted::Blocks;
-use crate::taylor::{Hyper, Scalar, Taylor};
+use crate::taylor::{Dual, Hyper, Scalar, Taylor};
 
 /// A discretization map $R_d(q, v) = (R_1, R_2)$ on $\mathbb{R}^n$ written once over a
 /// [`Scalar`], so that it can be evaluated on Taylor and dual numbers.
@@ -43,16 +43,17 @@ fn inverse_factorial(l: usize) -> f64 {
 }
 
 /// The lift of `x` to a curve's series: component $a$ has coefficients $x^{(j)}_a / j!$, the
-/// constant one seeded as variable `offset + a` when `V > 0` variables are tracked.
-fn curve<const N: usize, const K: usize, const V: usize>(
+/// constant one the variable `offset + a` (`variable(value, index)`).
+fn curve<T: Scalar, const N: usize, const K: usize>(
     x: &Blocks<N, K>,
     offset: usize,
-) -> [Taylor<Hyper<V>, K>; N] {
+    variable: impl Fn(f64, usize) -> T,
+) -> [Taylor<T, K>; N] {
     core::array::from_fn(|a| {
         let mut series = Taylor::from_derivatives(core::array::from_fn(|j| x[j][a]))
             .c
-            .map(Hyper::constant);
-        series[0] = Hyper::variable(x[0][a], offset + a);
+            .map(T::constant);
+        series[0] = variable(x[0][a], offset + a);
         Taylor { c: series }
     })
 }
@@ -65,7 +66,7 @@ fn series<B: BaseMap<N>, const N: usize, const K: usize, const V: usize>(
     x: &Blocks<N, K>,
     xi: &Blocks<N, K>,
 ) -> ([Taylor<Hyper<V>, K>; N], [Taylor<Hyper<V>, K>; N]) {
-    map.base(curve(x, 0), curve(xi, N))
+    map.base(curve(x, 0, Hyper::variable), curve(xi, N, Hyper::variable))
 }
 
 macro_rules! taylor_lift {
@@ -92,8 +93,12 @@ macro_rules! taylor_lift {
 
             /// $\partial D^j R / \partial z^{(i)} = (j!/i!)\, c_{j-i}[\partial R]$.
             fn jacobians(&self, x: &Blocks<$n, K>, xi: &Blocks<$n, K>) -> MapJacobians<$n, K> {
-                let (r1, r2) = series::<B, $n, K, $v>(&self.0, x, xi);
-                let jacobian = |r: &[Taylor<Hyper<$v>, K>; $n],
+                // first-order duals: the Hessian is not needed here
+                let (r1, r2) = self.0.base(
+                    curve::<Dual<$v>, $n, K>(x, 0, Dual::variable),
+                    curve::<Dual<$v>, $n, K>(xi, $n, Dual::variable),
+                );
+                let jacobian = |r: &[Taylor<Dual<$v>, K>; $n],
                                 offset: usize|
                  -> BlockMatrix<$n, K> {
                     core::array::from_fn(|j| {
