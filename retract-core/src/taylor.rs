@@ -10,8 +10,9 @@
 //! Only the field operations are provided ($+$, $-$, $\times$, $/$ and negation, with `f64`
 //! on either side): enough for rational maps such as the projection maps of a sphere.
 
-// (the product and quotient rules add and multiply inside `Mul` and `Div`)
-#![allow(clippy::suspicious_arithmetic_impl)]
+// (the product and quotient rules add and multiply inside `Mul` and `Div`; the symmetric
+// Hessians are filled by index pairs)
+#![allow(clippy::suspicious_arithmetic_impl, clippy::needless_range_loop)]
 
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
