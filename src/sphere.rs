@@ -22,10 +22,10 @@
 //!   $\theta^{16}$, exact to rounding for $|\xi| \le 2$ (a step that turns the point by less
 //!   than 2 rad).
 //!
-//! Each is a unit struct implementing [`SphereMap`] for orders $k = 1, \dots, 4$. At $k = 1, 2$
+//! Each is a unit struct implementing [`SphereMap`] for orders $k = 1, 2, 3$. At $k = 1, 2$
 //! the lifted map is generated (`in_chart::k1`, `in_chart::k2`): straight-line code, the
 //! fastest. Its size grows fast with the order (1 to 7 MB of source per map at $k = 3$), so
-//! at $k = 3, 4$ the same map text, compiled a second time over a
+//! at $k = 3$ the same map text, compiled a second time over a
 //! [`Scalar`](retract_core::taylor::Scalar) (`in_chart::any`), is lifted at run time by
 //! [`TaylorLift`]: one evaluation on Taylor series of second-order dual numbers gives the
 //! lift, its Jacobians and its covector Hessian. The tests check that both agree at $k = 1,
@@ -44,7 +44,7 @@ macro_rules! sphere_maps {
     (@orders [] $args:tt $prelude:tt $($rest:tt)*) => {
         /// The maps at every order, written over a [`Scalar`](retract_core::taylor::Scalar)
         /// and lifted at run time by [`TaylorLift`](retract_core::map::TaylorLift) (module
-        /// docs): what [`SphereMap`](retract_core::sphere::SphereMap) uses for $k \ge 3$.
+        /// docs): what [`SphereMap`](retract_core::sphere::SphereMap) uses at $k = 3$.
         pub mod any {
             use retract_core::map::BaseMap;
             use retract_core::taylor::Scalar;
@@ -204,7 +204,7 @@ pub mod in_chart {
 }
 
 /// Implements [`SphereMap`] for a unit struct: by its generated map at orders 1 and 2, by its
-/// lift at run time ([`TaylorLift`]) at orders 3 and 4.
+/// lift at run time ([`TaylorLift`]) at order 3.
 macro_rules! sphere_map_impls {
     ($name:ident) => {
         impl SphereMap<1> for $name {
@@ -220,12 +220,6 @@ macro_rules! sphere_map_impls {
             }
         }
         impl SphereMap<3> for $name {
-            type InChart = TaylorLift<in_chart::any::$name>;
-            fn in_chart(&self, chart: [f64; 9]) -> Self::InChart {
-                TaylorLift(in_chart::any::$name { chart })
-            }
-        }
-        impl SphereMap<4> for $name {
             type InChart = TaylorLift<in_chart::any::$name>;
             fn in_chart(&self, chart: [f64; 9]) -> Self::InChart {
                 TaylorLift(in_chart::any::$name { chart })

@@ -36,7 +36,8 @@ pub trait Separable<const N: usize, const K: usize>: Lagrangian<N, K> {
     fn kinetic_weight(&self) -> f64;
 }
 
-/// The exact free flow $e^{tA} z$. In the variables $w = (x_0, \dots, x_{k-1}, p_{k-1}/c,
+/// The exact free flow $e^{tA} z$ for the weight $c$ = `weight` (finite and positive: the
+/// caller's to check, as [`split_step`] does; otherwise the result is not finite). In the variables $w = (x_0, \dots, x_{k-1}, p_{k-1}/c,
 /// -p_{k-2}/c, \dots, (-1)^{k-1} p_0 / c)$, the derivatives $(q, \dots, q^{(2k-1)})$ of the
 /// free motion $q^{(2k)} = 0$, $A$ is the shift $w_m \mapsto w_{m+1}$, so the flow is the
 /// Taylor polynomial $w_m(t) = \sum_i t^i w_{m+i} / i!$.
@@ -136,7 +137,8 @@ where
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] for a weight that is not finite and positive, or a step size
-/// that is not finite; [`Error::NonFinite`] if $\nabla V$ or the state is not finite;
+/// that is not finite; [`Error::NonFinite`] if the state, $\nabla V$ or the result is not
+/// finite;
 /// [`Error::Domain`] if the step leaves the domain of $L$.
 pub fn split_step<Sys, const N: usize, const K: usize, const S: usize, const M: usize>(
     system: &Sys,
@@ -149,6 +151,12 @@ where
 {
     const { assert!(M == S + N, "M must equal S + N") };
     let weight = weight_of(system)?;
+    if !z0.iter().all(|v| v.is_finite()) {
+        return Err(Error::NonFinite {
+            iteration: 0,
+            location: "initial state of the explicit splitting step",
+        });
+    }
     if !h.is_finite() {
         return Err(Error::InvalidArgument {
             name: "h",

@@ -7,8 +7,8 @@
 //! in $V$ variables. [`crate::map::TaylorLift`] uses this to lift a discretization map to
 //! $T^{(k-1)}Q$ at any order without generating the lift's code.
 //!
-//! Only the field operations are provided ($+$, $-$, $\times$, $/$ and negation, with `f64`
-//! on either side): enough for rational maps such as the projection maps of a sphere.
+//! Only the field operations are provided ($+$, $-$, $\times$, $/$ and negation, with an `f64`
+//! on the right): enough for rational maps such as the projection maps of a sphere.
 
 // (the product and quotient rules add and multiply inside `Mul` and `Div`; the symmetric
 // Hessians are filled by index pairs)
@@ -62,6 +62,9 @@ pub struct Hyper<const V: usize> {
 
 impl<const V: usize> Hyper<V> {
     /// The variable $z_a$ with value `value`: gradient $e_a$, Hessian 0.
+    ///
+    /// # Panics
+    /// If `a` $\ge V$.
     pub fn variable(value: f64, a: usize) -> Self {
         let mut x = Self::constant(value);
         x.g[a] = 1.0;
@@ -192,6 +195,9 @@ pub struct Dual<const V: usize> {
 
 impl<const V: usize> Dual<V> {
     /// The variable $z_a$ with value `value`: gradient $e_a$.
+    ///
+    /// # Panics
+    /// If `a` $\ge V$.
     pub fn variable(value: f64, a: usize) -> Self {
         let mut x = Self::constant(value);
         x.g[a] = 1.0;
@@ -316,6 +322,7 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
     }
     #[inline(always)]
     fn recip(self) -> Self {
+        const { assert!(D >= 1, "a series has at least its constant term") };
         let r0 = self.c[0].recip();
         let mut r = [r0; D];
         for j in 1..D {

@@ -1,7 +1,8 @@
 //! The explicit splitting of `retract::split` on the obstacle model L = 1/2 |q''|^2 + V(q)
 //! (which the macro marks `Separable`): order 2, and 4, 6, 8 composed; symplectic, with a
 //! derivative that matches differences; the same solution as the implicit midpoint
-//! compositions; the guard; and nothing marked that is not of the form.
+//! compositions, also at order k = 3 with a weight c != 1; and the guard. (That forms other
+//! than c/2 |u|^2 + V(q) are not marked is tested in retract-codegen's `separable`.)
 
 use crate::common;
 
@@ -10,7 +11,7 @@ use retract::compose::compose;
 use retract::diagnostics::canonical_structure;
 use retract::nalgebra::SVector;
 use retract::split::{Separable, split_step, split_step_derivative};
-use retract::{Error, LiftedSystem, StepOptions, composed_step};
+use retract::{Error, LiftedSystem, StepOptions, composed_step, higher_order_lagrangian};
 
 type Z = SVector<f64, 12>;
 
@@ -118,4 +119,40 @@ fn a_step_into_the_obstacle_is_a_domain_error() {
     let z0 = system.legendre(&Z::from_column_slice(&jet));
     let result = split_step(&system, &z0, 0.1, &StepOptions::default());
     assert!(matches!(result, Err(Error::Domain(_))), "{result:?}");
+}
+
+/// k = 3 with the weight m: L = m/2 |q^(3)|^2 + a cos(q_0 q_1) + q_0^4 / 10.
+#[higher_order_lagrangian(order = 3)]
+fn weighted(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2], dddq: [f64; 2], m: f64, a: f64) -> f64 {
+    0.5 * m * (dddq[0].powi(2) + dddq[1].powi(2)) + a * (q[0] * q[1]).cos() + 0.1 * q[0].powi(4)
+}
+
+#[test]
+fn with_a_weight_at_order_3_the_splitting_matches_the_midpoint_compositions() {
+    let system = Weighted { m: 2.5, a: 0.7 };
+    assert_eq!(system.kinetic_weight(), 2.5);
+    let jet = SVector::<f64, 12>::from([
+        0.3, -0.2, 0.5, 0.1, -0.4, 0.2, 0.3, 0.0, -0.1, 0.2, 0.05, -0.3,
+    ]);
+    let z0 = system.legendre(&jet);
+    let options = StepOptions::default();
+    let (t, steps) = (1.0, 64);
+    let h = t / steps as f64;
+    let run = |order: u32, splitting: bool| {
+        (0..steps).fold(z0, |z, _| {
+            if splitting {
+                compose(|z, h| split_step(&system, z, h, &options), &z, h, order)
+            } else {
+                composed_step(&system, &z, h, order, &options)
+            }
+            .expect("regular")
+            .0
+        })
+    };
+    let (split8, midpoint8) = (run(8, true), run(8, false));
+    let gap = (split8 - midpoint8).amax();
+    assert!(gap < 1e-10, "order 8: {gap:e}");
+    // Strang's splitting alone is a different method of order 2: far from both
+    let strang = (run(2, true) - midpoint8).amax();
+    assert!(strang > 1e3 * gap, "{strang:e}");
 }

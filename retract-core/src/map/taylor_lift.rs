@@ -28,7 +28,9 @@ pub trait BaseMap<const N: usize> {
 }
 
 /// The lift of a [`BaseMap`] to $T^{(k-1)}Q$, a [`DiscretizationMap`] at every order $k$
-/// (module docs), for $n \le 3$.
+/// (module docs), for $n \le 3$. Where the base map is not finite (a division by zero, such
+/// as a chart's edge for the maps of a sphere), neither are the results: [`super::step`]
+/// reports that as an error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TaylorLift<B>(pub B);
 
@@ -262,20 +264,25 @@ mod tests {
     }
 
     /// The Jacobians are the derivatives of the points, and the covector Hessian the
-    /// derivative of the covector's gradient, by central differences at order 3.
+    /// derivative of the covector's gradient, by central differences at orders 3 and 4.
     #[test]
     fn derivatives_of_the_lift_match_differences() {
-        let (x, xi) = (blocks::<3>(0.3), blocks::<3>(1.1));
-        let (w1, w2) = (blocks::<3>(2.3), blocks::<3>(-0.7));
+        check_derivatives::<3>();
+        check_derivatives::<4>();
+    }
+
+    fn check_derivatives<const K: usize>() {
+        let (x, xi) = (blocks::<K>(0.3), blocks::<K>(1.1));
+        let (w1, w2) = (blocks::<K>(2.3), blocks::<K>(-0.7));
         let map = TaylorLift(Rational);
         let jac = map.jacobians(&x, &xi);
         let hess = map.covector_hessian(&x, &xi, &w1, &w2);
         // grad of phi = w2 . R2 - w1 . R1 in (x, xi) from the Jacobians
-        let gradient = |x: &Blocks<2, 3>, xi: &Blocks<2, 3>| -> [[SVector<f64, 2>; 3]; 2] {
+        let gradient = |x: &Blocks<2, K>, xi: &Blocks<2, K>| -> [[SVector<f64, 2>; K]; 2] {
             let j = map.jacobians(x, xi);
-            let part = |r1: &BlockMatrix<2, 3>, r2: &BlockMatrix<2, 3>| {
+            let part = |r1: &BlockMatrix<2, K>, r2: &BlockMatrix<2, K>| {
                 core::array::from_fn(|l| {
-                    (0..3).fold(SVector::zeros(), |acc, i| {
+                    (0..K).fold(SVector::zeros(), |acc, i| {
                         acc + r2[i][l].transpose() * w2[i] - r1[i][l].transpose() * w1[i]
                     })
                 })
@@ -283,7 +290,7 @@ mod tests {
             [part(&j.r1_x, &j.r2_x), part(&j.r1_xi, &j.r2_xi)]
         };
         let e = 1e-6;
-        for (i, a) in (0..3).flat_map(|i| (0..2).map(move |a| (i, a))) {
+        for (i, a) in (0..K).flat_map(|i| (0..2).map(move |a| (i, a))) {
             for (on_xi, side) in [(false, 0), (true, 1)] {
                 let (mut xp, mut xm, mut xip, mut xim) = (x, x, xi, xi);
                 if on_xi {
@@ -299,7 +306,7 @@ mod tests {
                 } else {
                     (&jac.r1_x, &jac.r2_x)
                 };
-                for j in 0..3 {
+                for j in 0..K {
                     let d1 = (pp.0[j] - pm.0[j]) / (2.0 * e);
                     let d2 = (pp.1[j] - pm.1[j]) / (2.0 * e);
                     assert!(
@@ -312,7 +319,7 @@ mod tests {
                     );
                 }
                 let (gp, gm) = (gradient(&xp, &xip), gradient(&xm, &xim));
-                for l in 0..3 {
+                for l in 0..K {
                     let dx = (gp[0][l] - gm[0][l]) / (2.0 * e);
                     let dxi = (gp[1][l] - gm[1][l]) / (2.0 * e);
                     // d/dz_{i,a} of d phi/dx_l and of d phi/dxi_l
