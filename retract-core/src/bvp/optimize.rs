@@ -905,17 +905,12 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let options = crate::StepOptions::default()
             .with_theta(self.options.theta)
             .with_chord_check(self.options.chord_spacing, self.options.max_chord_pieces);
+        // (the momenta are not read by the guard: zero, set once)
+        let (mut z0, mut w) = (SVector::<f64, S>::zeros(), SVector::<f64, M>::zeros());
         for i in 0..self.steps {
-            let z0 = SVector::<f64, S>::from_fn(|r, _| if r < X { iterate.x[i][r] } else { 0.0 });
-            let w = SVector::<f64, M>::from_fn(|r, _| {
-                if r < X {
-                    iterate.x[i + 1][r]
-                } else if r >= S {
-                    iterate.u[i][r - S]
-                } else {
-                    0.0
-                }
-            });
+            z0.fixed_rows_mut::<X>(0).copy_from(&iterate.x[i]);
+            w.fixed_rows_mut::<X>(0).copy_from(&iterate.x[i + 1]);
+            w.fixed_rows_mut::<N>(S).copy_from(&iterate.u[i]);
             crate::step::check_step_domain(self.system_at(i), &z0, &w, &options)
                 .map_err(|v| (i, v))?;
         }
