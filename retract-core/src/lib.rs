@@ -21,6 +21,7 @@
 //! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
 //!   among them; [`map::TaylorLift`] lifts a map written over a [`taylor::Scalar`] at any
 //!   order by Taylor arithmetic ([`taylor`]).
+//! - [`so3`]: the rotation group in Gibbs charts and its Cayley midpoint map.
 //! - [`split`]: an explicit symplectic splitting for $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$
 //!   (one gradient of $V$ per step), which the macro detects.
 //! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
@@ -66,6 +67,7 @@ pub mod newton;
 #[cfg(feature = "std")]
 pub mod output;
 pub mod reduced;
+pub mod so3;
 pub mod sphere;
 pub mod split;
 pub mod state;

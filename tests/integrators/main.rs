@@ -24,6 +24,7 @@ mod map_macro;
 mod messages_runtime;
 mod robustness_chord_invariant;
 mod robustness_runtime;
+mod so3;
 mod sphere;
 mod sphere_order3;
 mod splitting;

@@ -1,0 +1,90 @@
+//! The rotation group SO(3) in Gibbs (Rodrigues) charts, and its Cayley midpoint map.
+//!
+//! The chart centred at the identity writes a rotation as the unit quaternion
+//! $Q(y) = (1, y)/\sqrt{1 + |y|^2}$, $y \in \mathbb{R}^3$ (a rotation by $2 \arctan |y|$ about
+//! $y$); it covers every rotation by less than $\pi$. The body angular velocity of a curve
+//! $y(t)$ is $\Omega = 2 Q^{-1} \dot Q = 2 (y' - y \times y') / (1 + |y|^2)$, so a Lagrangian
+//! written in body coordinates becomes a Lagrangian of $y$ by substituting $\Omega$ (and its
+//! total derivatives): rational functions, which the macro differentiates as usual.
+//!
+//! [`CayleyMidpoint`] is the group's discretization map $R_d(g, \xi) = (g\,
+//! \mathrm{cay}(-\xi/2), g\, \mathrm{cay}(\xi/2))$ with $\xi = 2 Q^{-1} \delta Q$ the body
+//! vector of the tangent vector $v$ at $y$ and $\mathrm{cay}(\omega) \propto (1, \omega/2)$
+//! (the Cayley map, equal to $\exp$ to second order). In the chart, with
+//! $w = \xi/4 = (v - y \times v) / (2 (1 + |y|^2))$ and the product
+//! $(1, y)(1, \pm w) = (1 \mp y \cdot w, y \pm w \pm y \times w)$:
+//!
+//! $$R_{1,2}(y, v) = \frac{y \mp w \mp y \times w}{1 \pm y \cdot w}.$$
+//!
+//! It is symmetric ($R_d(y, -v) = (R_2, R_1)(y, v)$), so of order 2, and equivariant under
+//! left multiplication, so a left-invariant Lagrangian's spatial momentum
+//! ([`spatial_momentum`]) is conserved by its cotangent lift; [`crate::map::TaylorLift`]
+//! lifts it to every order.
+
+use nalgebra::{SVector, Vector3};
+
+use crate::map::BaseMap;
+use crate::taylor::Scalar;
+
+/// The Cayley midpoint map of SO(3) in the Gibbs chart (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CayleyMidpoint;
+
+/// $a \times b$.
+fn cross<T: Scalar>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// $a \cdot b$.
+fn dot<T: Scalar>(a: &[T; 3], b: &[T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl BaseMap<3> for CayleyMidpoint {
+    fn base<T: Scalar>(&self, y: [T; 3], v: [T; 3]) -> ([T; 3], [T; 3]) {
+        let yv = cross(&y, &v);
+        let scale = (dot(&y, &y) + 1.0) * 2.0;
+        let w: [T; 3] = core::array::from_fn(|a| (v[a] - yv[a]) / scale);
+        let yw = cross(&y, &w);
+        let d = dot(&y, &w);
+        let (minus, plus) = (-d + 1.0, d + 1.0);
+        (
+            core::array::from_fn(|a| (y[a] - w[a] - yw[a]) / plus),
+            core::array::from_fn(|a| (y[a] + w[a] + yw[a]) / minus),
+        )
+    }
+}
+
+/// The Noether momentum of left multiplication at the chart state $(y, p)$ of a
+/// first-order system ($k = 1$): component $a$ is $p \cdot \delta_a y$ with
+/// $\delta_a y = \tfrac12 (e_a + e_a \times y + (e_a \cdot y)\, y)$, the chart velocity of
+/// $Q \mapsto (1, \epsilon e_a / 2) Q$. For a Lagrangian written in body coordinates this is
+/// the spatial angular momentum $R\, \partial L / \partial \Omega$, conserved by the
+/// cotangent lift of [`CayleyMidpoint`].
+pub fn spatial_momentum(y: &Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::from_fn(|a, _| {
+        let e = Vector3::ith(a, 1.0);
+        let delta = (e + e.cross(y) + y * e.dot(y)) * 0.5;
+        p.dot(&delta)
+    })
+}
+
+/// The rotation matrix of the chart point $y$: $R = ((1 - |y|^2) I + 2 y y^T + 2 \hat y)
+/// / (1 + |y|^2)$ with $\hat y v = y \times v$.
+pub fn rotation(y: &Vector3<f64>) -> nalgebra::Matrix3<f64> {
+    let n = y.norm_squared();
+    ((1.0 - n) * nalgebra::Matrix3::identity() + 2.0 * y * y.transpose() + 2.0 * y.cross_matrix())
+        / (1.0 + n)
+}
+
+/// The chart state $(y, p)$ of a first-order system as blocks of $z \in \mathbb{R}^6$.
+pub fn parts(z: &SVector<f64, 6>) -> (Vector3<f64>, Vector3<f64>) {
+    (
+        z.fixed_rows::<3>(0).into_owned(),
+        z.fixed_rows::<3>(3).into_owned(),
+    )
+}
