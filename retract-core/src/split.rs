@@ -136,8 +136,8 @@ where
 /// unless `options.check_domain` is false.
 ///
 /// # Errors
-/// [`Error::InvalidArgument`] for a weight that is not finite and positive, or a step size
-/// that is not finite; [`Error::NonFinite`] if the state, $\nabla V$ or the result is not
+/// [`Error::InvalidArgument`] for a weight that is not finite and positive, or a step size or
+/// options that [`crate::step()`] rejects (`h` zero or not finite); [`Error::NonFinite`] if the state, $\nabla V$ or the result is not
 /// finite;
 /// [`Error::Domain`] if the step leaves the domain of $L$.
 pub fn split_step<Sys, const N: usize, const K: usize, const S: usize, const M: usize>(
@@ -157,12 +157,8 @@ where
             location: "initial state of the explicit splitting step",
         });
     }
-    if !h.is_finite() {
-        return Err(Error::InvalidArgument {
-            name: "h",
-            requirement: "finite",
-        });
-    }
+    // the step size and the guard's settings, checked as for the implicit step
+    options.validate(h)?;
     let mut z = free_flow::<N, K, S>(z0, 0.5 * h, weight);
     let (x, u) = jet_of::<N, K, S>(&z, weight);
     let grad = system.gradient(&x, &u).x[0];
