@@ -15,6 +15,10 @@ use super::riccati::{Direction, Dynamics, Riccati, StageModel, Terminal};
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
 
+/// The error below which a full step's factorisation is kept for a simplified Newton step
+/// at the next iterate.
+const CHORD_ERROR: f64 = 1e-3;
+
 /// One run of the SQP iteration.
 pub(super) struct Sqp<
     'p,
@@ -50,6 +54,19 @@ struct Models<const N: usize, const X: usize> {
     terminal: Terminal<X>,
     /// $\nabla\Phi(x_N)$ (zero without a terminal cost).
     terminal_gradient: SVector<f64, X>,
+}
+
+/// A solved subproblem: the factorisation used (`stale` if it is the previous iterate's),
+/// its inertia correction, the direction, the momenta and residuals, and the error
+/// $\max$(stationarity, feasibility).
+struct Subproblem<const N: usize, const X: usize> {
+    riccati: Riccati<N, X>,
+    rho: f64,
+    stale: bool,
+    direction: Direction<N, X>,
+    momenta: Vec<SVector<f64, X>>,
+    certificate: Certificate,
+    error: f64,
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
@@ -369,10 +386,12 @@ where
     /// error below $\sqrt{\varepsilon}$ the residuals at the new point are first evaluated
     /// with the last subproblem's multipliers (the Newton estimates there): if they and the
     /// inertia of the factorisation at the point certify it, it is returned without solving
-    /// its own subproblem.
+    /// its own subproblem. Without stage constraints, a full step from an error below
+    /// `CHORD_ERROR` keeps its factorisation for the next iterate's subproblem (a simplified
+    /// Newton step, [`Self::subproblem`]); a point is never certified with a kept one.
     pub fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
         let options = &self.problem.options;
-        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        let theta = self.dynamics.theta;
         let count = self.problem.inequalities.len();
         let values: Vec<f64> = self
             .inequalities(&iterate)
@@ -395,6 +414,9 @@ where
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
         let mut full_step: Option<Direction<N, X>> = None;
+        let mut kept: Option<(Riccati<N, X>, f64)> = None;
+        // (the stage constraints' projections change with the iterate: no simplified steps)
+        let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
             let fail = |failure, iterate: &Iterate<N, X>, cost, certificate, momenta| PlanError {
@@ -421,23 +443,22 @@ where
                     last: None,
                 });
             };
-            let Some((riccati, rho)) = self.factor_corrected(&models, rho_last) else {
+            let Some(sub) = self.subproblem(&models, &barrier, kept.take(), rho_last) else {
                 let unknown = super::optimize::unknown_certificate();
                 let failure = Failure::Regularization;
                 return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
             };
+            let Subproblem {
+                riccati,
+                rho,
+                stale,
+                direction,
+                momenta,
+                certificate,
+                error,
+            } = sub;
             rho_last = rho;
-            let direction = riccati.solve(
-                &self.dynamics,
-                &models.stages,
-                h * rho,
-                &models.r0,
-                (&models.r_end, &models.terminal_gradient),
-            );
-            let (momenta, certificate) =
-                self.residuals(&models, &barrier, riccati.negative, &direction);
             let (complementarity, complementarity_error) = barrier.complementarity();
-            let error = certificate.stationarity.max(certificate.feasibility);
             if barrier.mu > floor && error.max(complementarity_error) <= 10.0 * barrier.mu {
                 barrier.decrease(floor);
                 continue;
@@ -449,7 +470,7 @@ where
                     .certify(
                         (&iterate, &y, &barrier),
                         &models,
-                        (rho == 0.0).then_some(&riccati),
+                        (rho == 0.0 && !stale).then_some(&riccati),
                         certificate,
                     )
                     .map(|certificate| {
@@ -494,7 +515,56 @@ where
             // (worth trying when Newton's quadratic convergence will take the error from here
             // to below the tolerance)
             full_step = (alpha == 1.0 && error <= options.tolerance.sqrt()).then_some(direction);
+            // near a solution, one step with this factorisation at the next iterate
+            if alpha == 1.0 && rho == 0.0 && !stale && unconstrained && error <= CHORD_ERROR {
+                kept = Some((riccati, error));
+            }
         }
+    }
+
+    /// The subproblem at `models`, solved with the factorisation `kept` of the previous
+    /// iterate (whose error was `e_prev`) if there is one and the simplified Newton step is
+    /// predicted to reach the tolerance: its error from here is about $e^2 / e_{\rm prev}$
+    /// (the factorisation's error is of the size of the last step, $e_{\rm prev}$). Else
+    /// (and if it is not) with a new inertia-corrected factorisation ([`Self::factor_corrected`]);
+    /// `None` if none is positive definite.
+    fn subproblem(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        kept: Option<(Riccati<N, X>, f64)>,
+        rho_last: f64,
+    ) -> Option<Subproblem<N, X>> {
+        let solve = |riccati: Riccati<N, X>, rho: f64, stale: bool| {
+            let direction = riccati.solve(
+                &self.dynamics,
+                &models.stages,
+                self.dynamics.h * rho,
+                &models.r0,
+                (&models.r_end, &models.terminal_gradient),
+            );
+            let (momenta, certificate) =
+                self.residuals(models, barrier, riccati.negative, &direction);
+            let error = certificate.stationarity.max(certificate.feasibility);
+            Subproblem {
+                riccati,
+                rho,
+                stale,
+                direction,
+                momenta,
+                certificate,
+                error,
+            }
+        };
+        if let Some((riccati, e_prev)) = kept {
+            let sub = solve(riccati, 0.0, true);
+            let tolerance = self.problem.options.tolerance;
+            if sub.error <= tolerance || sub.error * sub.error <= tolerance * e_prev {
+                return Some(sub);
+            }
+        }
+        let (riccati, rho) = self.factor_corrected(models, rho_last)?;
+        Some(solve(riccati, rho, false))
     }
 
     /// The plan at the point reached by a full step, certified with the last subproblem's
