@@ -39,7 +39,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-mod taylor_lift;
+pub(crate) mod taylor_lift;
 pub use taylor_lift::{BaseMap, TaylorLift};
 
 use crate::lifted::{Blocks, join, split};

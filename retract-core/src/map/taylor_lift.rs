@@ -35,7 +35,7 @@ pub trait BaseMap<const N: usize> {
 pub struct TaylorLift<B>(pub B);
 
 /// $j! / i!$ for $i \le j$.
-fn falling(j: usize, i: usize) -> f64 {
+pub(crate) fn falling(j: usize, i: usize) -> f64 {
     (i + 1..=j).map(|m| m as f64).product()
 }
 
@@ -46,7 +46,7 @@ fn inverse_factorial(l: usize) -> f64 {
 
 /// The lift of `x` to a curve's series: component $a$ has coefficients $x^{(j)}_a / j!$, the
 /// constant one the variable `offset + a` (`variable(value, index)`).
-fn curve<T: Scalar, const N: usize, const K: usize>(
+pub(crate) fn curve<T: Scalar, const N: usize, const K: usize>(
     x: &Blocks<N, K>,
     offset: usize,
     variable: impl Fn(f64, usize) -> T,

@@ -20,8 +20,18 @@
 //! left multiplication, so a left-invariant Lagrangian's spatial momentum
 //! ([`spatial_momentum`]) is conserved by its cotangent lift; [`crate::map::TaylorLift`]
 //! lifts it to every order.
+//!
+//! One chart ends at a turn by $\pi$ from its centre. Moving charts ([`recentre`] after each
+//! step, a centre quaternion $c$ and the rotation $c\,Q(y)$) follow a body through any
+//! number of turns; the change of chart is symplectic and commutes with the step (module
+//! `moving`).
 
 use nalgebra::{SVector, Vector3};
+
+mod moving;
+pub use moving::{
+    chart_point, chart_quaternion, orientation, recentre, transition, translate, world_momentum,
+};
 
 use crate::map::BaseMap;
 use crate::taylor::Scalar;
@@ -66,11 +76,8 @@ impl BaseMap<3> for CayleyMidpoint {
 /// the spatial angular momentum $R\, \partial L / \partial \Omega$, conserved by the
 /// cotangent lift of [`CayleyMidpoint`].
 pub fn spatial_momentum(y: &Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
-    Vector3::from_fn(|a, _| {
-        let e = Vector3::ith(a, 1.0);
-        let delta = (e + e.cross(y) + y * e.dot(y)) * 0.5;
-        p.dot(&delta)
-    })
+    let z = crate::lifted::join::<3, 1, 6>(&[*y], &[*p]);
+    world_momentum::<1, 6>(&nalgebra::UnitQuaternion::identity(), &z)
 }
 
 /// The rotation matrix of the chart point $y$: $R = ((1 - |y|^2) I + 2 y y^T + 2 \hat y)

@@ -1,0 +1,159 @@
+//! Moving charts: a rotation stored as a centre $c$ (a unit quaternion) and a Gibbs chart
+//! state whose point $y$ gives the rotation $g = c\,Q(y)$. After each step the chart is
+//! moved to the step's end ([`recentre`]), so $y$ stays near 0, where the chart is best
+//! conditioned, and a trajectory may turn through any angle.
+//!
+//! Moving the centre from $c$ to $c\,Q(a)$ changes chart points by the left translation
+//! $Q(\phi_a(y)) \propto Q(a)^{-1} Q(y)$:
+//!
+//! $$\phi_a(y) = \frac{y - a - a \times y}{1 + a \cdot y},$$
+//!
+//! defined where $1 + a \cdot y > 0$ (less than a half-turn from the new centre). The jet
+//! $(y, y', \dots, y^{(k-1)})$ changes by the derivatives of $\phi_a$ along the curve,
+//! $y_{\rm new}^{(j)} = D^j \phi_a(y(t))$, and the momenta by the cotangent lift of that
+//! point transformation, $p_{\rm new} = (\partial Y_{\rm new} / \partial Y)^{-T} p$: a
+//! symplectic change of coordinates. The Jacobian is block lower triangular with blocks
+//! $\partial y^{(j)}_{\rm new} / \partial y^{(i)} = \frac{j!}{i!} c_{j-i}[D\phi_a]$ (the
+//! Taylor coefficients of $D\phi_a$ along the curve, as in [`crate::map::TaylorLift`]).
+//! The Cayley midpoint map and a Lagrangian written in body coordinates are both invariant
+//! under left translations, so a step commutes with the change of chart: stepping and
+//! recentring give the same rotations as stepping in one chart, wherever that chart is
+//! defined.
+
+use nalgebra::{Matrix3, Quaternion, SVector, UnitQuaternion, Vector3};
+
+use crate::Error;
+use crate::lifted::{Blocks, join, split};
+use crate::map::taylor_lift::{curve, falling};
+use crate::taylor::{Dual, Scalar, Taylor};
+
+/// $\phi_a(y) = (y - a - a \times y) / (1 + a \cdot y)$: the chart point, in the chart
+/// centred at $c\,Q(a)$, of the point $y$ of the chart centred at $c$.
+pub fn translate<T: Scalar>(a: &Vector3<f64>, y: [T; 3]) -> [T; 3] {
+    let ay = [
+        y[2] * a[1] - y[1] * a[2],
+        y[0] * a[2] - y[2] * a[0],
+        y[1] * a[0] - y[0] * a[1],
+    ];
+    let den = y[0] * a[0] + y[1] * a[1] + y[2] * a[2] + 1.0;
+    core::array::from_fn(|i| (y[i] - ay[i] - a[i]) / den)
+}
+
+/// The unit quaternion $Q(y) = (1, y) / \sqrt{1 + |y|^2}$ of the chart point $y$.
+pub fn chart_quaternion(y: &Vector3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_normalize(Quaternion::new(1.0, y[0], y[1], y[2]))
+}
+
+/// The rotation $c\,Q(y)$ of the chart state `z` (of order $k$) centred at `centre`.
+pub fn orientation<const K: usize, const S: usize>(
+    centre: &UnitQuaternion<f64>,
+    z: &SVector<f64, S>,
+) -> UnitQuaternion<f64> {
+    let (x, _) = split::<3, K, S>(z);
+    centre * chart_quaternion(&x[0])
+}
+
+/// The chart point of the rotation `g` in the chart centred at `centre`:
+/// $y = \mathrm{vec}(c^{-1} g) / \mathrm{re}(c^{-1} g)$; `None` for a half-turn from the
+/// centre (where no Gibbs chart centred there reaches).
+pub fn chart_point(centre: &UnitQuaternion<f64>, g: &UnitQuaternion<f64>) -> Option<Vector3<f64>> {
+    let relative = centre.inverse() * g;
+    let w = relative.w;
+    (w.abs() > 1e-12).then(|| relative.imag() / w)
+}
+
+/// The state `z` (of order $k$: jet and momenta of $y$) in the chart centred at
+/// $c\,Q(a)$ instead of $c$ (module docs): the jet by $D^j \phi_a$, the momenta by the
+/// inverse transpose of its Jacobian. An error if the point is a half-turn or more from the
+/// new centre ($1 + a \cdot y \le 0$) or the result is not finite.
+pub fn transition<const K: usize, const S: usize>(
+    a: &Vector3<f64>,
+    z: &SVector<f64, S>,
+) -> Result<SVector<f64, S>, Error> {
+    let (x, p) = split::<3, K, S>(z);
+    let den = 1.0 + a.dot(&x[0]);
+    if den.is_nan() || den <= 0.0 {
+        return Err(Error::InvalidArgument {
+            name: "z",
+            requirement: "a chart point less than a half-turn from the new centre \
+                          (1 + a . y > 0)",
+        });
+    }
+    let series: [Taylor<Dual<3>, K>; 3] =
+        translate(a, curve::<Dual<3>, 3, K>(&x, 0, Dual::variable));
+    // the new jet, and the diagonal block (D phi at y) and those below it
+    let jet: Blocks<3, K> =
+        core::array::from_fn(|j| Vector3::from_fn(|c, _| series[c].c[j].f * falling(j, 0)));
+    let block = |j: usize, i: usize| -> Matrix3<f64> {
+        let scale = falling(j, i);
+        Matrix3::from_fn(|c, b| scale * series[c].c[j - i].g[b])
+    };
+    let Some(inverse_t) = block(0, 0).transpose().try_inverse() else {
+        return Err(Error::SingularJacobian { iteration: 0 });
+    };
+    // J^T p_new = p, J block lower triangular: back substitution from the top derivative
+    let mut momenta: Blocks<3, K> = [Vector3::zeros(); K];
+    for i in (0..K).rev() {
+        let mut rhs = p[i];
+        for (j, pj) in momenta.iter().enumerate().skip(i + 1) {
+            rhs -= block(j, i).transpose() * pj;
+        }
+        momenta[i] = inverse_t * rhs;
+    }
+    let out = join::<3, K, S>(&jet, &momenta);
+    if out.iter().all(|v| v.is_finite()) {
+        Ok(out)
+    } else {
+        Err(Error::NonFinite {
+            iteration: 0,
+            location: "chart transition",
+        })
+    }
+}
+
+/// Moves the chart of `z` to its own point: `centre` becomes $c\,Q(y)$ (renormalised) and
+/// `z` the same state in that chart ([`transition`] with $a = y$), whose point is 0. An
+/// error (with nothing changed) if `z` is not finite.
+pub fn recentre<const K: usize, const S: usize>(
+    centre: &mut UnitQuaternion<f64>,
+    z: &mut SVector<f64, S>,
+) -> Result<(), Error> {
+    let (x, _) = split::<3, K, S>(z);
+    let moved = transition::<K, S>(&x[0], z)?;
+    *centre =
+        UnitQuaternion::new_normalize(centre.into_inner() * chart_quaternion(&x[0]).into_inner());
+    *z = moved;
+    Ok(())
+}
+
+/// The spatial angular momentum (the Noether momentum of left multiplication, in the world
+/// frame) of the chart state `z` of order $k$ centred at `centre`: $R(c)\, M$ with
+/// $M_a = \sum_j p_j \cdot D^j[\delta_a y]$, where $\delta_a y = \tfrac12 (e_a + e_a
+/// \times y + (e_a \cdot y)\, y)$ is the chart velocity of $Q \mapsto (1, \epsilon e_a / 2)
+/// Q$. At $k = 1$ and $c = 1$ it is [`super::spatial_momentum`]. The lifted Cayley midpoint
+/// map conserves it for a Lagrangian written in body coordinates.
+pub fn world_momentum<const K: usize, const S: usize>(
+    centre: &UnitQuaternion<f64>,
+    z: &SVector<f64, S>,
+) -> Vector3<f64> {
+    let (x, p) = split::<3, K, S>(z);
+    let y: [Taylor<f64, K>; 3] =
+        core::array::from_fn(|c| Taylor::from_derivatives(core::array::from_fn(|j| x[j][c])));
+    let chart = Vector3::from_fn(|a, _| {
+        // delta_a y = (e_a + e_a x y + y_a y) / 2
+        let e_cross_y = [
+            [Taylor::constant(0.0), -y[2], y[1]],
+            [y[2], Taylor::constant(0.0), -y[0]],
+            [-y[1], y[0], Taylor::constant(0.0)],
+        ][a];
+        let delta: [Taylor<f64, K>; 3] = core::array::from_fn(|c| {
+            let unit = if c == a { 1.0 } else { 0.0 };
+            (e_cross_y[c] + y[a] * y[c] + unit) * 0.5
+        });
+        let d = delta.map(|s| s.derivatives());
+        (0..K)
+            .map(|j| (0..3).map(|c| p[j][c] * d[c][j]).sum::<f64>())
+            .sum::<f64>()
+    });
+    centre * chart
+}

@@ -1,0 +1,321 @@
+//! SO(3) with moving charts (`retract::so3::{recentre, transition, ...}`): the chart
+//! transition is the left translation, moves jets along their curves and momenta
+//! symplectically, and commutes with the Cayley midpoint step; with a recentring after every
+//! step the free rigid body turns through many half-turns with its rotation orthogonal and its
+//! spatial momentum conserved to rounding, converging with order 2; the minimum-torque body
+//! (k = 2, L = 1/2 |J Omega' + Omega x J Omega|^2) conserves its spatial momentum the same way.
+
+use retract::diagnostics::canonical_structure;
+use retract::higher_order_lagrangian;
+use retract::map::{self, TaylorLift};
+use retract::nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use retract::so3::{
+    CayleyMidpoint, chart_point, chart_quaternion, orientation, recentre, transition, translate,
+    world_momentum,
+};
+use retract::taylor::Taylor;
+use retract::{LiftedSystem, NewtonOptions};
+
+/// The minimum-torque rigid body: tau = J Omega' + Omega x J Omega with
+/// Omega = s (y' - y x y'), s = 2 / (1 + |y|^2), and
+/// Omega' = s (y'' - y x y'') - s^2 (y . y') (y' - y x y').
+#[higher_order_lagrangian(order = 2)]
+fn min_torque(y: [f64; 3], dy: [f64; 3], ddy: [f64; 3], j1: f64, j2: f64, j3: f64) -> f64 {
+    let s = 2.0 / (1.0 + y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+    let yv = y[0] * dy[0] + y[1] * dy[1] + y[2] * dy[2];
+    let v0 = dy[0] - (y[1] * dy[2] - y[2] * dy[1]);
+    let v1 = dy[1] - (y[2] * dy[0] - y[0] * dy[2]);
+    let v2 = dy[2] - (y[0] * dy[1] - y[1] * dy[0]);
+    let a0 = ddy[0] - (y[1] * ddy[2] - y[2] * ddy[1]);
+    let a1 = ddy[1] - (y[2] * ddy[0] - y[0] * ddy[2]);
+    let a2 = ddy[2] - (y[0] * ddy[1] - y[1] * ddy[0]);
+    let (w0, w1, w2) = (s * v0, s * v1, s * v2);
+    let d0 = s * a0 - s * s * yv * v0;
+    let d1 = s * a1 - s * s * yv * v1;
+    let d2 = s * a2 - s * s * yv * v2;
+    let t0 = j1 * d0 + (w1 * j3 * w2 - w2 * j2 * w1);
+    let t1 = j2 * d1 + (w2 * j1 * w0 - w0 * j3 * w2);
+    let t2 = j3 * d2 + (w0 * j2 * w1 - w1 * j1 * w0);
+    0.5 * (t0 * t0 + t1 * t1 + t2 * t2)
+}
+
+const J: [f64; 3] = [1.0, 2.0, 3.0];
+
+/// The free rigid body with inertia `J` in a Gibbs chart (as in the one-chart tests).
+fn body() -> super::so3::RigidBodyGibbs {
+    super::so3::system()
+}
+
+/// A pseudo-random vector of entries in (-scale, scale).
+fn random(seed: u64, scale: f64) -> Vector3<f64> {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    Vector3::from_fn(|_, _| {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * scale
+    })
+}
+
+/// The state of order `K` with jet blocks `jet` and momenta `momenta`.
+fn state<const K: usize, const S: usize>(
+    jet: [Vector3<f64>; K],
+    momenta: [Vector3<f64>; K],
+) -> SVector<f64, S> {
+    retract::lifted::join::<3, K, S>(&jet, &momenta)
+}
+
+#[test]
+fn the_transition_is_the_left_translation() {
+    for seed in 0..20 {
+        let (a, y) = (random(seed, 0.8), random(seed + 100, 0.8));
+        let moved = Vector3::from(translate(&a, [y[0], y[1], y[2]]));
+        let expected = chart_quaternion(&a).inverse() * chart_quaternion(&y);
+        let angle = chart_quaternion(&moved).angle_to(&expected);
+        assert!(angle < 1e-14, "seed {seed}: {angle:e}");
+        // and chart_point inverts the chart
+        let centre = UnitQuaternion::from_scaled_axis(random(seed + 200, 2.0));
+        let g = centre * chart_quaternion(&y);
+        let back = chart_point(&centre, &g).expect("less than a half-turn");
+        assert!((back - y).amax() < 1e-14);
+    }
+}
+
+/// Omega and its derivatives along the curve of a jet (coefficients of the series).
+fn body_velocity_series(jet: &[Vector3<f64>; 3]) -> [[f64; 3]; 3] {
+    let y: [Taylor<f64, 3>; 3] =
+        core::array::from_fn(|c| Taylor::from_derivatives(core::array::from_fn(|j| jet[j][c])));
+    let dy: [Taylor<f64, 3>; 3] = core::array::from_fn(|c| {
+        // the derivative of the series: coefficients (j + 1) c_{j+1}
+        Taylor {
+            c: core::array::from_fn(|j| {
+                if j < 2 {
+                    (j + 1) as f64 * y[c].c[j + 1]
+                } else {
+                    0.0
+                }
+            }),
+        }
+    });
+    let norm = y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + 1.0;
+    let cross = [
+        y[1] * dy[2] - y[2] * dy[1],
+        y[2] * dy[0] - y[0] * dy[2],
+        y[0] * dy[1] - y[1] * dy[0],
+    ];
+    core::array::from_fn(|c| ((dy[c] - cross[c]) * 2.0 / norm).c)
+}
+
+#[test]
+fn the_transition_moves_jets_along_their_curves() {
+    // Omega(t) is chart-independent: its series (to the order the jet determines) agrees
+    for seed in 0..10 {
+        let a = random(seed, 0.6);
+        let jet = [
+            random(seed + 1, 0.6),
+            random(seed + 2, 1.0),
+            random(seed + 3, 1.0),
+        ];
+        let z = state::<3, 18>(jet, [Vector3::zeros(); 3]);
+        let moved = transition::<3, 18>(&a, &z).expect("inside the chart");
+        let (new_jet, _) = retract::lifted::split::<3, 3, 18>(&moved);
+        let (before, after) = (body_velocity_series(&jet), body_velocity_series(&new_jet));
+        // a jet of order 3 fixes Omega and Omega' (the series' first two coefficients)
+        for c in 0..3 {
+            for j in 0..2 {
+                let gap = (before[c][j] - after[c][j]).abs();
+                assert!(
+                    gap < 1e-13,
+                    "seed {seed}, component {c}, order {j}: {gap:e}"
+                );
+            }
+        }
+    }
+}
+
+/// The Jacobian of `f` at `z` by central differences.
+fn jacobian<const S: usize>(
+    f: impl Fn(&SVector<f64, S>) -> SVector<f64, S>,
+    z: &SVector<f64, S>,
+) -> SMatrix<f64, S, S> {
+    let eps = 1e-6;
+    let mut d = SMatrix::<f64, S, S>::zeros();
+    for c in 0..S {
+        let mut plus = *z;
+        let mut minus = *z;
+        plus[c] += eps;
+        minus[c] -= eps;
+        d.set_column(c, &((f(&plus) - f(&minus)) / (2.0 * eps)));
+    }
+    d
+}
+
+#[test]
+fn the_transition_is_symplectic_and_inverted_by_the_opposite_one() {
+    let a = random(7, 0.7);
+    let z1 = state::<1, 6>([random(8, 0.5)], [random(9, 1.0)]);
+    let z2 = state::<2, 12>(
+        [random(10, 0.5), random(11, 1.0)],
+        [random(12, 1.0), random(13, 1.0)],
+    );
+    let d1 = jacobian(|z| transition::<1, 6>(&a, z).expect("inside"), &z1);
+    let d2 = jacobian(|z| transition::<2, 12>(&a, z).expect("inside"), &z2);
+    let e1 = (d1.transpose() * canonical_structure::<6>() * d1 - canonical_structure::<6>()).amax();
+    let e2 =
+        (d2.transpose() * canonical_structure::<12>() * d2 - canonical_structure::<12>()).amax();
+    assert!(e1 < 1e-8 && e2 < 1e-8, "|D^T J D - J| = {e1:e}, {e2:e}");
+    // the centre c Q(a) moved by Q(-a) is c again: phi_{-a} inverts phi_a
+    let back =
+        transition::<2, 12>(&-a, &transition::<2, 12>(&a, &z2).expect("inside")).expect("inside");
+    assert!((back - z2).amax() < 1e-13);
+    // a point a half-turn from the new centre has no chart there
+    assert!(
+        transition::<1, 6>(
+            &a,
+            &state::<1, 6>([-a / a.norm_squared()], [Vector3::zeros()])
+        )
+        .is_err()
+    );
+}
+
+/// The free body's state at the identity with body velocity `omega`.
+fn free_start(omega: Vector3<f64>) -> SVector<f64, 6> {
+    body().legendre(&state::<1, 6>([Vector3::zeros()], [omega / 2.0]))
+}
+
+/// `steps` steps of size `h` from the identity with body velocity `omega`, recentring after
+/// each; `observe` sees the centre and state after every step. Returns the last state.
+fn run_moving_with(
+    h: f64,
+    steps: usize,
+    omega: Vector3<f64>,
+    mut observe: impl FnMut(&UnitQuaternion<f64>, &SVector<f64, 6>),
+) -> SVector<f64, 6> {
+    let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
+    let (mut centre, mut z) = (UnitQuaternion::identity(), free_start(omega));
+    observe(&centre, &z);
+    for _ in 0..steps {
+        z = map::step(&system, &map, &z, h, &options)
+            .expect("regular")
+            .0;
+        recentre::<1, 6>(&mut centre, &mut z).expect("finite");
+        observe(&centre, &z);
+    }
+    z
+}
+
+/// [`run_moving_with`] keeping the orientations and world momenta.
+fn run_moving(
+    h: f64,
+    steps: usize,
+    omega: Vector3<f64>,
+) -> (Vec<UnitQuaternion<f64>>, Vec<Vector3<f64>>) {
+    let (mut rotations, mut momenta) = (Vec::new(), Vec::new());
+    run_moving_with(h, steps, omega, |centre, z| {
+        rotations.push(orientation::<1, 6>(centre, z));
+        momenta.push(world_momentum::<1, 6>(centre, z));
+    });
+    (rotations, momenta)
+}
+
+#[test]
+fn recentred_steps_are_the_steps_of_one_chart() {
+    let omega = Vector3::new(0.4, 0.9, -0.3);
+    let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
+    let mut z = free_start(omega);
+    let (moving, momenta) = run_moving(0.05, 40, omega);
+    for (i, rotation) in moving.iter().enumerate().skip(1) {
+        z = map::step(&system, &map, &z, 0.05, &options)
+            .expect("regular")
+            .0;
+        let fixed = orientation::<1, 6>(&UnitQuaternion::identity(), &z);
+        assert!(fixed.angle_to(rotation) < 1e-12, "step {i}");
+        // and the chart's momentum formula at the identity is the world momentum
+        assert!(
+            (world_momentum::<1, 6>(&UnitQuaternion::identity(), &z) - momenta[i]).amax() < 1e-12
+        );
+    }
+}
+
+#[test]
+fn moving_charts_have_order_2_through_several_turns() {
+    // |Omega| about 3.2 rad/s for 4 s: two turns, beyond any one chart
+    let omega = Vector3::new(1.0, 3.0, -0.5);
+    let t = 4.0;
+    let exact = super::so3::euler_reference(omega, t, 40_000);
+    let errors = [200, 400, 800].map(|n| run_moving(t / n as f64, n, omega).0[n].angle_to(&exact));
+    for pair in errors.windows(2) {
+        let observed = (pair[0] / pair[1]).log2();
+        assert!(
+            (observed - 2.0).abs() < 0.1,
+            "order {observed} ({errors:?})"
+        );
+    }
+}
+
+#[test]
+fn many_turns_keep_the_rotation_orthogonal_and_the_momentum() {
+    // 10^6 steps of 0.01 s at about 3 rad/s: some 5000 turns
+    let omega = Vector3::new(1.0, 3.0, -0.5);
+    let m0 = world_momentum::<1, 6>(&UnitQuaternion::identity(), &free_start(omega));
+    let (mut drift, mut orthogonality): (f64, f64) = (0.0, 0.0);
+    let z = run_moving_with(0.01, 1_000_000, omega, |centre, z| {
+        drift = drift.max((world_momentum::<1, 6>(centre, z) - m0).amax() / m0.amax());
+        let r = orientation::<1, 6>(centre, z)
+            .to_rotation_matrix()
+            .into_inner();
+        orthogonality = orthogonality.max((r.transpose() * r - Matrix3::identity()).amax());
+    });
+    assert!(orthogonality <= 1e-13, "|R^T R - I| = {orthogonality:e}");
+    assert!(drift < 1e-10, "momentum drift {drift:e}");
+    // the energy of a symplectic step: bounded, no drift
+    let system = body();
+    let energy = |z: &SVector<f64, 6>| system.hamiltonian(z).expect("finite");
+    let e0 = energy(&free_start(omega));
+    let gap = (energy(&z) - e0).abs() / e0;
+    assert!(gap < 1e-3, "energy error {gap:e}");
+}
+
+#[test]
+fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
+    let system = MinTorque {
+        j1: J[0],
+        j2: J[1],
+        j3: J[2],
+    };
+    let (map, options) = (TaylorLift(CayleyMidpoint), NewtonOptions::default());
+    // at the identity with Omega = (1, 3, -0.5) and Omega' = (0.3, -0.2, 0.4)
+    let jet = [
+        Vector3::zeros(),
+        Vector3::new(1.0, 3.0, -0.5) / 2.0,
+        Vector3::new(0.3, -0.2, 0.4) / 2.0,
+    ];
+    let (mut centre, mut z) = (
+        UnitQuaternion::identity(),
+        system.legendre(&state::<2, 12>(
+            [jet[0], jet[1]],
+            [jet[2], Vector3::zeros()],
+        )),
+    );
+    let m0 = world_momentum::<2, 12>(&centre, &z);
+    let mut drift: f64 = 0.0;
+    let mut turned = 0.0;
+    // (its extremals spin up: by t = 1.5 the body turns at some 30 rad/s)
+    for _ in 0..300 {
+        let before = orientation::<2, 12>(&centre, &z);
+        z = map::step(&system, &map, &z, 0.005, &options)
+            .expect("regular")
+            .0;
+        recentre::<2, 12>(&mut centre, &mut z).expect("finite");
+        turned += before.angle_to(&orientation::<2, 12>(&centre, &z));
+        drift = drift.max((world_momentum::<2, 12>(&centre, &z) - m0).amax() / m0.amax());
+    }
+    assert!(turned > 2.0 * std::f64::consts::PI, "turned {turned}");
+    assert!(drift < 1e-12, "momentum drift {drift:e}");
+    let d = map::step_map_derivative(&system, &map, &z, 0.005, &options).expect("regular");
+    let j = canonical_structure::<12>();
+    let error = (d.transpose() * j * d - j).amax();
+    assert!(error < 1e-10, "|D^T J D - J| = {error:e}");
+}
