@@ -319,3 +319,35 @@ fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
     let error = (d.transpose() * j * d - j).amax();
     assert!(error < 1e-10, "|D^T J D - J| = {error:e}");
 }
+
+#[test]
+fn compositions_of_recentred_steps_have_orders_4_and_6() {
+    let omega = Vector3::new(1.0, 3.0, -0.5);
+    let t = 4.0;
+    let exact = super::so3::euler_reference(omega, t, 40_000);
+    let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
+    for (order, sizes) in [(4, [40, 80, 160]), (6, [30, 60, 120])] {
+        let errors = sizes.map(|n| {
+            let (mut centre, mut z) = (UnitQuaternion::identity(), free_start(omega));
+            // the stage: a step and a recentring (the centre moves with each stage)
+            let mut stage = |z: &SVector<f64, 6>, h: f64| {
+                let (mut next, report) = map::step(&system, &map, z, h, &options)?;
+                recentre::<1, 6>(&mut centre, &mut next)?;
+                Ok((next, report))
+            };
+            for _ in 0..n {
+                z = retract::compose::compose(&mut stage, &z, t / n as f64, order)
+                    .expect("regular")
+                    .0;
+            }
+            orientation::<1, 6>(&centre, &z).angle_to(&exact)
+        });
+        for pair in errors.windows(2) {
+            let observed = (pair[0] / pair[1]).log2();
+            assert!(
+                (observed - f64::from(order)).abs() < 0.3,
+                "order {order}: observed {observed} ({errors:?})"
+            );
+        }
+    }
+}
