@@ -5,33 +5,22 @@
 //! momentum to rounding (left equivariance), and converges with order 2 to an RK4 solution
 //! of Euler's equations with quaternion kinematics.
 
+#[path = "../../examples/common/attitude.rs"]
+pub(crate) mod attitude;
+
 use retract::diagnostics::canonical_structure;
-use retract::higher_order_lagrangian;
 use retract::lifted::Blocks;
 use retract::map::{self, DiscretizationMap, TaylorLift};
-use retract::nalgebra::{SVector, UnitQuaternion, Vector3, Vector4};
+use retract::nalgebra::{SVector, Vector3};
 use retract::so3::{CayleyMidpoint, parts, rotation, spatial_momentum};
 use retract::{LiftedSystem, NewtonOptions};
 
-/// The free rigid body with inertia diag(j1, j2, j3), in the Gibbs chart at the identity.
-#[higher_order_lagrangian(order = 1)]
-pub(crate) fn rigid_body_gibbs(y: [f64; 3], dy: [f64; 3], j1: f64, j2: f64, j3: f64) -> f64 {
-    let s = 2.0 / (1.0 + y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-    let w0 = s * (dy[0] - (y[1] * dy[2] - y[2] * dy[1]));
-    let w1 = s * (dy[1] - (y[2] * dy[0] - y[0] * dy[2]));
-    let w2 = s * (dy[2] - (y[0] * dy[1] - y[1] * dy[0]));
-    0.5 * (j1 * w0 * w0 + j2 * w1 * w1 + j3 * w2 * w2)
-}
-
-const J: [f64; 3] = [1.0, 2.0, 3.0];
+const J: [f64; 3] = attitude::INERTIA;
 const OMEGA0: [f64; 3] = [0.4, 0.9, -0.3];
 
-pub(crate) fn system() -> RigidBodyGibbs {
-    RigidBodyGibbs {
-        j1: J[0],
-        j2: J[1],
-        j3: J[2],
-    }
+/// The free rigid body with inertia `J` in the Gibbs chart (`attitude::gibbs_free`).
+pub(crate) fn system() -> attitude::GibbsFree {
+    attitude::gibbs_free_body()
 }
 
 /// The state at the identity with body velocity `OMEGA0` (y = 0, y' = Omega / 2).
@@ -67,34 +56,10 @@ fn run_with<Map: DiscretizationMap<3, 1>>(map: &Map, h: f64, steps: usize) -> Ve
     states
 }
 
-/// The chart point y = vec(q) / q_0 of [`euler_reference`] from `OMEGA0` at `t`.
+/// The chart point y = vec(q) / q_0 of `attitude::euler_reference` from `OMEGA0` at `t`.
 fn reference(t: f64, steps: usize) -> Vector3<f64> {
-    let q = euler_reference(Vector3::from(OMEGA0), t, steps);
+    let q = attitude::euler_reference(Vector3::from(OMEGA0), t, steps);
     q.imag() / q.w
-}
-
-/// Euler's equations J Omega' = (J Omega) x Omega with q' = q (0, Omega) / 2 from the
-/// identity with body velocity `omega`, by RK4: the rotation at `t`.
-pub(crate) fn euler_reference(omega: Vector3<f64>, t: f64, steps: usize) -> UnitQuaternion<f64> {
-    let rhs = |q: &Vector4<f64>, w: &Vector3<f64>| {
-        let jw = Vector3::new(J[0] * w[0], J[1] * w[1], J[2] * w[2]);
-        let c = jw.cross(w);
-        let dw = Vector3::new(c[0] / J[0], c[1] / J[1], c[2] / J[2]);
-        let v = Vector3::new(q[1], q[2], q[3]);
-        let dv = w * q[0] + v.cross(w);
-        (Vector4::new(-v.dot(w), dv[0], dv[1], dv[2]) * 0.5, dw)
-    };
-    let h = t / steps as f64;
-    let (mut q, mut w) = (Vector4::new(1.0, 0.0, 0.0, 0.0), omega);
-    for _ in 0..steps {
-        let (a1, b1) = rhs(&q, &w);
-        let (a2, b2) = rhs(&(q + a1 * (h / 2.0)), &(w + b1 * (h / 2.0)));
-        let (a3, b3) = rhs(&(q + a2 * (h / 2.0)), &(w + b2 * (h / 2.0)));
-        let (a4, b4) = rhs(&(q + a3 * h), &(w + b3 * h));
-        q += (a1 + a2 * 2.0 + a3 * 2.0 + a4) * (h / 6.0);
-        w += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (h / 6.0);
-    }
-    UnitQuaternion::new_normalize(retract::nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
 }
 
 #[test]

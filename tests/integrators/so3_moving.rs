@@ -6,7 +6,6 @@
 //! (k = 2, L = 1/2 |J Omega' + Omega x J Omega|^2) conserves its spatial momentum the same way.
 
 use retract::diagnostics::canonical_structure;
-use retract::higher_order_lagrangian;
 use retract::map::{self, TaylorLift};
 use retract::nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 use retract::so3::{
@@ -16,33 +15,8 @@ use retract::so3::{
 use retract::taylor::Taylor;
 use retract::{LiftedSystem, NewtonOptions};
 
-/// The minimum-torque rigid body: tau = J Omega' + Omega x J Omega with
-/// Omega = s (y' - y x y'), s = 2 / (1 + |y|^2), and
-/// Omega' = s (y'' - y x y'') - s^2 (y . y') (y' - y x y').
-#[higher_order_lagrangian(order = 2)]
-fn min_torque(y: [f64; 3], dy: [f64; 3], ddy: [f64; 3], j1: f64, j2: f64, j3: f64) -> f64 {
-    let s = 2.0 / (1.0 + y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-    let yv = y[0] * dy[0] + y[1] * dy[1] + y[2] * dy[2];
-    let v0 = dy[0] - (y[1] * dy[2] - y[2] * dy[1]);
-    let v1 = dy[1] - (y[2] * dy[0] - y[0] * dy[2]);
-    let v2 = dy[2] - (y[0] * dy[1] - y[1] * dy[0]);
-    let a0 = ddy[0] - (y[1] * ddy[2] - y[2] * ddy[1]);
-    let a1 = ddy[1] - (y[2] * ddy[0] - y[0] * ddy[2]);
-    let a2 = ddy[2] - (y[0] * ddy[1] - y[1] * ddy[0]);
-    let (w0, w1, w2) = (s * v0, s * v1, s * v2);
-    let d0 = s * a0 - s * s * yv * v0;
-    let d1 = s * a1 - s * s * yv * v1;
-    let d2 = s * a2 - s * s * yv * v2;
-    let t0 = j1 * d0 + (w1 * j3 * w2 - w2 * j2 * w1);
-    let t1 = j2 * d1 + (w2 * j1 * w0 - w0 * j3 * w2);
-    let t2 = j3 * d2 + (w0 * j2 * w1 - w1 * j1 * w0);
-    0.5 * (t0 * t0 + t1 * t1 + t2 * t2)
-}
-
-const J: [f64; 3] = [1.0, 2.0, 3.0];
-
 /// The free rigid body with inertia `J` in a Gibbs chart (as in the one-chart tests).
-fn body() -> super::so3::RigidBodyGibbs {
+fn body() -> super::so3::attitude::GibbsFree {
     super::so3::system()
 }
 
@@ -244,7 +218,7 @@ fn moving_charts_have_order_2_through_several_turns() {
     // |Omega| about 3.2 rad/s for 4 s: two turns, beyond any one chart
     let omega = Vector3::new(1.0, 3.0, -0.5);
     let t = 4.0;
-    let exact = super::so3::euler_reference(omega, t, 40_000);
+    let exact = super::so3::attitude::euler_reference(omega, t, 40_000);
     let errors = [200, 400, 800].map(|n| run_moving(t / n as f64, n, omega).0[n].angle_to(&exact));
     for pair in errors.windows(2) {
         let observed = (pair[0] / pair[1]).log2();
@@ -280,11 +254,7 @@ fn many_turns_keep_the_rotation_orthogonal_and_the_momentum() {
 
 #[test]
 fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
-    let system = MinTorque {
-        j1: J[0],
-        j2: J[1],
-        j3: J[2],
-    };
+    let system = super::so3::attitude::gibbs_body();
     let (map, options) = (TaylorLift(CayleyMidpoint), NewtonOptions::default());
     // at the identity with Omega = (1, 3, -0.5) and Omega' = (0.3, -0.2, 0.4)
     let jet = [
@@ -324,7 +294,7 @@ fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
 fn compositions_of_recentred_steps_have_orders_4_and_6() {
     let omega = Vector3::new(1.0, 3.0, -0.5);
     let t = 4.0;
-    let exact = super::so3::euler_reference(omega, t, 40_000);
+    let exact = super::so3::attitude::euler_reference(omega, t, 40_000);
     let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
     for (order, sizes) in [(4, [40, 80, 160]), (6, [30, 60, 120])] {
         let errors = sizes.map(|n| {

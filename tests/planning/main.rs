@@ -7,6 +7,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod attitude_slew;
 mod bvp;
 mod car;
 mod extrapolate;
@@ -24,3 +25,7 @@ mod car_models;
 // the double pendulum's models and receding-horizon loop, shared with the examples
 #[path = "../../examples/common/pendulum.rs"]
 mod pendulum;
+
+// the spacecraft's attitude models and slew, shared with the example
+#[path = "../../examples/common/attitude.rs"]
+mod attitude;

@@ -1,0 +1,120 @@
+//! Planning on SO(3) (`examples/attitude.rs` at reduced size): the minimum-torque slew by 170
+//! degrees in a Gibbs chart centred halfway, free and around the sun keep-out cone. The chart
+//! Lagrangians are checked against torques from the rotation curve itself.
+
+use retract::Lagrangian;
+use retract::bvp::{Plan, PlanGuess};
+use retract::nalgebra::{Quaternion, SVector, UnitQuaternion, Vector3};
+use retract::so3::chart_quaternion;
+
+use crate::attitude::{
+    self, BORESIGHT, CONE_DEGREES, euler_body, gibbs_body, gibbs_cone, gibbs_problem, gibbs_slew,
+    slew_ends, sun,
+};
+
+/// Omega and Omega' of the rotation curve `g(t)` at t = 0, from Omega = 2 vec(g^-1 g') by
+/// central differences of step `e`.
+fn body_rates(g: impl Fn(f64) -> UnitQuaternion<f64>, e: f64) -> (Vector3<f64>, Vector3<f64>) {
+    let omega = |t: f64| {
+        let dq: Quaternion<f64> = (g(t + e).into_inner() - g(t - e).into_inner()) / (2.0 * e);
+        (g(t).into_inner().conjugate() * dq).imag() * 2.0
+    };
+    (omega(0.0), (omega(e) - omega(-e)) / (2.0 * e))
+}
+
+/// 1/2 |J Omega' + Omega x J Omega|^2.
+fn cost_of(omega: &Vector3<f64>, domega: &Vector3<f64>) -> f64 {
+    let j = Vector3::from(attitude::INERTIA);
+    (domega.component_mul(&j) + omega.cross(&omega.component_mul(&j))).norm_squared() / 2.0
+}
+
+#[test]
+fn chart_lagrangians_are_the_minimum_torque_cost() {
+    let (gibbs, euler) = (gibbs_body(), euler_body());
+    for seed in 0..8 {
+        let v = |k: u64| {
+            Vector3::from_fn(|r, _| {
+                (((seed * 3 + k) * 7 + r as u64) as f64 * 0.618_034).fract() - 0.5
+            })
+        };
+        let (q, dq, ddq) = (v(0), v(1) * 2.0, v(2) * 2.0);
+        let curve = |t: f64| q + dq * t + ddq * (t * t / 2.0);
+        let expected = cost_of_curve(|t| chart_quaternion(&curve(t)));
+        let got = gibbs.lagrangian(&[q, dq], &ddq);
+        assert!(
+            (got - expected).abs() < 1e-6 * (1.0 + expected),
+            "Gibbs {got} vs {expected}"
+        );
+        let expected = cost_of_curve(|t| {
+            let a = curve(t);
+            UnitQuaternion::from_euler_angles(a[2], a[1], a[0])
+        });
+        let got = euler.lagrangian(&[q, dq], &ddq);
+        assert!(
+            (got - expected).abs() < 1e-6 * (1.0 + expected),
+            "Euler {got} vs {expected}"
+        );
+    }
+}
+
+/// The minimum-torque cost of the rotation curve at t = 0.
+fn cost_of_curve(g: impl Fn(f64) -> UnitQuaternion<f64>) -> f64 {
+    let (omega, domega) = body_rates(g, 1e-4);
+    cost_of(&omega, &domega)
+}
+
+/// The boresight's angle from the sun (degrees) at the steps' midpoints.
+fn sun_angles(centre: &UnitQuaternion<f64>, plan: &Plan<3, 6>) -> Vec<f64> {
+    plan.x
+        .windows(2)
+        .map(|w| {
+            let y: SVector<f64, 6> = (w[0] + w[1]) / 2.0;
+            let b = centre
+                * chart_quaternion(&y.fixed_rows::<3>(0).into_owned())
+                * Vector3::from(BORESIGHT);
+            b.dot(&sun()).clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .collect()
+}
+
+#[test]
+fn the_slew_keeps_out_of_the_sun_cone() {
+    let steps = 60;
+    let system = gibbs_body();
+    let (centre, start, goal) = gibbs_slew();
+    // the chart's ends are the slew's rotations
+    let (g0, g1) = slew_ends();
+    let end = |x: &[f64; 6]| centre * chart_quaternion(&Vector3::new(x[0], x[1], x[2]));
+    assert!(end(&start).angle_to(&g0) < 1e-14 && end(&goal).angle_to(&g1) < 1e-14);
+    let free = gibbs_problem(&system, &start, &goal, steps)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let cone = gibbs_cone(&centre);
+    let avoiding = gibbs_problem(&system, &start, &goal, steps)
+        .with_inequality(&cone)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    for plan in [&free, &avoiding] {
+        let c = &plan.certificate;
+        assert_eq!(c.negative_directions, 0);
+        assert!(c.min_reduced_hessian_eig > 0.0, "{c:?}");
+    }
+    // the free slew passes through the cone; the planned one stays out at every evaluation
+    // point, touching it, at a higher cost
+    let closest = |plan| {
+        sun_angles(&centre, plan)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(
+        closest(&free) < CONE_DEGREES - 5.0,
+        "free: {}",
+        closest(&free)
+    );
+    let touching = closest(&avoiding);
+    assert!(
+        (touching - CONE_DEGREES).abs() < 1e-6,
+        "constrained: {touching}"
+    );
+    assert!(avoiding.cost > free.cost);
+}
