@@ -9,6 +9,8 @@
 //!    longer determine the rotation's velocity (gimbal lock).
 //! 3. The free rigid body through the same singularity: the Cayley midpoint map in moving
 //!    charts against the midpoint rule in Euler angles, and a long run of the former.
+//! 4. A fully actuated rigid body in SE(3) (attitude in a Gibbs chart, position in world axes)
+//!    flying among spheres while it turns, each sphere a hard constraint.
 //!
 //! Run: `cargo run --release --example attitude [-- boresight.svg torque.svg]`
 
@@ -19,8 +21,8 @@ mod common;
 use std::time::Instant;
 
 use attitude::{
-    BORESIGHT, CONE_DEGREES, EulerSunClearance, INERTIA, SLEW_DEGREES, SLEW_TIME, euler_body,
-    euler_reference, gibbs_body, gibbs_cone, gibbs_problem, gibbs_slew, sun,
+    BORESIGHT, CONE_DEGREES, EulerSunClearance, INERTIA, OutsideSphere, SLEW_DEGREES, SLEW_TIME,
+    SPHERES, euler_body, euler_reference, gibbs_body, gibbs_cone, gibbs_problem, gibbs_slew, sun,
 };
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::map::{self, TaylorLift};
@@ -264,6 +266,63 @@ fn tumbling(long_steps: usize) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// The smallest clearance |p - c| - r from the spheres at the steps' evaluation points
+/// (midpoints, where the constraints are imposed) and along the chords (20 points per step).
+fn sphere_clearance(plan: &Plan<6, 12>) -> (f64, f64) {
+    let clearance = |x: &SVector<f64, 12>| {
+        let p = Vector3::new(x[3], x[4], x[5]);
+        SPHERES
+            .iter()
+            .map(|&(centre, radius)| (p - Vector3::from(centre)).norm() - radius)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (mut at_midpoints, mut along) = (f64::INFINITY, f64::INFINITY);
+    for w in plan.x.windows(2) {
+        at_midpoints = at_midpoints.min(clearance(&((w[0] + w[1]) / 2.0)));
+        for k in 0..=20 {
+            let s = f64::from(k) / 20.0;
+            along = along.min(clearance(&(w[0] * (1.0 - s) + w[1] * s)));
+        }
+    }
+    (at_midpoints, along)
+}
+
+/// The SE(3) flight among the spheres, free and constrained.
+fn flight(steps: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let system = attitude::se3_body();
+    let (start, goal, time) = attitude::se3_flight();
+    let spheres: Vec<OutsideSphere> = SPHERES
+        .iter()
+        .map(|&(c, r)| OutsideSphere::new(c, r))
+        .collect();
+    println!(
+        "\n## SE(3): turning by 120 deg while flying 4.5 among {} spheres, T = {time} s, N = {steps}\n",
+        SPHERES.len()
+    );
+    println!(
+        "| flight | J | iterations | ms | min reduced Hessian eigenvalue | least clearance at the midpoints | along the chords |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (name, avoid) in [("free", false), ("among spheres", true)] {
+        let mut problem = OptimalControlProblem::new(&system, &start, &goal, time, steps)
+            .with_options(PlanOptions::default().with_min_eigenvalue(true));
+        if avoid {
+            for sphere in &spheres {
+                problem = problem.with_inequality(sphere);
+            }
+        }
+        let clock = Instant::now();
+        let plan = problem.solve(PlanGuess::Spline)?;
+        let ms = clock.elapsed().as_secs_f64() * 1e3;
+        let (at_midpoints, along) = sphere_clearance(&plan);
+        println!(
+            "| {name} | {:.6} | {} | {ms:.1} | {:.2e} | {at_midpoints:.1e} | {along:.1e} |",
+            plan.cost, plan.iterations, plan.certificate.min_reduced_hessian_eig,
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let drawn = slews(200)?;
     slews(400)?;
@@ -301,5 +360,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         boresight_path.display(),
         torque_path.display()
     );
+    flight(120)?;
     tumbling(1_000_000)
 }
