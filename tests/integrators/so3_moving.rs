@@ -6,11 +6,11 @@
 //! (k = 2, L = 1/2 |J Omega' + Omega x J Omega|^2) conserves its spatial momentum the same way.
 
 use retract::diagnostics::canonical_structure;
-use retract::map::{self, TaylorLift};
+use retract::map::{self, DiscretizationMap, TaylorLift};
 use retract::nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 use retract::so3::{
-    CayleyMidpoint, chart_point, chart_quaternion, orientation, recentre, transition, translate,
-    world_momentum,
+    CayleyMidpoint, CayleyMidpoint1, CayleyMidpoint2, chart_point, chart_quaternion, orientation,
+    recentre, transition, translate, world_momentum,
 };
 use retract::taylor::Taylor;
 use retract::{LiftedSystem, NewtonOptions};
@@ -159,15 +159,15 @@ fn free_start(omega: Vector3<f64>) -> SVector<f64, 6> {
     body().legendre(&state::<1, 6>([Vector3::zeros()], [omega / 2.0]))
 }
 
-/// `steps` steps of size `h` from the identity with body velocity `omega`, recentring after
-/// each; `observe` sees the centre and state after every step. Returns the last state.
+/// `steps` steps of size `h` of the generated map from the identity with body velocity
+/// `omega`, recentring after each; `observe` sees the centre and state after every step. Returns the last state.
 fn run_moving_with(
     h: f64,
     steps: usize,
     omega: Vector3<f64>,
     mut observe: impl FnMut(&UnitQuaternion<f64>, &SVector<f64, 6>),
 ) -> SVector<f64, 6> {
-    let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
+    let (system, map, options) = (body(), CayleyMidpoint1, NewtonOptions::default());
     let (mut centre, mut z) = (UnitQuaternion::identity(), free_start(omega));
     observe(&centre, &z);
     for _ in 0..steps {
@@ -320,4 +320,61 @@ fn compositions_of_recentred_steps_have_orders_4_and_6() {
             );
         }
     }
+}
+
+/// The largest entry of a block matrix's difference.
+fn block_gap<const K: usize>(a: &map::BlockMatrix<3, K>, b: &map::BlockMatrix<3, K>) -> f64 {
+    let mut gap: f64 = 0.0;
+    for (ra, rb) in a.iter().zip(b) {
+        for (ma, mb) in ra.iter().zip(rb) {
+            gap = gap.max((ma - mb).amax());
+        }
+    }
+    gap
+}
+
+/// The generated map of order `K` against the run-time lift at random points: the points,
+/// the four Jacobians and the covector Hessian agree to rounding.
+fn generated_matches_the_lift<const K: usize>(generated: &impl DiscretizationMap<3, K>) {
+    let lift = TaylorLift(CayleyMidpoint);
+    for seed in 0..10 {
+        let blocks = |offset: u64, scale: f64| -> [Vector3<f64>; K] {
+            core::array::from_fn(|j| random(seed * 40 + offset + j as u64, scale))
+        };
+        let (x, xi, w1, w2) = (
+            blocks(0, 0.7),
+            blocks(10, 0.5),
+            blocks(20, 1.0),
+            blocks(30, 1.0),
+        );
+        let (a1, a2) = generated.points(&x, &xi);
+        let (b1, b2) = lift.points(&x, &xi);
+        for j in 0..K {
+            assert!((a1[j] - b1[j]).amax() < 1e-12 && (a2[j] - b2[j]).amax() < 1e-12);
+        }
+        let (ja, jb) = (generated.jacobians(&x, &xi), lift.jacobians(&x, &xi));
+        let jacobians = [
+            block_gap(&ja.r1_x, &jb.r1_x),
+            block_gap(&ja.r1_xi, &jb.r1_xi),
+            block_gap(&ja.r2_x, &jb.r2_x),
+            block_gap(&ja.r2_xi, &jb.r2_xi),
+        ];
+        assert!(jacobians.iter().all(|g| *g < 1e-11), "{jacobians:?}");
+        let (ha, hb) = (
+            generated.covector_hessian(&x, &xi, &w1, &w2),
+            lift.covector_hessian(&x, &xi, &w1, &w2),
+        );
+        let hessian = [
+            block_gap(&ha.xx, &hb.xx),
+            block_gap(&ha.x_xi, &hb.x_xi),
+            block_gap(&ha.xi_xi, &hb.xi_xi),
+        ];
+        assert!(hessian.iter().all(|g| *g < 1e-10), "{hessian:?}");
+    }
+}
+
+#[test]
+fn the_generated_cayley_maps_are_the_run_time_lift() {
+    generated_matches_the_lift::<1>(&CayleyMidpoint1);
+    generated_matches_the_lift::<2>(&CayleyMidpoint2);
 }
