@@ -291,12 +291,12 @@ fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
 }
 
 #[test]
-fn compositions_of_recentred_steps_have_orders_4_and_6() {
+fn compositions_of_recentred_steps_have_orders_4_6_and_8() {
     let omega = Vector3::new(1.0, 3.0, -0.5);
     let t = 4.0;
     let exact = super::so3::attitude::euler_reference(omega, t, 40_000);
     let (system, map, options) = (body(), TaylorLift(CayleyMidpoint), NewtonOptions::default());
-    for (order, sizes) in [(4, [40, 80, 160]), (6, [30, 60, 120])] {
+    for (order, sizes) in [(4, [40, 80, 160]), (6, [30, 60, 120]), (8, [30, 60, 120])] {
         let errors = sizes.map(|n| {
             let (mut centre, mut z) = (UnitQuaternion::identity(), free_start(omega));
             // the stage: a step and a recentring (the centre moves with each stage)
