@@ -33,7 +33,7 @@ use retract::so3::{
 };
 use retract::{LiftedSystem, NewtonOptions, StepOptions};
 
-/// J w + Omega x J Omega: the torque of body velocity `omega` and acceleration `domega`.
+/// J Omega' + Omega x J Omega: the torque of body velocity `omega` and acceleration `domega`.
 fn torque(omega: &Vector3<f64>, domega: &Vector3<f64>) -> Vector3<f64> {
     let j = Vector3::from(INERTIA);
     domega.component_mul(&j) + omega.cross(&omega.component_mul(&j))

@@ -43,8 +43,11 @@ fn state<const K: usize, const S: usize>(
 
 #[test]
 fn the_transition_is_the_left_translation() {
-    for seed in 0..20 {
-        let (a, y) = (random(seed, 0.8), random(seed + 100, 0.8));
+    // (seeds from 20 on: points and centres far apart, some with 1 + a . y < 0, where only
+    // the quaternion representative changes sign)
+    for seed in 0..40 {
+        let scale = if seed < 20 { 0.8 } else { 2.5 };
+        let (a, y) = (random(seed, scale), random(seed + 100, scale));
         let moved = Vector3::from(translate(&a, [y[0], y[1], y[2]]));
         let expected = chart_quaternion(&a).inverse() * chart_quaternion(&y);
         let angle = chart_quaternion(&moved).angle_to(&expected);
@@ -144,7 +147,23 @@ fn the_transition_is_symplectic_and_inverted_by_the_opposite_one() {
     let back =
         transition::<2, 12>(&-a, &transition::<2, 12>(&a, &z2).expect("inside")).expect("inside");
     assert!((back - z2).amax() < 1e-13);
-    // a point a half-turn from the new centre has no chart there
+    // the same at k = 3 with momenta
+    let z3 = state::<3, 18>(
+        [random(14, 0.5), random(15, 1.0), random(16, 1.0)],
+        [random(17, 1.0), random(18, 1.0), random(19, 1.0)],
+    );
+    let back =
+        transition::<3, 18>(&-a, &transition::<3, 18>(&a, &z3).expect("inside")).expect("inside");
+    assert!((back - z3).amax() < 1e-12);
+    // with 1 + a . y < 0 the point still has a chart there: a = (2, 0, 0) and y = (-2, 0, 0)
+    // are turns by 126.87 and -126.87 deg about x, 253.74 deg apart: 106.26 = 2 atan(4/3) deg
+    let far = transition::<1, 6>(
+        &Vector3::new(2.0, 0.0, 0.0),
+        &state::<1, 6>([Vector3::new(-2.0, 0.0, 0.0)], [Vector3::zeros()]),
+    )
+    .expect("not a half-turn");
+    assert!((far.fixed_rows::<3>(0) - Vector3::new(4.0 / 3.0, 0.0, 0.0)).amax() < 1e-15);
+    // a rotation a half-turn from the new centre has no chart there
     assert!(
         transition::<1, 6>(
             &a,
@@ -253,7 +272,7 @@ fn many_turns_keep_the_rotation_orthogonal_and_the_momentum() {
 }
 
 #[test]
-fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
+fn the_minimum_torque_body_recentres_exactly_and_conserves_its_momentum() {
     let system = super::so3::attitude::gibbs_body();
     let (map, options) = (TaylorLift(CayleyMidpoint), NewtonOptions::default());
     // at the identity with Omega = (1, 3, -0.5) and Omega' = (0.3, -0.2, 0.4)
@@ -272,14 +291,24 @@ fn the_minimum_torque_body_conserves_its_momentum_through_turns() {
     let m0 = world_momentum::<2, 12>(&centre, &z);
     let mut drift: f64 = 0.0;
     let mut turned = 0.0;
+    // the same steps in the fixed chart at the identity, while it holds (about a radian)
+    let mut fixed = z;
     // (its extremals spin up: by t = 1.5 the body turns at some 30 rad/s)
-    for _ in 0..300 {
+    for i in 0..300 {
         let before = orientation::<2, 12>(&centre, &z);
         z = map::step(&system, &map, &z, 0.005, &options)
             .expect("regular")
             .0;
         recentre::<2, 12>(&mut centre, &mut z).expect("finite");
-        turned += before.angle_to(&orientation::<2, 12>(&centre, &z));
+        let after = orientation::<2, 12>(&centre, &z);
+        if i < 60 {
+            fixed = map::step(&system, &map, &fixed, 0.005, &options)
+                .expect("regular")
+                .0;
+            let gap = orientation::<2, 12>(&UnitQuaternion::identity(), &fixed).angle_to(&after);
+            assert!(gap < 1e-11, "step {i}: {gap:e}");
+        }
+        turned += before.angle_to(&after);
         drift = drift.max((world_momentum::<2, 12>(&centre, &z) - m0).amax() / m0.amax());
     }
     assert!(turned > 2.0 * std::f64::consts::PI, "turned {turned}");

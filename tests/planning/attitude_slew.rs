@@ -164,7 +164,7 @@ fn the_rigid_body_flies_among_spheres_in_se3() {
         );
         let reached = chart_quaternion(&Vector3::new(last[0], last[1], last[2]));
         assert!(reached.angle_to(&turn) < 1e-12);
-        assert!((last[3] - 4.5).abs() < 1e-12);
+        assert!((last[3] - 4.5).abs() < 1e-12 && last[4].abs() < 1e-12 && last[5].abs() < 1e-12);
     }
 }
 

@@ -502,6 +502,11 @@ where
             let Some((next, alpha, at_rounding)) =
                 self.line_search(&iterate, &models, &direction, &barrier, &ds, &mut penalty)
             else {
+                if stale {
+                    // the simplified direction failed: solve this iterate's own subproblem
+                    iterations -= 1;
+                    continue;
+                }
                 let failure = Failure::LineSearch;
                 return Err(fail(failure, &iterate, models.cost, certificate, momenta));
             };
@@ -522,12 +527,13 @@ where
         }
     }
 
-    /// The subproblem at `models`, solved with the factorisation `kept` of the previous
-    /// iterate (whose error was `e_prev`) if there is one and the simplified Newton step is
-    /// predicted to reach the tolerance: its error from here is about $e^2 / e_{\rm prev}$
-    /// (the factorisation's error is of the size of the last step, $e_{\rm prev}$). Else
-    /// (and if it is not) with a new inertia-corrected factorisation ([`Self::factor_corrected`]);
-    /// `None` if none is positive definite.
+    /// The subproblem at `models`. With the factorisation `kept` of the previous iterate
+    /// (whose error was $e_{\rm prev}$), a simplified Newton step: taken if its predicted error
+    /// from here, about $e^2 / e_{\rm prev}$ (the kept factorisation is off by about the last
+    /// step, $e_{\rm prev}$), is below the tolerance. Otherwise, or without `kept`, a new
+    /// inertia-corrected factorisation ([`Self::factor_corrected`]); `None` if none is positive
+    /// definite. (A kept factorisation was positive definite without correction, so the
+    /// negative directions reported with it, 0, are those of the previous iterate.)
     fn subproblem(
         &self,
         models: &Models<N, X>,

@@ -8,7 +8,8 @@
 //!
 //! $$\phi_a(y) = \frac{y - a - a \times y}{1 + a \cdot y},$$
 //!
-//! defined where $1 + a \cdot y > 0$ (less than a half-turn from the new centre). The jet
+//! defined where $1 + a \cdot y \ne 0$ (where the rotation is not a half-turn from the new
+//! centre; the sign of $1 + a \cdot y$ is that of the quaternion representative). The jet
 //! $(y, y', \dots, y^{(k-1)})$ changes by the derivatives of $\phi_a$ along the curve,
 //! $y_{\rm new}^{(j)} = D^j \phi_a(y(t))$, and the momenta by the cotangent lift of that
 //! point transformation, $p_{\rm new} = (\partial Y_{\rm new} / \partial Y)^{-T} p$: a
@@ -49,6 +50,7 @@ pub fn orientation<const K: usize, const S: usize>(
     centre: &UnitQuaternion<f64>,
     z: &SVector<f64, S>,
 ) -> UnitQuaternion<f64> {
+    const { assert!(K >= 1, "the order k is at least 1") };
     let (x, _) = split::<3, K, S>(z);
     centre * chart_quaternion(&x[0])
 }
@@ -64,19 +66,21 @@ pub fn chart_point(centre: &UnitQuaternion<f64>, g: &UnitQuaternion<f64>) -> Opt
 
 /// The state `z` (of order $k$: jet and momenta of $y$) in the chart centred at
 /// $c\,Q(a)$ instead of $c$ (module docs): the jet by $D^j \phi_a$, the momenta by the
-/// inverse transpose of its Jacobian. An error if the point is a half-turn or more from the
-/// new centre ($1 + a \cdot y \le 0$) or the result is not finite.
+/// inverse transpose of its Jacobian. An error if the rotation is a half-turn from the new
+/// centre ($|1 + a \cdot y| \le 10^{-12} (1 + |a| |y|)$, where no Gibbs chart centred there
+/// reaches) or the result is not finite.
 pub fn transition<const K: usize, const S: usize>(
     a: &Vector3<f64>,
     z: &SVector<f64, S>,
 ) -> Result<SVector<f64, S>, Error> {
+    const { assert!(K >= 1, "the order k is at least 1") };
     let (x, p) = split::<3, K, S>(z);
     let den = 1.0 + a.dot(&x[0]);
-    if den.is_nan() || den <= 0.0 {
+    if den.is_nan() || den.abs() <= 1e-12 * (1.0 + a.norm() * x[0].norm()) {
         return Err(Error::InvalidArgument {
             name: "z",
-            requirement: "a chart point less than a half-turn from the new centre \
-                          (1 + a . y > 0)",
+            requirement: "a rotation that is not a half-turn from the new centre \
+                          (1 + a . y != 0)",
         });
     }
     let series: [Taylor<Dual<3>, K>; 3] =
