@@ -67,6 +67,27 @@ pub fn min_torque(y: [f64; 3], dy: [f64; 3], ddy: [f64; 3], j1: f64, j2: f64, j3
     effort([r[0], r[1], r[2]], [r[3], r[4], r[5]], [j1, j2, j3])
 }
 
+/// The minimum-torque rigid body written on SO(3) in body coordinates (`so3`):
+/// L = 1/2 |J Omega' + Omega x J Omega|^2; the macro composes it with the Gibbs chart
+/// centred at the parameter `so3_centre`, giving [`min_torque`].
+#[higher_order_lagrangian(order = 2, so3, helpers = [effort])]
+pub fn body_min_torque(_r: [f64; 9], w: [f64; 3], dw: [f64; 3], j1: f64, j2: f64, j3: f64) -> f64 {
+    effort(w, dw, [j1, j2, j3])
+}
+
+/// The boresight's clearance from the sun cone on SO(3) (`so3`): cos(cone) - (R b) . s with
+/// b = e_z, R b the third column of R (row major: r[2], r[5], r[8]) and `sun` in world axes.
+#[jet_function(order = 2, so3)]
+pub fn sun_clearance(
+    r: [f64; 9],
+    _w: [f64; 3],
+    _dw: [f64; 3],
+    sun: [f64; 3],
+    cos_cone: f64,
+) -> f64 {
+    cos_cone - (r[2] * sun[0] + r[5] * sun[1] + r[8] * sun[2])
+}
+
 /// The system with [`INERTIA`].
 pub fn gibbs_body() -> MinTorque {
     MinTorque {

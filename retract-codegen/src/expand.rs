@@ -6,6 +6,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 use syn::ItemFn;
 
+use crate::charts;
 use crate::emit::Emission;
 use crate::emit::lagrangian::lagrangian_impl;
 use crate::emit::lifted::lifted_system_impl;
@@ -16,8 +17,7 @@ use crate::emit::ty::type_and_constructor;
 use crate::graph::{Graph, Id};
 use crate::lower::{Guard, Lower, without_output_marks};
 use crate::mechanics::{self, Degenerate};
-use crate::signature::{self, Attribute, Signature};
-use crate::sphere;
+use crate::signature::{self, Attribute, Signature, Space};
 use crate::util::combine;
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
@@ -78,12 +78,12 @@ fn expand_counted(
         stats.lowered_nodes = lower.g.len();
         stats.graph_nodes = lower.g.len();
         stats.guards = lower.guards.len();
-        if let Some(output) = lower.outputs.first().filter(|_| sig.sphere) {
+        if let Some(output) = lower.outputs.first().filter(|_| sig.space != Space::Flat) {
             let span = output.name.span();
             lower.errors.push(syn::Error::new(
                 span,
-                "named outputs are not supported with `sphere` (the generated system works in \
-                 a chart)",
+                "named outputs are not supported with `sphere` or `so3` (the generated system \
+                 works in a chart)",
             ));
         }
         if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
@@ -93,25 +93,24 @@ fn expand_counted(
         (root, std::mem::take(&mut lower.guards), outputs)
     };
     let function = without_output_marks(&function);
-    let (sig, root, guards) = if sig.sphere {
-        on_sphere(&mut graph, &sig, root, guards)
-    } else {
-        (sig, root, guards)
-    };
+    let (sig, root, guards) = in_chart(&mut graph, sig, root, guards);
     let mech = mechanics::build(&mut graph, root, sig.dim, sig.order);
     stats.graph_nodes = graph.len();
     let mech = mech.map_err(|reason| {
         let top = &sig.jet[sig.order];
+        // (on SO(3) the top argument is Omega^(k-1), which holds the chart's q^(k))
+        let what = match sig.space {
+            Space::So3 => format!("Omega^({})", sig.order - 1),
+            _ => format!("q^({})", sig.order),
+        };
         let msg = match reason {
             Degenerate::Independent => format!(
-                "the Lagrangian does not depend on `{top}` = q^({}): its Legendre map is \
-                 singular; lower the order or add a term in `{top}` (e.g. 0.5 * |{top}|^2)",
-                sig.order
+                "the Lagrangian does not depend on `{top}` = {what}: its Legendre map is \
+                 singular; lower the order or add a term in `{top}` (e.g. 0.5 * |{top}|^2)"
             ),
             Degenerate::Linear => format!(
-                "the Lagrangian is linear in `{top}` = q^({}): d2L/d{top}2 = 0, so its Legendre \
-                 map is singular; it must be (at least locally) strictly convex in `{top}`",
-                sig.order
+                "the Lagrangian is linear in `{top}` = {what}: d2L/d{top}2 = 0, so its Legendre \
+                 map is singular; it must be (at least locally) strictly convex in `{top}`"
             ),
             Degenerate::Singular => format!(
                 "d2L/d{top}2 is a singular constant matrix (or has a non-finite entry): the \
@@ -141,24 +140,24 @@ fn expand_counted(
     Ok(out)
 }
 
-/// L and its guards composed with the gnomonic chart of the sphere (`sphere`), with the
-/// signature of the composed Lagrangian.
-fn on_sphere(
+/// L and its guards composed with the chart of their space (`charts`), with the signature
+/// of the composed Lagrangian.
+fn in_chart(
     graph: &mut Graph,
-    sig: &Signature,
+    sig: Signature,
     root: Id,
     guards: Vec<Guard>,
 ) -> (Signature, Id, Vec<Guard>) {
     let roots: Vec<Id> = core::iter::once(root)
         .chain(guards.iter().map(|g| g.node))
         .collect();
-    let composed = sphere::compose(graph, sig, &roots);
+    let (sig, composed) = charts::compose(graph, sig, &roots);
     let guards = guards
         .into_iter()
         .zip(&composed[1..])
         .map(|(guard, &node)| Guard { node, ..guard })
         .collect();
-    (sphere::chart_signature(sig), composed[0], guards)
+    (sig, composed[0], guards)
 }
 
 /// The generated items, in order: the function and its type (`emit::ty`), the `Lagrangian`

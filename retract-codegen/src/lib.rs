@@ -11,11 +11,15 @@
 //! reuses them for a scalar function of the jet, emitting only its value, gradient and
 //! Hessian. `#[discretization_map]` (module `map`) lowers a map (q, v) -> (R1, R2) the same
 //! way, checks its conditions (`map_check`), lifts it by total derivatives and differentiates
-//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). With `sphere`, the stage `sphere` composes an
-//! ambient Lagrangian on S^2 with a gnomonic chart between `lower` and `mechanics`. Helpers used by several stages (`util`) import none of them.
+//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). With `sphere` or `so3`, the stage `charts` composes
+//! the function with its space's chart between `lower` and `mechanics`: an ambient
+//! Lagrangian on S^2 with a gnomonic chart (`sphere`), one in the rotation and body velocity
+//! with a Gibbs chart of SO(3) (`so3`). Helpers used by several stages (`util`) import none
+//! of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod charts;
 mod codegen;
 mod diff;
 mod emit;
@@ -31,6 +35,7 @@ mod mechanics;
 mod scopes;
 mod separable;
 mod signature;
+mod so3;
 mod sphere;
 mod util;
 

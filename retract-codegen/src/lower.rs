@@ -886,7 +886,7 @@ impl<'a> Lower<'a> {
         };
         let (len, var) = match self.lookup(&name) {
             Some((_, Binding::Jet { order, offset })) if !self.sig.scalar_jet => (
-                self.sig.dim,
+                self.sig.jet_len(order),
                 Var::Jet {
                     order,
                     index: offset,

@@ -111,11 +111,58 @@ pub struct Signature {
     pub guard: bool,
     /// Whether a discretization map's conditions are checked at compile time (`check`).
     pub check: bool,
-    /// Whether the Lagrangian lives on the unit sphere S^2 (`sphere`): the jet is ambient
-    /// (`[f64; 3]`) and the generated system works in a gnomonic chart (`crate::sphere`).
-    pub sphere: bool,
+    /// Where the Lagrangian lives: R^n, the unit sphere (`sphere`) or SO(3) (`so3`); on the
+    /// last two the generated system works in a chart whose frame is a parameter.
+    pub space: Space,
     /// The attribute that is expanded.
     pub attribute: Attribute,
+}
+
+/// The configuration space of a Lagrangian or jet function.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Space {
+    /// R^n: the jet is the argument list as written.
+    Flat,
+    /// The unit sphere S^2 (`sphere`): the jet is ambient (`[f64; 3]`) and the generated
+    /// system works in a gnomonic chart (`crate::sphere`).
+    Sphere,
+    /// The rotation group SO(3) (`so3`): the arguments are the rotation R (`[f64; 9]`, row
+    /// major) and the body velocity Omega with its derivatives (`[f64; 3]`); the generated
+    /// system works in a Gibbs chart centred at a rotation (`crate::so3`).
+    So3,
+}
+
+impl Space {
+    /// The name and length of the parameter that holds the chart's frame, appended after
+    /// the user's parameters; `None` on R^n.
+    pub fn chart_param(self) -> Option<(&'static str, usize)> {
+        match self {
+            Space::Flat => None,
+            Space::Sphere => Some((SPHERE_CHART, 9)),
+            Space::So3 => Some((SO3_CENTRE, 9)),
+        }
+    }
+
+    /// The option's name, for messages.
+    fn option(self) -> &'static str {
+        match self {
+            Space::Flat => "",
+            Space::Sphere => "sphere",
+            Space::So3 => "so3",
+        }
+    }
+}
+
+impl Signature {
+    /// The number of components of jet argument `order` as written: 9 for the rotation of
+    /// `so3`, else the dimension n.
+    pub fn jet_len(&self, order: u8) -> usize {
+        if self.space == Space::So3 && order == 0 {
+            9
+        } else {
+            self.dim
+        }
+    }
 }
 
 /// Options of the attribute.
@@ -124,7 +171,7 @@ struct Options {
     name: Option<Ident>,
     guard: bool,
     check: bool,
-    sphere: Option<Span>,
+    space: Option<(Space, Span)>,
 }
 
 fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options> {
@@ -133,7 +180,7 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         name: None,
         guard: true,
         check: true,
-        sphere: None,
+        space: None,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("order") {
@@ -158,8 +205,18 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
-        } else if meta.path.is_ident("sphere") && attribute != Attribute::Map {
-            options.sphere = Some(meta.path.span());
+        } else if let Some(space) = [Space::Sphere, Space::So3]
+            .into_iter()
+            .find(|space| meta.path.is_ident(space.option()) && attribute != Attribute::Map)
+        {
+            if let Some((other, _)) = options.space.filter(|(other, _)| *other != space) {
+                return Err(meta.error(format!(
+                    "`{}` and `{}` exclude each other: a Lagrangian lives on one space",
+                    other.option(),
+                    space.option()
+                )));
+            }
+            options.space = Some((space, meta.path.span()));
             Ok(())
         } else if meta.path.is_ident("check") && attribute == Attribute::Map {
             let lit: syn::LitBool = meta.value()?.parse()?;
@@ -173,11 +230,12 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         } else if attribute == Attribute::Lagrangian {
             Err(meta.error(
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
-                 `guard = false`, `sphere`",
+                 `guard = false`, `sphere`, `so3`",
             ))
         } else {
             Err(meta.error(
-                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, `sphere`",
+                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, `sphere`, \
+                 `so3`",
             ))
         }
     });
@@ -431,15 +489,8 @@ fn dimension(
     }
 }
 
-/// The conditions of `sphere`: the jet is ambient, `[f64; 3]`, and no parameter takes the
-/// name of the chart's (`SPHERE_CHART`).
-fn check_sphere(
-    args: &[(Ident, Kind)],
-    jet_kind: Option<Kind>,
-    jet_count: usize,
-    span: Span,
-    errors: &mut Errors,
-) {
+/// The conditions of `sphere`: the jet is ambient, `[f64; 3]`.
+fn check_sphere(args: &[(Ident, Kind)], jet_kind: Option<Kind>, span: Span, errors: &mut Errors) {
     if jet_kind.is_some() && jet_kind != Some(Kind::Array(3)) {
         errors.fail(
             args.first().map_or(span, |(name, _)| name.span()),
@@ -450,13 +501,70 @@ fn check_sphere(
             ),
         );
     }
-    for (name, _) in args.iter().skip(jet_count) {
-        if name == SPHERE_CHART {
+}
+
+/// The conditions of `so3`: the arguments are the rotation `[f64; 9]` and then the body
+/// velocity and its derivatives, `[f64; 3]` each.
+fn check_so3(args: &[(Ident, Kind)], order: usize, errors: &mut Errors) {
+    for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
+        let (expected, what) = if i == 0 {
+            (
+                Kind::Array(9),
+                "the rotation R, row major: r[3 * i + j] = R_ij".to_string(),
+            )
+        } else if i == 1 {
+            (
+                Kind::Array(3),
+                "the body angular velocity Omega".to_string(),
+            )
+        } else {
+            (
+                Kind::Array(3),
+                format!("Omega^({}), the derivative of the body velocity", i - 1),
+            )
+        };
+        if *kind != expected {
             errors.fail(
                 name.span(),
                 format!(
-                    "`{SPHERE_CHART}` is the name of the chart that `sphere` adds to the \
-                     parameters; rename this parameter"
+                    "a Lagrangian on SO(3) (`so3`) of order {order} takes R: [f64; 9], then \
+                     Omega, ..., Omega^({}): [f64; 3]; argument {} (`{name}`) must be `{}` \
+                     ({what}), not {}",
+                    order - 1,
+                    i + 1,
+                    expected.describe(),
+                    kind.describe()
+                ),
+            );
+        }
+    }
+}
+
+/// The conditions of a chart option: those of its space, and no parameter takes the name
+/// of the chart's.
+fn check_space(
+    space: Space,
+    args: &[(Ident, Kind)],
+    (order, jet_kind, jet_count): (usize, Option<Kind>, usize),
+    span: Span,
+    errors: &mut Errors,
+) {
+    match space {
+        Space::Flat => return,
+        Space::Sphere => check_sphere(args, jet_kind, span, errors),
+        Space::So3 => check_so3(args, order, errors),
+    }
+    let Some((chart, _)) = space.chart_param() else {
+        return;
+    };
+    for (name, _) in args.iter().skip(jet_count) {
+        if name == chart {
+            errors.fail(
+                name.span(),
+                format!(
+                    "`{chart}` is the name of the chart that `{}` adds to the parameters; \
+                     rename this parameter",
+                    space.option()
                 ),
             );
         }
@@ -465,6 +573,10 @@ fn check_sphere(
 
 /// The name of the chart parameter `[c, e1, e2]` (9 numbers) that `sphere` appends.
 pub const SPHERE_CHART: &str = "sphere_chart";
+
+/// The name of the chart centre (a rotation matrix, 9 numbers, row major) that `so3`
+/// appends.
+pub const SO3_CENTRE: &str = "so3_centre";
 
 /// The names of q, q', ..., q^(order) (the first `order + 1` arguments), or of q and v for
 /// a map; errors where one is not of the type of q.
@@ -566,18 +678,37 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
     let jet_count = attribute.jet_count(order);
     let (args, jet_span) = arguments(sig, jet_count, &mut errors);
     let jet_kind = args.first().map(|(_, k)| *k);
-    let (dim, scalar_jet) = dimension(sig, jet_kind, jet_span, order, &mut errors);
+    let space = options.space.map_or(Space::Flat, |(space, _)| space);
+    let (dim, scalar_jet) = if space == Space::So3 {
+        (3, false)
+    } else {
+        dimension(sig, jet_kind, jet_span, order, &mut errors)
+    };
     if attribute == Attribute::Map {
         check_map_return(sig, jet_kind, &mut errors);
     }
-    if let Some(span) = options.sphere {
-        check_sphere(&args, jet_kind, jet_count, span, &mut errors);
+    if let Some((space, span)) = options.space {
+        check_space(
+            space,
+            &args,
+            (order, jet_kind, jet_count),
+            span,
+            &mut errors,
+        );
     }
     if args.len() < jet_count && errors.list.is_empty() {
         let msg = if attribute == Attribute::Map {
             format!(
                 "a discretization map takes the point q and the tangent vector v (two arguments \
                  of one type) before its parameters; the signature has {}",
+                args.len()
+            )
+        } else if space == Space::So3 {
+            format!(
+                "order = {order} with `so3` needs {} arguments before the parameters (R: \
+                 [f64; 9], then Omega, ..., Omega^({}): [f64; 3]); the signature has {}",
+                order + 1,
+                order - 1,
                 args.len()
             )
         } else {
@@ -590,7 +721,15 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         };
         errors.fail(order_span, msg);
     }
-    let jet = jet_names(&args, order, jet_kind, &mut errors);
+    let jet = if space == Space::So3 {
+        // (their types were checked by `check_so3`)
+        args.iter()
+            .take(jet_count)
+            .map(|(n, _)| n.clone())
+            .collect()
+    } else {
+        jet_names(&args, order, jet_kind, &mut errors)
+    };
     let params = args
         .iter()
         .skip(jet_count)
@@ -619,7 +758,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         type_name,
         guard: options.guard,
         check: options.check,
-        sphere: options.sphere.is_some(),
+        space,
         attribute,
     })
 }

@@ -13,7 +13,11 @@ use proc_macro::TokenStream;
 /// `name = ...`). The function stays callable. Options: `order = k` (1..=4, required),
 /// `name = TypeName`, `guard = false` (no singularity guard), `sphere` (a Lagrangian on the
 /// unit sphere written in ambient coordinates, `[f64; 3]`: composed with a gnomonic chart,
-/// see `retract::sphere`). See the `retract` crate docs for the generated API.
+/// see `retract::sphere`), `so3` (a Lagrangian on the rotation group written in body
+/// coordinates: the arguments are the rotation R, `[f64; 9]` row major, then the body
+/// angular velocity Omega and its derivatives up to Omega^(k-1), `[f64; 3]` each; composed
+/// with a Gibbs chart whose centre is the field `so3_centre`, see `retract::so3`). See the
+/// `retract` crate docs for the generated API.
 ///
 /// The type name is the function's in UpperCamelCase; where that is not a type name (`_1`,
 /// `_2d_arm`, `self_`) the macro asks for `name = ...`. Compile-time integers (indices, loop
@@ -37,7 +41,7 @@ pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStr
 /// the docs of `retract`, which re-exports this attribute).
 ///
 /// The signature, the body and the options (`order = k`, required; `name = TypeName`;
-/// `sphere`) follow
+/// `sphere`; `so3`) follow
 /// `#[higher_order_lagrangian]`, but g may be linear in, or independent of, q^(k): only
 /// `value`, `gradient` and `hessian` in (x, u) are generated, on a type named after the
 /// function (`PoleTorque`) with the parameters as public fields and `new`. The function

@@ -25,6 +25,7 @@ mod messages_runtime;
 mod robustness_chord_invariant;
 mod robustness_runtime;
 mod so3;
+mod so3_body;
 mod so3_moving;
 mod sphere;
 mod sphere_order3;

@@ -9,7 +9,7 @@ use syn::ItemFn;
 
 use crate::codegen::{Leaves, signed_add};
 use crate::graph::Var;
-use crate::signature::{Kind, SPHERE_CHART, Signature};
+use crate::signature::{Kind, SO3_CENTRE, SPHERE_CHART, Signature, Space};
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -167,22 +167,53 @@ pub(crate) fn function_and_type(
     }
 }
 
-/// For a function on the sphere (`sphere`), `SphereSystem`: the chart parameter, read and
-/// replaced.
-pub(crate) fn sphere_system_impl(params: &ParamTokens) -> TokenStream {
+/// Where a generated system lives, for its docs: "R^n", or the space and its chart.
+pub(crate) fn space_description(sig: &Signature) -> String {
+    match sig.space {
+        Space::Flat => format!("R^{}", sig.dim),
+        Space::Sphere => "the unit sphere S^2, in the gnomonic chart `sphere_chart` (R^2; see \
+                          `retract::sphere`),"
+            .into(),
+        Space::So3 => "SO(3), written in the rotation R and the body velocity Omega with its \
+                       derivatives, in the Gibbs chart centred at `so3_centre` (R^3; see \
+                       `retract::so3`),"
+            .into(),
+    }
+}
+
+/// For a function on the sphere (`sphere`), `SphereSystem`; on SO(3) (`so3`), `So3System`:
+/// the chart parameter, read and replaced. Nothing on R^n.
+pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStream {
     let (generics, ty) = (&params.generics, &params.ty_full);
     let allow = allow_generated();
-    let chart = syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site());
+    let Some((name, _)) = space.chart_param() else {
+        return TokenStream::new();
+    };
+    let field = syn::Ident::new(name, proc_macro2::Span::call_site());
+    let (module, tr, read, replace) = match space {
+        Space::So3 => (
+            quote!(so3),
+            quote!(So3System),
+            quote!(centre),
+            quote!(with_centre),
+        ),
+        _ => (
+            quote!(sphere),
+            quote!(SphereSystem),
+            quote!(chart),
+            quote!(with_chart),
+        ),
+    };
     quote! {
         #[automatically_derived]
         #allow
-        impl #generics ::retract::__private::retract_core::sphere::SphereSystem for #ty {
-            fn chart(&self) -> [f64; 9] {
-                self.#chart
+        impl #generics ::retract::__private::retract_core::#module::#tr for #ty {
+            fn #read(&self) -> [f64; 9] {
+                self.#field
             }
 
-            fn with_chart(&self, chart: [f64; 9]) -> Self {
-                Self { #chart: chart, ..*self }
+            fn #replace(&self, frame: [f64; 9]) -> Self {
+                Self { #field: frame, ..*self }
             }
         }
     }
@@ -231,18 +262,27 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
                     )
                 }
             };
-            let doc = if sig.sphere && name == SPHERE_CHART {
-                "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set \
-                 by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`."
-                    .to_string()
-            } else {
-                doc
+            let doc = match sig.space {
+                Space::Sphere if name == SPHERE_CHART => {
+                    "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), \
+                     set by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after \
+                     `new`."
+                        .to_string()
+                }
+                Space::So3 if name == SO3_CENTRE => {
+                    "The Gibbs chart's centre C, a rotation matrix row major \
+                     (`retract::so3::centre_matrix`), moved by `retract::so3`; the identity \
+                     after `new`."
+                        .to_string()
+                }
+                _ => doc,
             };
             quote!(#[doc = #doc] pub #name: #t)
         })
         .collect();
     // the chart of a system on the sphere is set by the stepper, not by the user
-    let user_params = &sig.params[..sig.params.len() - usize::from(sig.sphere)];
+    let chart = sig.space.chart_param();
+    let user_params = &sig.params[..sig.params.len() - usize::from(chart.is_some())];
     let ctor_args = user_params
         .iter()
         .map(|p| {
@@ -267,9 +307,14 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
             quote!(#name)
         })
         .collect();
-    if sig.sphere {
-        let chart = syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site());
-        field_names.push(quote!(#chart: [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]));
+    if let Some((name, _)) = chart {
+        let field = syn::Ident::new(name, proc_macro2::Span::call_site());
+        // the sphere's north pole, or the identity rotation
+        let frame = match sig.space {
+            Space::So3 => quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+            _ => quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+        };
+        field_names.push(quote!(#field: #frame));
     }
     ParamTokens {
         generics,

@@ -25,10 +25,17 @@
 //! step, a centre quaternion $c$ and the rotation $c\,Q(y)$) follow a body through any
 //! number of turns; the change of chart is symplectic and commutes with the step (module
 //! `moving`).
+//!
+//! A Lagrangian written in body coordinates, L(R, Omega, ..., Omega^(k-1)), is composed
+//! with the chart by `#[higher_order_lagrangian(order = k, so3)]`, with the chart's centre as
+//! a parameter ([`So3System`], module `body`): [`body_state`] starts it from body rates and
+//! [`recentre_system`] moves chart and centre together.
 
 use nalgebra::{SVector, Vector3};
 
+mod body;
 mod moving;
+pub use body::{So3System, body_state, centre_matrix, centred, chart_derivatives, recentre_system};
 pub use moving::{
     chart_point, chart_quaternion, orientation, recentre, transition, translate, world_momentum,
 };
