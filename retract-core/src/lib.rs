@@ -70,6 +70,8 @@ pub mod reduced;
 pub mod so3;
 pub mod sphere;
 pub mod split;
+pub mod split_methods;
+pub mod split_stepper;
 pub mod state;
 pub mod step;
 pub mod system;
