@@ -199,7 +199,11 @@ where
                 z[r]
             } else {
                 let i = m - K;
-                let sign = if i.is_multiple_of(2) { inverse } else { -inverse };
+                let sign = if i.is_multiple_of(2) {
+                    inverse
+                } else {
+                    -inverse
+                };
                 z[(2 * K - 1 - i) * N + a] * sign
             }
         })
