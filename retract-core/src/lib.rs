@@ -24,6 +24,8 @@
 //! - [`so3`]: the rotation group in Gibbs charts and its Cayley midpoint map.
 //! - [`split`]: an explicit symplectic splitting for $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$
 //!   (one gradient of $V$ per step), which the macro detects.
+//!   [`split_methods`]: splitting methods for it (fused compositions, Blanes-Moan RKN
+//!   methods of order 4 and 6); [`split_stepper`]: their stepper.
 //! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
 //!   discretization map of $S^2$.
 //! - [`state`](mod@state): typed derivative data ([`Jet`]) and states ([`State`]), built by
@@ -70,6 +72,8 @@ pub mod reduced;
 pub mod so3;
 pub mod sphere;
 pub mod split;
+pub mod split_methods;
+pub mod split_stepper;
 pub mod state;
 pub mod step;
 pub mod system;

@@ -26,7 +26,7 @@ use crate::step::{StepOptions, StepReport, check_step_domain};
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// The largest order the free flow supports (that of the macro).
-const MAX_K: usize = 4;
+pub(crate) const MAX_K: usize = 4;
 
 /// A Lagrangian $L(x, u) = \tfrac{c}{2} |u|^2 + V(x_0)$: quadratic in the top derivative
 /// $u = q^{(k)}$ with the constant weight $c > 0$, free of $q', \dots, q^{(k-1)}$, and no
@@ -92,7 +92,7 @@ pub fn free_flow<const N: usize, const K: usize, const S: usize>(
 }
 
 /// $e^{tA}$ as a matrix (the free flow's derivative).
-fn free_flow_matrix<const N: usize, const K: usize, const S: usize>(
+pub(crate) fn free_flow_matrix<const N: usize, const K: usize, const S: usize>(
     t: f64,
     weight: f64,
 ) -> SMatrix<f64, S, S> {
@@ -106,7 +106,7 @@ fn free_flow_matrix<const N: usize, const K: usize, const S: usize>(
 }
 
 /// $(x, u)$ at state `z` with $u = p_{k-1}/c$ (the top derivative of the free flow).
-fn jet_of<const N: usize, const K: usize, const S: usize>(
+pub(crate) fn jet_of<const N: usize, const K: usize, const S: usize>(
     z: &SVector<f64, S>,
     weight: f64,
 ) -> ([SVector<f64, N>; K], SVector<f64, N>) {
@@ -115,7 +115,7 @@ fn jet_of<const N: usize, const K: usize, const S: usize>(
 }
 
 /// The weight $c$ of `system`, checked: finite and positive.
-fn weight_of<Sys, const N: usize, const K: usize>(system: &Sys) -> Result<f64, Error>
+pub(crate) fn weight_of<Sys, const N: usize, const K: usize>(system: &Sys) -> Result<f64, Error>
 where
     Sys: Separable<N, K> + ?Sized,
 {

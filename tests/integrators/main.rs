@@ -30,4 +30,5 @@ mod so3_moving;
 mod sphere;
 mod sphere_order3;
 mod splitting;
+mod splitting_methods;
 mod structure;

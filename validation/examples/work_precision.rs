@@ -3,9 +3,14 @@
 //! 1. The paper's obstacle IVP (SE(2), tau = 1e-2, q(0) = (-2, 1.05, 0), q'(0) = (1, 0, 0.5),
 //!    T = 4): final error against a tight reference versus wall time for the midpoint rule
 //!    and its compositions of order 4, 6, 8 (all on the generated reduced step), the explicit
-//!    splitting (`retract::split`) and its compositions, and classical RK4 and adaptive
-//!    DOP853 (ode_solvers) on the plain first-order system y' = (q', q'', q''', -grad V)
-//!    (their best form). Prints `work-precision 1e-8: best=..., DOP853 ..., ratio ...`.
+//!    splitting methods (`retract::split_stepper`): Strang's splitting and its compositions
+//!    of order 4, 6, 8 with fused free flows (and the order-6 one as per-stage
+//!    `split::split_step` calls, the form before), Blanes and Moan's RKN methods SRKN6b
+//!    (order 4), SRKN11b and SRKN14a (order 6), and SRKN14a without the singularity guard;
+//!    and classical RK4 and adaptive DOP853 (ode_solvers) on the plain first-order system
+//!    y' = (q', q'', q''', -grad V) (their best form, no checks). Prints
+//!    `work-precision 1e-8: best=..., DOP853 ..., ratio ...` (over the guarded methods) and
+//!    `work-precision 1e-8 without the guard: ...`.
 //! 2. The bounded Pais-Uhlenbeck oscillator (MATH.md; w1 = 1, w2 = sqrt 2, eps = -0.05) over
 //!    10^6 midpoint steps of h = 0.1 (T = 10^5): max |H - H(0)| so far against time for the
 //!    midpoint rule, the order-4 composition at 3h (same number of implicit solves), RK4 and
@@ -27,6 +32,8 @@ use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::plot::{self, Scale};
 use retract::split::{Separable, split_step};
+use retract::split_methods::SplittingMethod;
+use retract::split_stepper::SplitStepper;
 use retract::{LiftedSystem, ReducedScheme, ReducedStepper, StepOptions};
 
 #[higher_order_lagrangian(order = 2)]
@@ -213,8 +220,10 @@ where
     Ok(z)
 }
 
-/// `steps` steps of the explicit splitting composed to `order` (2: Strang itself).
-fn split<Sys, const S: usize, const M: usize>(
+/// `steps` steps of Strang's splitting composed to `order`, each stage a full
+/// `split_step` (two half free flows, the guard and the checks per stage): the form before
+/// `retract::split_stepper`, kept for comparison.
+fn split_per_stage<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
     t_end: f64,
@@ -229,6 +238,28 @@ where
     let mut z = *z0;
     for _ in 0..steps {
         z = compose(|z, h| split_step(system, z, h, &options), &z, h, order)?.0;
+    }
+    Ok(z)
+}
+
+/// `steps` steps of the splitting `method` ([`SplitStepper`]; default options, the guard on
+/// unless `guard` is false).
+fn split<Sys, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, 12>,
+    t_end: f64,
+    steps: usize,
+    (method, guard): (SplittingMethod, bool),
+) -> Result<SVector<f64, 12>, retract::Error>
+where
+    Sys: Separable<3, 2> + LiftedSystem<12, M>,
+{
+    let options = StepOptions::default().with_domain_check(guard);
+    let mut stepper = SplitStepper::<Sys, 3, 2, 12>::new(system, method)?;
+    let h = t_end / steps as f64;
+    let mut z = *z0;
+    for _ in 0..steps {
+        z = stepper.step(&z, h, &options)?.0;
     }
     Ok(z)
 }
@@ -292,16 +323,66 @@ fn obstacle_ivp() -> Result<(), Box<dyn std::error::Error>> {
         let run = |n| composed(&system, &z0, t_end, n, order).map_err(|e| e.to_string());
         curves.push(sweep(name, points, steps, run, &reference));
     }
-    let explicit: [(&str, u32, &[usize]); 4] = [
-        ("splitting", 2, &[200, 400, 800, 1600, 3200, 6400, 12800]),
-        ("splitting, order 4", 4, &[40, 80, 160, 320, 640, 1280]),
-        ("splitting, order 6", 6, &[20, 40, 80, 160, 320]),
-        ("splitting, order 8", 8, &[10, 20, 40, 80, 160]),
+    let per_stage = |n| split_per_stage(&system, &z0, t_end, n, 6).map_err(|e| e.to_string());
+    curves.push(sweep(
+        "splitting, order 6, per-stage steps",
+        &[20, 40, 80, 160, 320],
+        steps,
+        per_stage,
+        &reference,
+    ));
+    let composition = |order| SplittingMethod::composition(order).map_err(|e| e.to_string());
+    let explicit: [(&str, SplittingMethod, &[usize]); 7] = [
+        (
+            "splitting",
+            composition(2)?,
+            &[200, 400, 800, 1600, 3200, 6400, 12800],
+        ),
+        (
+            "splitting, order 4",
+            composition(4)?,
+            &[40, 80, 160, 320, 640, 1280],
+        ),
+        (
+            "splitting, order 6",
+            composition(6)?,
+            &[20, 40, 80, 160, 320],
+        ),
+        (
+            "splitting, order 8",
+            composition(8)?,
+            &[10, 20, 40, 80, 160],
+        ),
+        (
+            "splitting, BM SRKN6b",
+            SplittingMethod::blanes_moan_4(),
+            &[20, 40, 80, 160, 320, 640],
+        ),
+        (
+            "splitting, BM SRKN11b",
+            SplittingMethod::blanes_moan_6(),
+            &[10, 20, 40, 80, 160],
+        ),
+        (
+            "splitting, BM SRKN14a",
+            SplittingMethod::blanes_moan_6a(),
+            &[10, 20, 40, 80, 160],
+        ),
     ];
-    for (name, order, points) in explicit {
-        let run = |n| split(&system, &z0, t_end, n, order).map_err(|e| e.to_string());
+    for (name, method, points) in explicit {
+        let run = |n| split(&system, &z0, t_end, n, (method, true)).map_err(|e| e.to_string());
         curves.push(sweep(name, points, steps, run, &reference));
     }
+    // the peers check nothing: the best splitting without the singularity guard, for scale
+    let unguarded = (SplittingMethod::blanes_moan_6a(), false);
+    let run = |n| split(&system, &z0, t_end, n, unguarded).map_err(|e| e.to_string());
+    curves.push(sweep(
+        "BM SRKN14a, guard off",
+        &[10, 20, 40, 80],
+        steps,
+        run,
+        &reference,
+    ));
     let rk4 = |n| Ok(system.legendre(&plain.rk4(&jet, t_end, n)));
     curves.push(sweep(
         "RK4",
@@ -345,7 +426,7 @@ fn print_at_target(curves: &[plot::Curve]) {
         .filter_map(|c| time_at_error(&c.points, 1e-8).map(|t| (c.label.as_str(), t)))
         .collect();
     for (label, time) in &at_target {
-        println!("  {label:<22} {:>7.1} us", time * 1e6);
+        println!("  {label:<36} {:>7.1} us", time * 1e6);
     }
     let dop = at_target.iter().find(|(label, _)| *label == "DOP853");
     let best = at_target
@@ -358,6 +439,16 @@ fn print_at_target(curves: &[plot::Curve]) {
             best * 1e6,
             dop * 1e6,
             best / dop
+        );
+    }
+    let unguarded = at_target
+        .iter()
+        .find(|(label, _)| label.ends_with("guard off"));
+    if let (Some((_, dop)), Some((label, time))) = (dop, unguarded) {
+        println!(
+            "work-precision 1e-8 without the guard: {label} {:.1} us, ratio {:.2}",
+            time * 1e6,
+            time / dop
         );
     }
 }
