@@ -1,16 +1,17 @@
 //! Attitude on SO(3) (`retract::so3`).
 //!
 //! 1. A 170-degree rest-to-rest slew about the world y axis in 10 s with minimum torque,
-//!    L = 1/2 |J Omega' + Omega x J Omega|^2, free and with a sun keep-out cone on the
-//!    boresight (a hard constraint), planned by the optimizer in a Gibbs chart centred
-//!    halfway; the boresight's paths and the torque are drawn to `docs/attitude.svg` and
+//!    L = 1/2 |J Omega' + Omega x J Omega|^2 written in body coordinates (`so3`), free and
+//!    with a sun keep-out cone on the boresight (a hard constraint, the sun in world axes),
+//!    planned by the optimizer in the Gibbs chart centred halfway; the boresight's paths and the torque are drawn to `docs/attitude.svg` and
 //!    `docs/attitude_torque.svg`.
 //! 2. The same slew in Z-Y-X Euler angles, whose pitch passes 90 degrees, where the rates no
 //!    longer determine the rotation's velocity (gimbal lock).
 //! 3. The free rigid body through the same singularity: the Cayley midpoint map in moving
 //!    charts against the midpoint rule in Euler angles, and a long run of the former.
-//! 4. A fully actuated rigid body in SE(3) (attitude in a Gibbs chart, position in world axes)
-//!    flying among spheres while it turns, each sphere a hard constraint.
+//! 4. A fully actuated rigid body in SE(3), written in body coordinates (`se3`) and planned in
+//!    the product chart at the identity, flying among spheres while it turns, each sphere a
+//!    hard constraint.
 //!
 //! Run: `cargo run --release --example attitude [-- boresight.svg torque.svg]`
 
@@ -21,8 +22,8 @@ mod common;
 use std::time::Instant;
 
 use attitude::{
-    BORESIGHT, CONE_DEGREES, EulerSunClearance, INERTIA, OutsideSphere, SLEW_DEGREES, SLEW_TIME,
-    SPHERES, euler_body, euler_reference, gibbs_body, gibbs_cone, gibbs_problem, gibbs_slew, sun,
+    BORESIGHT, CONE_DEGREES, ClearOfSphere, EulerSunClearance, INERTIA, SLEW_DEGREES, SLEW_TIME,
+    SPHERES, euler_body, euler_reference, gibbs_problem, gibbs_slew, slew_body, slew_cone, sun,
 };
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::map::{self, DiscretizationMap, TaylorLift};
@@ -131,8 +132,8 @@ fn slews(steps: usize) -> Result<Vec<(String, Slew)>, Box<dyn std::error::Error>
         "| chart, slew | J | iterations | ms | min reduced Hessian eigenvalue | closest to the sun (deg) | peak abs(tau) |"
     );
     println!("|---|---|---|---|---|---|---|");
-    let (system, (centre, start, goal)) = (gibbs_body(), gibbs_slew());
-    let cone = gibbs_cone(&centre);
+    let (centre, start, goal) = gibbs_slew();
+    let (system, cone) = (slew_body(&centre), slew_cone(&centre));
     let mut drawn = Vec::new();
     for (name, with_cone) in [("free", false), ("sun cone", true)] {
         let mut problem = gibbs_problem(&system, &start, &goal, steps);
@@ -296,11 +297,11 @@ fn sphere_clearance(plan: &Plan<6, 12>) -> (f64, f64) {
 
 /// The SE(3) flight among the spheres, free and constrained.
 fn flight(steps: usize) -> Result<(), Box<dyn std::error::Error>> {
-    let system = attitude::se3_body();
+    let system = attitude::flight_body();
     let (start, goal, time) = attitude::se3_flight();
-    let spheres: Vec<OutsideSphere> = SPHERES
+    let spheres: Vec<ClearOfSphere> = SPHERES
         .iter()
-        .map(|&(c, r)| OutsideSphere::new(c, r))
+        .map(|&(c, r)| ClearOfSphere::new(c, r))
         .collect();
     println!(
         "\n## SE(3): turning by 120 deg while flying 4.5 among {} spheres, T = {time} s, N = {steps}\n",

@@ -11,6 +11,7 @@ extern crate self as retract;
 
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod se3;
 pub mod so3;
 pub mod sphere;
 /// A runnable example: an obstacle course's Lagrangian, stepped once.

@@ -1,12 +1,14 @@
-//! Attitude models in charts of SO(3): the minimum-torque rigid body
-//! L = 1/2 |J Omega' + Omega x J Omega|^2 written in a Gibbs chart (`retract::so3`) and in
-//! Z-Y-X Euler angles, a sun keep-out cone on the boresight in each, and the slew's boundary
+//! Attitude models on SO(3): the minimum-torque rigid body
+//! L = 1/2 |J Omega' + Omega x J Omega|^2 written in body coordinates (`so3`, which the macro
+//! composes with a Gibbs chart), composed with a Gibbs chart by hand (to check the former), and
+//! in Z-Y-X Euler angles; a sun keep-out cone on the boresight in each, and the slew's boundary
 //! data. Shared by `examples/attitude.rs` and the tests (by path).
 #![allow(dead_code)] // each user takes a subset
 
 use retract::bvp::{OptimalControlProblem, PlanOptions};
-use retract::nalgebra::{Quaternion, UnitQuaternion, Vector3, Vector4};
-use retract::so3::chart_point;
+use retract::nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3, Vector4};
+use retract::se3;
+use retract::so3::{centred, chart_point};
 use retract::{helper, higher_order_lagrangian, jet_function};
 
 /// The inertia of the spacecraft.
@@ -88,7 +90,7 @@ pub fn sun_clearance(
     cos_cone - (r[2] * sun[0] + r[5] * sun[1] + r[8] * sun[2])
 }
 
-/// The system with [`INERTIA`].
+/// The hand-composed chart form [`min_torque`] with [`INERTIA`].
 pub fn gibbs_body() -> MinTorque {
     MinTorque {
         j1: INERTIA[0],
@@ -184,19 +186,36 @@ pub fn gibbs_slew() -> (UnitQuaternion<f64>, [f64; 6], [f64; 6]) {
     (centre, jet(&start), jet(&goal))
 }
 
-/// The sun cone in the Gibbs chart centred at `centre`.
+/// The body form [`body_min_torque`] with [`INERTIA`], its chart centred at `centre`.
+pub fn slew_body(centre: &UnitQuaternion<f64>) -> BodyMinTorque {
+    centred(
+        &BodyMinTorque::new(INERTIA[0], INERTIA[1], INERTIA[2]),
+        centre,
+    )
+}
+
+/// The sun cone on SO(3) ([`sun_clearance`], the sun in world axes), its chart centred at
+/// `centre`.
+pub fn slew_cone(centre: &UnitQuaternion<f64>) -> SunClearance {
+    let cone = SunClearance::new(sun().into(), CONE_DEGREES.to_radians().cos());
+    centred(&cone, centre)
+}
+
+/// The hand-composed sun cone in the Gibbs chart centred at `centre` (the sun in the
+/// centre's axes): [`slew_cone`] written out, to check it.
 pub fn gibbs_cone(centre: &UnitQuaternion<f64>) -> GibbsSunClearance {
     let sun = centre.inverse() * sun();
     GibbsSunClearance::new(sun.into(), CONE_DEGREES.to_radians().cos())
 }
 
-/// The slew in the Gibbs chart with `steps` steps (the cone is added by the caller).
+/// The slew of the body form `system` (centred as the jets' chart) with `steps` steps (the
+/// cone is added by the caller).
 pub fn gibbs_problem<'a>(
-    system: &'a MinTorque,
+    system: &'a BodyMinTorque,
     start: &[f64; 6],
     goal: &[f64; 6],
     steps: usize,
-) -> OptimalControlProblem<'a, MinTorque, 3, 2, 6> {
+) -> OptimalControlProblem<'a, BodyMinTorque, 3, 2, 6> {
     OptimalControlProblem::new(system, start, goal, SLEW_TIME, steps)
         .with_options(PlanOptions::default().with_min_eigenvalue(true))
 }
@@ -256,8 +275,9 @@ pub fn gibbs_free_body() -> GibbsFree {
     }
 }
 
-/// A fully actuated rigid body in SE(3), x = (y, p): its attitude in the Gibbs chart and its
-/// position p in world axes; the effort 1/2 |tau|^2 + 1/2 |m p''|^2 of the body torque and
+/// A fully actuated rigid body in SE(3) composed with the product chart at the identity by
+/// hand, x = (y, p): its attitude in the Gibbs chart and its position p in world axes (to
+/// check [`body_flight`]); the effort 1/2 |tau|^2 + 1/2 |m p''|^2 of the body torque and
 /// the force.
 #[higher_order_lagrangian(order = 2, helpers = [gibbs_rates, effort])]
 pub fn se3_effort(
@@ -288,19 +308,6 @@ pub fn se3_body() -> Se3Effort {
     }
 }
 
-/// The position's clearance from a sphere: |p - centre|^2 - radius^2.
-#[jet_function(order = 2)]
-pub fn outside_sphere(
-    x: [f64; 6],
-    _dx: [f64; 6],
-    _ddx: [f64; 6],
-    centre: [f64; 3],
-    radius: f64,
-) -> f64 {
-    let (a, b, c) = (x[3] - centre[0], x[4] - centre[1], x[5] - centre[2]);
-    a * a + b * b + c * c - radius * radius
-}
-
 /// The spheres the body flies among: (centre, radius).
 pub const SPHERES: [([f64; 3], f64); 3] = [
     ([1.2, 0.15, 0.0], 0.5),
@@ -309,15 +316,58 @@ pub const SPHERES: [([f64; 3], f64); 3] = [
 ];
 
 /// The flight: from rest at the origin, unrotated, to rest at (4.5, 0, 0) turned by 120
-/// degrees about the axis (0.2, 0.3, 1), in 6 s; the jets in the Gibbs chart at the identity.
+/// degrees about the axis (0.2, 0.3, 1), in 6 s; the jets in the product chart at the
+/// identity (`retract::se3::chart_point`).
 /// (About a principal axis the planar turn is a stationary point by symmetry, and for the
 /// largest inertia not a minimum: the optimizer reports `NotAMinimum` there.)
 pub fn se3_flight() -> ([f64; 12], [f64; 12], f64) {
     let axis = Vector3::new(0.2, 0.3, 1.0).normalize();
     let turn = UnitQuaternion::from_scaled_axis(axis * 120f64.to_radians());
-    let y = chart_point(&UnitQuaternion::identity(), &turn).expect("less than a half-turn");
+    let end = Isometry3::from_parts(Translation3::new(4.5, 0.0, 0.0), turn);
+    let point = se3::chart_point(&Isometry3::identity(), &end).expect("less than a half-turn");
     let mut goal = [0.0; 12];
-    goal[..3].copy_from_slice(y.as_slice());
-    goal[3] = 4.5;
+    goal[..6].copy_from_slice(point.as_slice());
     ([0.0; 12], goal, 6.0)
+}
+
+/// A fully actuated rigid body written on SE(3) in body coordinates (`se3`): the effort
+/// 1/2 |tau|^2 + 1/2 |f|^2 of the body torque tau = J Omega' + Omega x J Omega and the body
+/// force f = m (v' + Omega x v) (|f| = |m p''|, since p'' = R (v' + Omega x v)); the macro
+/// composes it with the product chart centred at `se3_centre`, giving [`se3_effort`].
+#[higher_order_lagrangian(order = 2, se3, helpers = [effort])]
+pub fn body_flight(
+    _g: [f64; 12],
+    xi: [f64; 6],
+    dxi: [f64; 6],
+    j1: f64,
+    j2: f64,
+    j3: f64,
+    mass: f64,
+) -> f64 {
+    let f0 = mass * (dxi[3] + xi[1] * xi[5] - xi[2] * xi[4]);
+    let f1 = mass * (dxi[4] + xi[2] * xi[3] - xi[0] * xi[5]);
+    let f2 = mass * (dxi[5] + xi[0] * xi[4] - xi[1] * xi[3]);
+    let w = [xi[0], xi[1], xi[2]];
+    let dw = [dxi[0], dxi[1], dxi[2]];
+    effort(w, dw, [j1, j2, j3]) + 0.5 * (f0 * f0 + f1 * f1 + f2 * f2)
+}
+
+/// [`body_flight`] with [`INERTIA`] and mass 1, its chart at the identity (where the chart
+/// jet of the position is the position).
+pub fn flight_body() -> BodyFlight {
+    BodyFlight::new(INERTIA[0], INERTIA[1], INERTIA[2], 1.0)
+}
+
+/// The position's clearance from a sphere on SE(3) (`se3`): |p - centre|^2 - radius^2 with
+/// p = g[9..12] in world axes.
+#[jet_function(order = 2, se3)]
+pub fn clear_of_sphere(
+    g: [f64; 12],
+    _xi: [f64; 6],
+    _dxi: [f64; 6],
+    centre: [f64; 3],
+    radius: f64,
+) -> f64 {
+    let (a, b, c) = (g[9] - centre[0], g[10] - centre[1], g[11] - centre[2]);
+    a * a + b * b + c * c - radius * radius
 }

@@ -82,7 +82,7 @@ fn expand_counted(
             let span = output.name.span();
             lower.errors.push(syn::Error::new(
                 span,
-                "named outputs are not supported with `sphere` or `so3` (the generated system \
+                "named outputs are not supported with `sphere`, `so3` or `se3` (the generated system \
                  works in a chart)",
             ));
         }
@@ -101,6 +101,7 @@ fn expand_counted(
         // (on SO(3) the top argument is Omega^(k-1), which holds the chart's q^(k))
         let what = match sig.space {
             Space::So3 => format!("Omega^({})", sig.order - 1),
+            Space::Se3 => format!("xi^({})", sig.order - 1),
             _ => format!("q^({})", sig.order),
         };
         let msg = match reason {

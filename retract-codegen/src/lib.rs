@@ -11,10 +11,11 @@
 //! reuses them for a scalar function of the jet, emitting only its value, gradient and
 //! Hessian. `#[discretization_map]` (module `map`) lowers a map (q, v) -> (R1, R2) the same
 //! way, checks its conditions (`map_check`), lifts it by total derivatives and differentiates
-//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). With `sphere` or `so3`, the stage `charts` composes
-//! the function with its space's chart between `lower` and `mechanics`: an ambient
-//! Lagrangian on S^2 with a gnomonic chart (`sphere`), one in the rotation and body velocity
-//! with a Gibbs chart of SO(3) (`so3`). Helpers used by several stages (`util`) import none
+//! it (`map_lift`), and emits a `DiscretizationMap` (`emit::map`). With `sphere`, `so3` or `se3`, the stage
+//! `charts` composes the function with its space's chart between `lower` and `mechanics`: an
+//! ambient Lagrangian on S^2 with a gnomonic chart (`sphere`), one in the rotation and body
+//! velocity with a Gibbs chart of SO(3) (`so3`), one in the pose and body velocity with the
+//! product chart of SE(3) (`se3`). Helpers used by several stages (`util`) import none
 //! of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -33,6 +34,7 @@ mod map_check;
 mod map_lift;
 mod mechanics;
 mod scopes;
+mod se3;
 mod separable;
 mod signature;
 mod so3;

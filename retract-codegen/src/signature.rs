@@ -111,8 +111,8 @@ pub struct Signature {
     pub guard: bool,
     /// Whether a discretization map's conditions are checked at compile time (`check`).
     pub check: bool,
-    /// Where the Lagrangian lives: R^n, the unit sphere (`sphere`) or SO(3) (`so3`); on the
-    /// last two the generated system works in a chart whose frame is a parameter.
+    /// Where the Lagrangian lives: R^n, the unit sphere (`sphere`), SO(3) (`so3`) or SE(3)
+    /// (`se3`); on the last three the generated system works in a chart whose frame is a parameter.
     pub space: Space,
     /// The attribute that is expanded.
     pub attribute: Attribute,
@@ -130,6 +130,11 @@ pub enum Space {
     /// major) and the body velocity Omega with its derivatives (`[f64; 3]`); the generated
     /// system works in a Gibbs chart centred at a rotation (`crate::so3`).
     So3,
+    /// The rigid motions SE(3) (`se3`): the arguments are the pose g = (R, p) (`[f64; 12]`,
+    /// R row major, then the position p) and the body velocity xi = (Omega, v), v = R^T p',
+    /// with its derivatives (`[f64; 6]`); the generated system works in the product chart
+    /// (Gibbs chart of R, position in the centre's axes) centred at a pose (`crate::se3`).
+    Se3,
 }
 
 impl Space {
@@ -140,6 +145,17 @@ impl Space {
             Space::Flat => None,
             Space::Sphere => Some((SPHERE_CHART, 9)),
             Space::So3 => Some((SO3_CENTRE, 9)),
+            Space::Se3 => Some((SE3_CENTRE, 12)),
+        }
+    }
+
+    /// For a Lagrangian written in body coordinates on a group (`so3`, `se3`): the length of
+    /// the group element's argument and of each body rate's (the chart's dimension).
+    pub fn body_coordinates(self) -> Option<(usize, usize)> {
+        match self {
+            Space::So3 => Some((9, 3)),
+            Space::Se3 => Some((12, 6)),
+            Space::Flat | Space::Sphere => None,
         }
     }
 
@@ -149,18 +165,18 @@ impl Space {
             Space::Flat => "",
             Space::Sphere => "sphere",
             Space::So3 => "so3",
+            Space::Se3 => "se3",
         }
     }
 }
 
 impl Signature {
     /// The number of components of jet argument `order` as written: 9 for the rotation of
-    /// `so3`, else the dimension n.
+    /// `so3`, 12 for the pose of `se3`, else the dimension n.
     pub fn jet_len(&self, order: u8) -> usize {
-        if self.space == Space::So3 && order == 0 {
-            9
-        } else {
-            self.dim
+        match self.space.body_coordinates() {
+            Some((group, _)) if order == 0 => group,
+            _ => self.dim,
         }
     }
 }
@@ -205,7 +221,7 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
-        } else if let Some(space) = [Space::Sphere, Space::So3]
+        } else if let Some(space) = [Space::Sphere, Space::So3, Space::Se3]
             .into_iter()
             .find(|space| meta.path.is_ident(space.option()) && attribute != Attribute::Map)
         {
@@ -230,12 +246,12 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
         } else if attribute == Attribute::Lagrangian {
             Err(meta.error(
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
-                 `guard = false`, `sphere`, `so3`",
+                 `guard = false`, `sphere`, `so3`, `se3`",
             ))
         } else {
             Err(meta.error(
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, `sphere`, \
-                 `so3`",
+                 `so3`, `se3`",
             ))
         }
     });
@@ -503,34 +519,52 @@ fn check_sphere(args: &[(Ident, Kind)], jet_kind: Option<Kind>, span: Span, erro
     }
 }
 
-/// The conditions of `so3`: the arguments are the rotation `[f64; 9]` and then the body
-/// velocity and its derivatives, `[f64; 3]` each.
-fn check_so3(args: &[(Ident, Kind)], order: usize, errors: &mut Errors) {
+/// The conditions of `so3` and `se3`: the arguments are the group element (the rotation
+/// `[f64; 9]`, the pose `[f64; 12]`) and then the body velocity and its derivatives
+/// (`[f64; 3]`, `[f64; 6]`).
+fn check_body(space: Space, args: &[(Ident, Kind)], order: usize, errors: &mut Errors) {
+    let Some((group, rate)) = space.body_coordinates() else {
+        return;
+    };
+    let (element, velocity, prefix) = if space == Space::So3 {
+        (
+            "the rotation R, row major: r[3 * i + j] = R_ij",
+            "the body angular velocity Omega",
+            format!(
+                "a Lagrangian on SO(3) (`so3`) of order {order} takes R: [f64; 9], then Omega, \
+                 ..., Omega^({}): [f64; 3]",
+                order - 1
+            ),
+        )
+    } else {
+        (
+            "the pose g = (R, p): R row major (g[3 * i + j] = R_ij), then p = g[9..12]",
+            "the body velocity xi = (Omega, v), v = R^T p'",
+            format!(
+                "a Lagrangian on SE(3) (`se3`) of order {order} takes g = (R, p): [f64; 12], \
+                 then xi, ..., xi^({}): [f64; 6] (xi = (Omega, v))",
+                order - 1
+            ),
+        )
+    };
     for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
-        let (expected, what) = if i == 0 {
-            (
-                Kind::Array(9),
-                "the rotation R, row major: r[3 * i + j] = R_ij".to_string(),
-            )
-        } else if i == 1 {
-            (
-                Kind::Array(3),
-                "the body angular velocity Omega".to_string(),
-            )
-        } else {
-            (
-                Kind::Array(3),
-                format!("Omega^({}), the derivative of the body velocity", i - 1),
-            )
+        let (expected, what) = match i {
+            0 => (Kind::Array(group), element.to_string()),
+            1 => (Kind::Array(rate), velocity.to_string()),
+            _ => (
+                Kind::Array(rate),
+                format!(
+                    "{}^({}), the derivative of the body velocity",
+                    if space == Space::So3 { "Omega" } else { "xi" },
+                    i - 1
+                ),
+            ),
         };
         if *kind != expected {
             errors.fail(
                 name.span(),
                 format!(
-                    "a Lagrangian on SO(3) (`so3`) of order {order} takes R: [f64; 9], then \
-                     Omega, ..., Omega^({}): [f64; 3]; argument {} (`{name}`) must be `{}` \
-                     ({what}), not {}",
-                    order - 1,
+                    "{prefix}; argument {} (`{name}`) must be `{}` ({what}), not {}",
                     i + 1,
                     expected.describe(),
                     kind.describe()
@@ -552,7 +586,7 @@ fn check_space(
     match space {
         Space::Flat => return,
         Space::Sphere => check_sphere(args, jet_kind, span, errors),
-        Space::So3 => check_so3(args, order, errors),
+        Space::So3 | Space::Se3 => check_body(space, args, order, errors),
     }
     let Some((chart, _)) = space.chart_param() else {
         return;
@@ -577,6 +611,10 @@ pub const SPHERE_CHART: &str = "sphere_chart";
 /// The name of the chart centre (a rotation matrix, 9 numbers, row major) that `so3`
 /// appends.
 pub const SO3_CENTRE: &str = "so3_centre";
+
+/// The name of the chart centre (a pose: rotation matrix row major, then the position; 12
+/// numbers) that `se3` appends.
+pub const SE3_CENTRE: &str = "se3_centre";
 
 /// The names of q, q', ..., q^(order) (the first `order + 1` arguments), or of q and v for
 /// a map; errors where one is not of the type of q.
@@ -679,8 +717,8 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
     let (args, jet_span) = arguments(sig, jet_count, &mut errors);
     let jet_kind = args.first().map(|(_, k)| *k);
     let space = options.space.map_or(Space::Flat, |(space, _)| space);
-    let (dim, scalar_jet) = if space == Space::So3 {
-        (3, false)
+    let (dim, scalar_jet) = if let Some((_, rate)) = space.body_coordinates() {
+        (rate, false)
     } else {
         dimension(sig, jet_kind, jet_span, order, &mut errors)
     };
@@ -711,6 +749,14 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                 order - 1,
                 args.len()
             )
+        } else if space == Space::Se3 {
+            format!(
+                "order = {order} with `se3` needs {} arguments before the parameters (g: \
+                 [f64; 12], then xi, ..., xi^({}): [f64; 6]); the signature has {}",
+                order + 1,
+                order - 1,
+                args.len()
+            )
         } else {
             format!(
                 "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
@@ -721,8 +767,8 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         };
         errors.fail(order_span, msg);
     }
-    let jet = if space == Space::So3 {
-        // (their types were checked by `check_so3`)
+    let jet = if space.body_coordinates().is_some() {
+        // (their types were checked by `check_body`)
         args.iter()
             .take(jet_count)
             .map(|(n, _)| n.clone())

@@ -11,25 +11,14 @@
 //!
 //! with [y]x v = y x v, Q(y)^T Q(y)' = [Omega]x, and D the total derivative of the chart jet
 //! (D y^(i) = y^(i+1)); Omega^(k-1) reads y^(k). Every argument of L (and of its guards) is
-//! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard.
+//! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard. The
+//! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::se3`).
 
 use std::collections::HashMap;
 
 use crate::diff::{Differentiator, substitute, total_derivative};
 use crate::graph::{Graph, Id, Var};
-use crate::signature::{Kind, Param, SO3_CENTRE, Signature};
-
-/// The signature of the composed Lagrangian: dimension 3, the parameters of `sig` followed
-/// by the centre `so3_centre: [f64; 9]`.
-pub fn chart_signature(sig: &Signature) -> Signature {
-    let mut chart = sig.clone();
-    chart.dim = 3;
-    chart.params.push(Param {
-        name: syn::Ident::new(SO3_CENTRE, proc_macro2::Span::call_site()),
-        kind: Kind::Array(9),
-    });
-    chart
-}
+use crate::signature::Signature;
 
 /// `a x b` in the graph.
 fn cross(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> [Id; 3] {
@@ -41,19 +30,41 @@ fn cross(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> [Id; 3] {
     })
 }
 
-/// The rotation R = C Q(y), row major, in the chart point y and the centre parameter
-/// (`Var::Param { param: centre }`).
-fn rotation(g: &mut Graph, centre: u32, y: [Id; 3]) -> [Id; 9] {
+/// |y|^2 in the graph.
+fn norm_squared(g: &mut Graph, y: [Id; 3]) -> Id {
     let mut n = g.constant(0.0);
     for &yi in &y {
         let sq = g.powi(yi, 2);
         n = g.add_op(n, sq);
     }
+    n
+}
+
+/// The chart variables `Var::Jet { order, index: first + a }`, a = 0, 1, 2.
+pub(crate) fn jet3(g: &mut Graph, order: u8, first: u32) -> [Id; 3] {
+    core::array::from_fn(|a| {
+        g.var(Var::Jet {
+            order,
+            index: first + a as u32,
+        })
+    })
+}
+
+/// The components `first..first + len` of the parameter number `param`.
+pub(crate) fn param_entries(g: &mut Graph, param: u32, first: u32, len: u32) -> Vec<Id> {
+    (first..first + len)
+        .map(|index| g.var(Var::Param { param, index }))
+        .collect()
+}
+
+/// Q(y) = ((1 - |y|^2) I + 2 y y^T + 2 [y]x) / (1 + |y|^2), row major.
+pub(crate) fn chart_rotation(g: &mut Graph, y: [Id; 3]) -> [Id; 9] {
+    let n = norm_squared(g, y);
     let one = g.constant(1.0);
     let two = g.constant(2.0);
     let (diagonal, den) = (g.sub(one, n), g.add_op(one, n));
     // Q_ij = ((1 - n) delta_ij + 2 y_i y_j + 2 [y]x_ij) / (1 + n), [y]x_ij = -eps_ijl y_l
-    let q: [Id; 9] = core::array::from_fn(|e| {
+    core::array::from_fn(|e| {
         let (i, j) = (e / 3, e % 3);
         let yy = g.mul(y[i], y[j]);
         let mut num = g.mul(two, yy);
@@ -70,66 +81,63 @@ fn rotation(g: &mut Graph, centre: u32, y: [Id; 3]) -> [Id; 9] {
             };
         }
         g.div(num, den)
-    });
+    })
+}
+
+/// The product `a b` of 3x3 matrices, row major.
+pub(crate) fn mat_mul(g: &mut Graph, a: &[Id], b: &[Id; 9]) -> [Id; 9] {
     core::array::from_fn(|e| {
         let (i, j) = (e / 3, e % 3);
         let mut acc = g.constant(0.0);
         for l in 0..3 {
-            let c = g.var(Var::Param {
-                param: centre,
-                index: (3 * i + l) as u32,
-            });
-            let term = g.mul(c, q[3 * l + j]);
+            let term = g.mul(a[3 * i + l], b[3 * l + j]);
             acc = g.add_op(acc, term);
         }
         acc
     })
 }
 
-/// The arguments of L in the chart jet: R (9 nodes) and Omega^(j), j = 0..k-1.
-fn body_jet(g: &mut Graph, centre: u32, k: usize) -> (Vec<Id>, Vec<[Id; 3]>) {
-    let jet = |g: &mut Graph, order: u8| -> [Id; 3] {
-        core::array::from_fn(|a| {
-            g.var(Var::Jet {
-                order,
-                index: a as u32,
-            })
-        })
-    };
-    let (y, dy) = (jet(g, 0), jet(g, 1));
-    let r = rotation(g, centre, y).to_vec();
-    let mut n = g.constant(0.0);
-    for &yi in &y {
-        let sq = g.powi(yi, 2);
-        n = g.add_op(n, sq);
-    }
+/// Omega = s (y' - y x y'), s = 2 / (1 + |y|^2): the body angular velocity of Q(y(t)).
+pub(crate) fn body_angular_velocity(g: &mut Graph, y: [Id; 3], dy: [Id; 3]) -> [Id; 3] {
+    let n = norm_squared(g, y);
     let one = g.constant(1.0);
     let two = g.constant(2.0);
     let den = g.add_op(one, n);
     let s = g.div(two, den);
     let ydy = cross(g, y, dy);
-    let omega: [Id; 3] = core::array::from_fn(|a| {
+    core::array::from_fn(|a| {
         let v = g.sub(dy[a], ydy[a]);
         g.mul(s, v)
-    });
-    let mut d = Differentiator::default();
-    let mut rates = vec![omega];
-    for j in 1..k {
-        let previous = rates[j - 1];
-        rates.push(previous.map(|f| total_derivative(g, &mut d, f, 3, j + 1)));
-    }
-    (r, rates)
+    })
 }
 
-/// `roots` (L and its guarded expressions, in the arguments R, Omega, ... of `sig`)
-/// rewritten in the chart jet: `Var::Jet { order: 0, index: e }` becomes R_e and
-/// `Var::Jet { order: j, index: a }` (j >= 1) becomes Omega^(j-1)_a. The centre parameter
-/// is number `sig.params.len()`.
-pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-    let centre = sig.params.len() as u32;
-    let (r, rates) = body_jet(g, centre, sig.order);
+/// The body rate `xi` (in the jet up to order 1 of a chart of dimension `dim`) and its total
+/// derivatives: xi^(j) = D^j xi, j = 0..k-1 (xi^(k-1) reads the chart's q^(k)).
+pub(crate) fn rates(g: &mut Graph, xi: Vec<Id>, dim: usize, k: usize) -> Vec<Vec<Id>> {
+    let mut d = Differentiator::default();
+    let mut rates = vec![xi];
+    for j in 1..k {
+        let previous = rates[j - 1].clone();
+        rates.push(
+            previous
+                .into_iter()
+                .map(|f| total_derivative(g, &mut d, f, dim, j + 1))
+                .collect(),
+        );
+    }
+    rates
+}
+
+/// `roots` rewritten by `arguments`: `Var::Jet { order: 0, index: e }` becomes
+/// `element[e]` and `Var::Jet { order: j, index: a }` (j >= 1) becomes `rates[j - 1][a]`.
+pub(crate) fn substitute_body(
+    g: &mut Graph,
+    roots: &[Id],
+    element: Vec<Id>,
+    rates: Vec<Vec<Id>>,
+) -> Vec<Id> {
     let map = move |_: &mut Graph, v: Var| match v {
-        Var::Jet { order: 0, index } => Some(r[index as usize]),
+        Var::Jet { order: 0, index } => Some(element[index as usize]),
         Var::Jet { order, index } => Some(rates[order as usize - 1][index as usize]),
         _ => None,
     };
@@ -138,4 +146,18 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
         .iter()
         .map(|&root| substitute(g, root, &map, &mut memo))
         .collect()
+}
+
+/// `roots` (L and its guarded expressions, in the arguments R, Omega, ... of `sig`)
+/// rewritten in the chart jet: `Var::Jet { order: 0, index: e }` becomes R_e of
+/// R = C Q(y) and `Var::Jet { order: j, index: a }` (j >= 1) becomes Omega^(j-1)_a. The
+/// centre parameter is number `sig.params.len()`.
+pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+    let centre = param_entries(g, sig.params.len() as u32, 0, 9);
+    let (y, dy) = (jet3(g, 0, 0), jet3(g, 1, 0));
+    let q = chart_rotation(g, y);
+    let r = mat_mul(g, &centre, &q).to_vec();
+    let omega = body_angular_velocity(g, y, dy).to_vec();
+    let rates = rates(g, omega, 3, sig.order);
+    substitute_body(g, roots, r, rates)
 }

@@ -15,19 +15,7 @@ use std::collections::HashMap;
 
 use crate::diff::{Differentiator, substitute, total_derivative};
 use crate::graph::{Func, Graph, Id, Var};
-use crate::signature::{Kind, Param, SPHERE_CHART, Signature};
-
-/// The signature of the composed Lagrangian: dimension 2, the parameters of `sig` followed
-/// by the chart `sphere_chart: [f64; 9]`.
-pub fn chart_signature(sig: &Signature) -> Signature {
-    let mut chart = sig.clone();
-    chart.dim = 2;
-    chart.params.push(Param {
-        name: syn::Ident::new(SPHERE_CHART, proc_macro2::Span::call_site()),
-        kind: Kind::Array(9),
-    });
-    chart
-}
+use crate::signature::Signature;
 
 /// The ambient jet q^(j)_a = D^j phi_a(y), j = 0..=k, as nodes in the chart jet
 /// (`Var::Jet` with index 0, 1) and the chart parameter (`Var::Param { param: chart }`).

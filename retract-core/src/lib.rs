@@ -22,6 +22,7 @@
 //!   among them; [`map::TaylorLift`] lifts a map written over a [`taylor::Scalar`] at any
 //!   order by Taylor arithmetic ([`taylor`]).
 //! - [`so3`]: the rotation group in Gibbs charts and its Cayley midpoint map.
+//! - [`se3`]: the rigid motions in moving product charts (Gibbs chart and position).
 //! - [`split`]: an explicit symplectic splitting for $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$
 //!   (one gradient of $V$ per step), which the macro detects.
 //!   [`split_methods`]: splitting methods for it (fused compositions, Blanes-Moan RKN
@@ -69,6 +70,7 @@ pub mod newton;
 #[cfg(feature = "std")]
 pub mod output;
 pub mod reduced;
+pub mod se3;
 pub mod so3;
 pub mod sphere;
 pub mod split;

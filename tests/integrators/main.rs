@@ -24,6 +24,7 @@ mod map_macro;
 mod messages_runtime;
 mod robustness_chord_invariant;
 mod robustness_runtime;
+mod se3;
 mod so3;
 mod so3_body;
 mod so3_moving;

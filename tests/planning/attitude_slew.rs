@@ -1,6 +1,7 @@
 //! Planning on SO(3) (`examples/attitude.rs` at reduced size): the minimum-torque slew by 170
-//! degrees in a Gibbs chart centred halfway, free and around the sun keep-out cone. The chart
-//! Lagrangians are checked against torques from the rotation curve itself.
+//! degrees, written in body coordinates (`so3`) and planned in the Gibbs chart centred halfway,
+//! free and around the sun keep-out cone. The chart Lagrangians (body form, hand-composed
+//! Gibbs form, Euler angles) are checked against torques from the rotation curve itself.
 
 use retract::Lagrangian;
 use retract::bvp::{Failure, OptimalControlProblem, Plan, PlanGuess, PlanOptions};
@@ -8,8 +9,8 @@ use retract::nalgebra::{Quaternion, SVector, UnitQuaternion, Vector3};
 use retract::so3::chart_quaternion;
 
 use crate::attitude::{
-    self, BORESIGHT, CONE_DEGREES, euler_body, gibbs_body, gibbs_cone, gibbs_problem, gibbs_slew,
-    slew_ends, sun,
+    self, BORESIGHT, CONE_DEGREES, euler_body, gibbs_body, gibbs_problem, gibbs_slew, slew_body,
+    slew_cone, slew_ends, sun,
 };
 
 /// Omega and Omega' of the rotation curve `g(t)` at t = 0, from Omega = 2 vec(g^-1 g') by
@@ -31,6 +32,7 @@ fn cost_of(omega: &Vector3<f64>, domega: &Vector3<f64>) -> f64 {
 #[test]
 fn chart_lagrangians_are_the_minimum_torque_cost() {
     let (gibbs, euler) = (gibbs_body(), euler_body());
+    let body = slew_body(&UnitQuaternion::identity());
     for seed in 0..8 {
         let v = |k: u64| {
             Vector3::from_fn(|r, _| {
@@ -44,6 +46,11 @@ fn chart_lagrangians_are_the_minimum_torque_cost() {
         assert!(
             (got - expected).abs() < 1e-6 * (1.0 + expected),
             "Gibbs {got} vs {expected}"
+        );
+        let got = body.lagrangian(&[q, dq], &ddq);
+        assert!(
+            (got - expected).abs() < 1e-6 * (1.0 + expected),
+            "body coordinates {got} vs {expected}"
         );
         let expected = cost_of_curve(|t| {
             let a = curve(t);
@@ -80,8 +87,8 @@ fn sun_angles(centre: &UnitQuaternion<f64>, plan: &Plan<3, 6>) -> Vec<f64> {
 #[test]
 fn the_slew_keeps_out_of_the_sun_cone() {
     let steps = 60;
-    let system = gibbs_body();
     let (centre, start, goal) = gibbs_slew();
+    let system = slew_body(&centre);
     // the chart's ends are the slew's rotations
     let (g0, g1) = slew_ends();
     let end = |x: &[f64; 6]| centre * chart_quaternion(&Vector3::new(x[0], x[1], x[2]));
@@ -89,7 +96,7 @@ fn the_slew_keeps_out_of_the_sun_cone() {
     let free = gibbs_problem(&system, &start, &goal, steps)
         .solve(PlanGuess::Spline)
         .unwrap();
-    let cone = gibbs_cone(&centre);
+    let cone = slew_cone(&centre);
     let avoiding = gibbs_problem(&system, &start, &goal, steps)
         .with_inequality(&cone)
         .solve(PlanGuess::Spline)
@@ -122,11 +129,11 @@ fn the_slew_keeps_out_of_the_sun_cone() {
 #[test]
 fn the_rigid_body_flies_among_spheres_in_se3() {
     let steps = 40;
-    let system = attitude::se3_body();
+    let system = attitude::flight_body();
     let (start, goal, time) = attitude::se3_flight();
-    let spheres: Vec<attitude::OutsideSphere> = attitude::SPHERES
+    let spheres: Vec<attitude::ClearOfSphere> = attitude::SPHERES
         .iter()
-        .map(|&(c, r)| attitude::OutsideSphere::new(c, r))
+        .map(|&(c, r)| attitude::ClearOfSphere::new(c, r))
         .collect();
     let problem = OptimalControlProblem::new(&system, &start, &goal, time, steps)
         .with_options(PlanOptions::default().with_min_eigenvalue(true));
@@ -172,7 +179,7 @@ fn the_rigid_body_flies_among_spheres_in_se3() {
 /// minimum: the optimizer, started on it, says so instead of returning it.
 #[test]
 fn a_planar_turn_about_the_largest_inertia_is_not_a_minimum() {
-    let system = gibbs_body();
+    let system = slew_body(&UnitQuaternion::identity());
     let goal_turn = UnitQuaternion::from_scaled_axis(Vector3::z() * 120f64.to_radians());
     let y = retract::so3::chart_point(&UnitQuaternion::identity(), &goal_turn).unwrap();
     let goal = [y[0], y[1], y[2], 0.0, 0.0, 0.0];

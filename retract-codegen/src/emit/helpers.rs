@@ -9,7 +9,7 @@ use syn::ItemFn;
 
 use crate::codegen::{Leaves, signed_add};
 use crate::graph::Var;
-use crate::signature::{Kind, SO3_CENTRE, SPHERE_CHART, Signature, Space};
+use crate::signature::{Kind, SE3_CENTRE, SO3_CENTRE, SPHERE_CHART, Signature, Space};
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -178,22 +178,33 @@ pub(crate) fn space_description(sig: &Signature) -> String {
                        derivatives, in the Gibbs chart centred at `so3_centre` (R^3; see \
                        `retract::so3`),"
             .into(),
+        Space::Se3 => "SE(3), written in the pose (R, p) and the body velocity (Omega, v) with \
+                       its derivatives, in the chart (Gibbs chart of R, position in the \
+                       centre's axes) centred at `se3_centre` (R^6; see `retract::se3`),"
+            .into(),
     }
 }
 
-/// For a function on the sphere (`sphere`), `SphereSystem`; on SO(3) (`so3`), `So3System`:
-/// the chart parameter, read and replaced. Nothing on R^n.
+/// For a function on the sphere (`sphere`), `SphereSystem`; on SO(3) (`so3`), `So3System`;
+/// on SE(3) (`se3`), `Se3System`: the chart parameter, read and replaced. Nothing on R^n.
 pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStream {
     let (generics, ty) = (&params.generics, &params.ty_full);
     let allow = allow_generated();
-    let Some((name, _)) = space.chart_param() else {
+    let Some((name, len)) = space.chart_param() else {
         return TokenStream::new();
     };
     let field = syn::Ident::new(name, proc_macro2::Span::call_site());
+    let len = index(len);
     let (module, tr, read, replace) = match space {
         Space::So3 => (
             quote!(so3),
             quote!(So3System),
+            quote!(centre),
+            quote!(with_centre),
+        ),
+        Space::Se3 => (
+            quote!(se3),
+            quote!(Se3System),
             quote!(centre),
             quote!(with_centre),
         ),
@@ -208,11 +219,11 @@ pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStre
         #[automatically_derived]
         #allow
         impl #generics ::retract::__private::retract_core::#module::#tr for #ty {
-            fn #read(&self) -> [f64; 9] {
+            fn #read(&self) -> [f64; #len] {
                 self.#field
             }
 
-            fn #replace(&self, frame: [f64; 9]) -> Self {
+            fn #replace(&self, frame: [f64; #len]) -> Self {
                 Self { #field: frame, ..*self }
             }
         }
@@ -275,6 +286,12 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
                      after `new`."
                         .to_string()
                 }
+                Space::Se3 if name == SE3_CENTRE => {
+                    "The chart's centre (C, c), a pose: C row major, then c \
+                     (`retract::se3::centre_pose`), moved by `retract::se3`; the identity \
+                     after `new`."
+                        .to_string()
+                }
                 _ => doc,
             };
             quote!(#[doc = #doc] pub #name: #t)
@@ -312,6 +329,7 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
         // the sphere's north pole, or the identity rotation
         let frame = match sig.space {
             Space::So3 => quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+            Space::Se3 => quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
             _ => quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
         };
         field_names.push(quote!(#field: #frame));

@@ -29,6 +29,7 @@ pub(crate) fn type_and_constructor(e: &Emission<'_>) -> TokenStream {
     let space = space_description(sig);
     let args = match sig.space {
         crate::signature::Space::So3 => format!("R, Omega, ..., Omega^({})", k - 1),
+        crate::signature::Space::Se3 => format!("(R, p), xi, ..., xi^({})", k - 1),
         _ => format!("q, ..., q^({k})"),
     };
     let struct_doc = format!(

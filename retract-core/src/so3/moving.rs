@@ -75,6 +75,25 @@ pub fn transition<const K: usize, const S: usize>(
 ) -> Result<SVector<f64, S>, Error> {
     const { assert!(K >= 1, "the order k is at least 1") };
     let (x, p) = split::<3, K, S>(z);
+    let (jet, momenta) = transition_blocks(a, &x, &p)?;
+    let out = join::<3, K, S>(&jet, &momenta);
+    if out.iter().all(|v| v.is_finite()) {
+        Ok(out)
+    } else {
+        Err(Error::NonFinite {
+            iteration: 0,
+            location: "chart transition",
+        })
+    }
+}
+
+/// [`transition`] of the jet `x` and the momenta `p` (blocks of order 0..k-1), without the
+/// finiteness test of the result.
+pub(crate) fn transition_blocks<const K: usize>(
+    a: &Vector3<f64>,
+    x: &Blocks<3, K>,
+    p: &Blocks<3, K>,
+) -> Result<(Blocks<3, K>, Blocks<3, K>), Error> {
     let den = 1.0 + a.dot(&x[0]);
     if den.is_nan() || den.abs() <= 1e-12 * (1.0 + a.norm() * x[0].norm()) {
         return Err(Error::InvalidArgument {
@@ -84,7 +103,7 @@ pub fn transition<const K: usize, const S: usize>(
         });
     }
     let series: [Taylor<Dual<3>, K>; 3] =
-        translate(a, curve::<Dual<3>, 3, K>(&x, 0, Dual::variable));
+        translate(a, curve::<Dual<3>, 3, K>(x, 0, Dual::variable));
     // the new jet, and the diagonal block (D phi at y) and those below it
     let jet: Blocks<3, K> =
         core::array::from_fn(|j| Vector3::from_fn(|c, _| series[c].c[j].f * falling(j, 0)));
@@ -104,15 +123,7 @@ pub fn transition<const K: usize, const S: usize>(
         }
         momenta[i] = inverse_t * rhs;
     }
-    let out = join::<3, K, S>(&jet, &momenta);
-    if out.iter().all(|v| v.is_finite()) {
-        Ok(out)
-    } else {
-        Err(Error::NonFinite {
-            iteration: 0,
-            location: "chart transition",
-        })
-    }
+    Ok((jet, momenta))
 }
 
 /// Moves the chart of `z` to its own point: `centre` becomes $c\,Q(y)$ (renormalised) and
@@ -141,9 +152,15 @@ pub fn world_momentum<const K: usize, const S: usize>(
     z: &SVector<f64, S>,
 ) -> Vector3<f64> {
     let (x, p) = split::<3, K, S>(z);
+    centre * chart_momentum(&x, &p)
+}
+
+/// The angular momentum of [`world_momentum`] in the centre's axes, of the jet `x` and the
+/// momenta `p` of the Gibbs chart: $M_a = \sum_j p_j \cdot D^j[\delta_a y]$.
+pub(crate) fn chart_momentum<const K: usize>(x: &Blocks<3, K>, p: &Blocks<3, K>) -> Vector3<f64> {
     let y: [Taylor<f64, K>; 3] =
         core::array::from_fn(|c| Taylor::from_derivatives(core::array::from_fn(|j| x[j][c])));
-    let chart = Vector3::from_fn(|a, _| {
+    Vector3::from_fn(|a, _| {
         // delta_a y = (e_a + e_a x y + y_a y) / 2
         let e_cross_y = [
             [Taylor::constant(0.0), -y[2], y[1]],
@@ -158,6 +175,5 @@ pub fn world_momentum<const K: usize, const S: usize>(
         (0..K)
             .map(|j| (0..3).map(|c| p[j][c] * d[c][j]).sum::<f64>())
             .sum::<f64>()
-    });
-    centre * chart
+    })
 }

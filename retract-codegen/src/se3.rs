@@ -1,0 +1,54 @@
+//! The stage behind `#[higher_order_lagrangian(order = k, se3)]`: a Lagrangian written on
+//! SE(3) in body coordinates (the pose g = (R, p) and the body velocity xi = (Omega, v),
+//! v = R^T p', with its derivatives), composed with the product chart so that the rest of
+//! the pipeline sees an order-k Lagrangian on R^6 with the chart jet (y, x).
+//!
+//! The chart is centred at the pose (C, c), a run-time parameter `se3_centre: [f64; 12]`
+//! (C row major, then c), and is the left translation of the chart at the identity:
+//!
+//! (R, p) = (C, c) (Q(y), x) = (C Q(y), c + C x),
+//! Omega = s (y' - y x y'),  v = R^T p' = Q(y)^T x',  xi^(j) = D^j xi,
+//!
+//! with Q the Gibbs chart of `crate::so3` and D the total derivative of the chart jet. A
+//! left-invariant L (one that reads only xi, ..., xi^(k-1)) is the same function of the chart
+//! jet for every centre.
+
+use crate::graph::{Graph, Id};
+use crate::signature::Signature;
+use crate::so3::{
+    body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates, substitute_body,
+};
+
+/// `roots` (L and its guarded expressions, in the arguments g, xi, ... of `sig`) rewritten
+/// in the chart jet: `Var::Jet { order: 0, index: e }` becomes g_e of the pose (R, p) and
+/// `Var::Jet { order: j, index: a }` (j >= 1) becomes xi^(j-1)_a. The centre parameter is
+/// number `sig.params.len()`.
+pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+    let param = sig.params.len() as u32;
+    let (rotation, position) = (param_entries(g, param, 0, 9), param_entries(g, param, 9, 3));
+    let (y, x) = (jet3(g, 0, 0), jet3(g, 0, 3));
+    let (dy, dx) = (jet3(g, 1, 0), jet3(g, 1, 3));
+    let q = chart_rotation(g, y);
+    let mut pose = mat_mul(g, &rotation, &q).to_vec();
+    // p = c + C x
+    for i in 0..3 {
+        let mut acc = position[i];
+        for l in 0..3 {
+            let term = g.mul(rotation[3 * i + l], x[l]);
+            acc = g.add_op(acc, term);
+        }
+        pose.push(acc);
+    }
+    // xi = (Omega, Q^T x')
+    let mut xi = body_angular_velocity(g, y, dy).to_vec();
+    for i in 0..3 {
+        let mut acc = g.constant(0.0);
+        for l in 0..3 {
+            let term = g.mul(q[3 * l + i], dx[l]);
+            acc = g.add_op(acc, term);
+        }
+        xi.push(acc);
+    }
+    let rates = rates(g, xi, 6, sig.order);
+    substitute_body(g, roots, pose, rates)
+}
