@@ -13,9 +13,8 @@ use retract::step::{check_step_domain, solve_step};
 use retract::{LiftedSystem, StepOptions, step, trajectory};
 
 use crate::Error;
-use crate::step_speed::{Row, best_of, format_ns};
 use crate::systems::{H, PAPER_STEPS, RigidBody, Z, closest_approach, paper_start};
-use crate::timing::{Timed, interleaved};
+use crate::timing::{Row, Timed, best_of, interleaved, write_rows};
 
 /// Pieces of the long step's chord.
 pub const PIECES: u32 = 16;
@@ -80,27 +79,19 @@ pub fn guard_costs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Ve
         StepOptions::default().with_domain_check(false),
     );
     let z0 = paper_start(system);
-    let names = [
-        STEP_UNCHECKED,
-        CHECK_DOMAIN,
-        CHECK_SHORT,
-        CHECK_LONG,
-        RUN_ON,
-        RUN_OFF,
-    ];
     let run = |options: &StepOptions| {
         black_box(trajectory(system, &z0, H, PAPER_STEPS, options).map(|t| t.states.len())).ok()
     };
-    let samples = interleaved(
+    Ok(interleaved(
         rounds,
         &mut [
-            Timed::new((calls / 10).max(1), &mut || {
+            Timed::new(STEP_UNCHECKED, (calls / 10).max(1), &mut || {
                 black_box(step(system, black_box(&case.z), H, &unchecked).map(|s| s.0[0])).ok();
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(CHECK_DOMAIN, calls, &mut || {
                 black_box(system.check_domain(black_box(&case.z), black_box(&case.w), 0.5)).ok();
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(CHECK_SHORT, calls, &mut || {
                 black_box(check_step_domain(
                     system,
                     black_box(&case.z),
@@ -109,7 +100,7 @@ pub fn guard_costs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Ve
                 ))
                 .ok();
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(CHECK_LONG, calls, &mut || {
                 black_box(check_step_domain(
                     system,
                     black_box(&case.z),
@@ -118,19 +109,14 @@ pub fn guard_costs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Ve
                 ))
                 .ok();
             }),
-            Timed::new(1, &mut || {
+            Timed::new(RUN_ON, 1, &mut || {
                 run(&checked);
             }),
-            Timed::new(1, &mut || {
+            Timed::new(RUN_OFF, 1, &mut || {
                 run(&unchecked);
             }),
         ],
-    );
-    Ok(names
-        .into_iter()
-        .zip(samples)
-        .map(|(name, samples)| Row { name, samples })
-        .collect())
+    ))
 }
 
 /// Writes the guard's table and its cost per chord piece, as markdown.
@@ -142,11 +128,7 @@ pub fn write_guard(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(
         out,
         "\nThe singularity guard at the closest approach (best of {rounds} interleaved rounds):\n"
     )?;
-    writeln!(out, "| guard | time |")?;
-    writeln!(out, "|---|---|")?;
-    for row in rows {
-        writeln!(out, "| {} | {} |", row.name, format_ns(row.samples.best()))?;
-    }
+    write_rows(out, "guard", rows)?;
     writeln!(
         out,
         "\nguard: check_domain {:.1}% of the step; a chord piece {:.0} ns; run guard on/off \

@@ -13,6 +13,9 @@
 mod error;
 pub mod guard_cost;
 pub mod long_run;
+/// The Lagrangians shared with `retract`'s integration tests (`tests/common/models.rs`).
+#[path = "../../tests/common/models.rs"]
+pub mod models;
 pub mod peers;
 pub mod report;
 pub mod step_speed;

@@ -33,14 +33,14 @@ pub struct Size {
 }
 
 impl Size {
-    /// The full report (about a minute on a 2-core machine).
+    /// The full report (about 10 s on a shared 2-core machine).
     pub fn full() -> Self {
         Self {
-            step_rounds: 100,
+            step_rounds: 300,
             step_calls: 2000,
-            run_rounds: 100,
+            run_rounds: 300,
             run_calls: 3,
-            sweep_rounds: 30,
+            sweep_rounds: 200,
             long_run_end: 1e5,
         }
     }
@@ -53,7 +53,7 @@ impl Size {
             step_calls: 200,
             run_rounds: 3,
             run_calls: 1,
-            sweep_rounds: 1,
+            sweep_rounds: 2,
             long_run_end: 1e3,
         }
     }

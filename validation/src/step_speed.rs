@@ -23,23 +23,7 @@ use crate::peers::{
     hand_reduced_step,
 };
 use crate::systems::{H, PAPER_STEPS, RigidBody, Z, paper_start};
-use crate::timing::{Samples, Timed, best_ns, interleaved};
-
-/// A timed variant: its name and its per-call times (ns).
-#[derive(Clone, Debug)]
-pub struct Row {
-    /// What was timed.
-    pub name: &'static str,
-    /// Its per-call times over the rounds.
-    pub samples: Samples,
-}
-
-/// The row named `name` (NaN samples if absent).
-pub fn best_of(rows: &[Row], name: &str) -> f64 {
-    rows.iter()
-        .find(|r| r.name == name)
-        .map_or(f64::NAN, |r| r.samples.best())
-}
+use crate::timing::{Row, Timed, best_ns, best_of, format_ns, interleaved, write_rows};
 
 /// Generated, reduced step (domain check on).
 pub const REDUCED: &str = "generated, reduced (2 unknowns)";
@@ -164,52 +148,37 @@ pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row>
     let (mut reduced, mut reduced_unchecked) =
         (ReducedStepper::new(system), ReducedStepper::new(system));
     let (slow, slowest) = ((calls / 20).max(1), (calls / 100).max(1));
-    let names = [
-        REDUCED,
-        REDUCED_UNCHECKED,
-        GENERAL,
-        HAND_DENSE,
-        HAND_REDUCED,
-        HAND_GUARDED,
-        DUAL,
-        FINITE_DIFFERENCES,
-    ];
-    let samples = interleaved(
+    interleaved(
         rounds,
         &mut [
-            Timed::new(calls, &mut || {
+            Timed::new(REDUCED, calls, &mut || {
                 black_box(reduced.step(black_box(z), H, &options).map(|s| s.0[0]).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(REDUCED_UNCHECKED, calls, &mut || {
                 let s = reduced_unchecked.step(black_box(z), H, &unchecked);
                 black_box(s.map(|s| s.0[0]).ok());
             }),
-            Timed::new(slow, &mut || {
+            Timed::new(GENERAL, slow, &mut || {
                 black_box(step(system, black_box(z), H, &options).map(|s| s.0[0]).ok());
             }),
-            Timed::new(slow, &mut || {
+            Timed::new(HAND_DENSE, slow, &mut || {
                 black_box(dense_step(black_box(z), DenseJacobian::Hand).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(HAND_REDUCED, calls, &mut || {
                 black_box(hand_reduced_step(black_box(z)).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(HAND_GUARDED, calls, &mut || {
                 black_box(hand_guarded_step(black_box(z)).ok());
             }),
-            Timed::new(slow, &mut || {
+            Timed::new(DUAL, slow, &mut || {
                 black_box(dense_step(black_box(z), DenseJacobian::Dual).ok());
             }),
-            Timed::new(slowest, &mut || {
+            Timed::new(FINITE_DIFFERENCES, slowest, &mut || {
                 let s = dense_step(black_box(z), DenseJacobian::FiniteDifferences);
                 black_box(s.ok());
             }),
         ],
-    );
-    names
-        .into_iter()
-        .zip(samples)
-        .map(|(name, samples)| Row { name, samples })
-        .collect()
+    )
 }
 
 /// The reduced stepper's 400-step run from a fresh stepper (domain check on).
@@ -248,38 +217,26 @@ pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec
     reduced_run(&unchecked)?;
     hand_run(hand_guarded_step)?;
     hand_run(hand_reduced_step)?;
-    let names = [
-        RUN_REDUCED,
-        RUN_HAND_GUARDED,
-        RUN_REDUCED_UNCHECKED,
-        RUN_HAND,
-        FACTORS,
-    ];
-    let samples = interleaved(
+    Ok(interleaved(
         rounds,
         &mut [
-            Timed::new(calls, &mut || {
+            Timed::new(RUN_REDUCED, calls, &mut || {
                 black_box(reduced_run(&options).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(RUN_HAND_GUARDED, calls, &mut || {
                 black_box(hand_run(hand_guarded_step).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(RUN_REDUCED_UNCHECKED, calls, &mut || {
                 black_box(reduced_run(&unchecked).ok());
             }),
-            Timed::new(calls, &mut || {
+            Timed::new(RUN_HAND, calls, &mut || {
                 black_box(hand_run(hand_reduced_step).ok());
             }),
-            Timed::new(calls * 10, &mut || {
+            Timed::new(FACTORS, calls * 10, &mut || {
                 black_box(ReducedFactors::new(system, black_box(H), 0.5).ok());
             }),
         ],
-    );
-    Ok(names
-        .into_iter()
-        .zip(samples)
-        .map(|(name, samples)| Row { name, samples })
-        .collect())
+    ))
 }
 
 /// Writes the step table (time, ratio to the generated reduced step) and the like-for-like
@@ -335,11 +292,7 @@ pub fn write_runs(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<()
         "\nThe paper's 400-step run (tau = 1e-2, from a fresh stepper; best of {rounds} \
          interleaved rounds):\n"
     )?;
-    writeln!(out, "| 400-step run | time |")?;
-    writeln!(out, "|---|---|")?;
-    for row in rows {
-        writeln!(out, "| {} | {} |", row.name, format_ns(row.samples.best()))?;
-    }
+    write_rows(out, "400-step run", rows)?;
     writeln!(
         out,
         "\nrun ratios: generated/hand-written {:.2}x (check on), {:.2}x (check off)",
@@ -347,17 +300,4 @@ pub fn write_runs(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<()
         best_of(rows, RUN_REDUCED_UNCHECKED) / best_of(rows, RUN_HAND),
     )?;
     Ok(())
-}
-
-/// A time in ns as "77 ns", "3.6 µs" or "1.43 ms".
-pub fn format_ns(ns: f64) -> String {
-    if ns < 1e3 {
-        format!("{ns:.0} ns")
-    } else if ns < 1e5 {
-        format!("{:.1} µs", ns / 1e3)
-    } else if ns < 1e6 {
-        format!("{:.0} µs", ns / 1e3)
-    } else {
-        format!("{:.2} ms", ns / 1e6)
-    }
 }

@@ -1,29 +1,12 @@
 //! The systems the measurements run on: the paper's SE(2) obstacle system and the bounded
-//! Pais-Uhlenbeck oscillator, with the paper's initial state and its closest approach.
+//! Pais-Uhlenbeck oscillator (both from [`crate::models`], the integration tests' models),
+//! with the paper's initial state and its closest approach.
 
-use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{LiftedSystem, StepOptions, trajectory};
 
 use crate::Error;
-
-/// The paper's SE(2) obstacle system: a rigid body $(x, y, \theta)$ with
-/// $L = \tfrac12 |q''|^2 + \tau / (x^2 + y^2 - r^2)$.
-#[higher_order_lagrangian(order = 2)]
-pub fn rigid_body(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, r: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2))
-        + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
-}
-
-/// The bounded Pais-Uhlenbeck oscillator in the plane (MATH.md), with a quartic term `eps`.
-#[higher_order_lagrangian(order = 2)]
-pub fn pais_uhlenbeck(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], w1: f64, w2: f64, eps: f64) -> f64 {
-    let r2 = q[0].powi(2) + q[1].powi(2);
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2))
-        - 0.5 * (w1 * w1 + w2 * w2) * (dq[0].powi(2) + dq[1].powi(2))
-        + 0.5 * w1 * w1 * w2 * w2 * r2
-        + eps * r2 * r2
-}
+pub use crate::models::{PaisUhlenbeck, RigidBody, bounded_pais_uhlenbeck};
 
 /// The barrier weight of the paper's run.
 pub const TAU: f64 = 1e-2;

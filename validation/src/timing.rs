@@ -2,6 +2,7 @@
 //! order that alternates from round to round), so that a change of the machine's speed during
 //! a measurement hits all alike; the figure of each is the best or the median over the rounds.
 
+use std::io::Write;
 use std::time::Instant;
 
 /// The per-call times (ns) of one closure over the rounds of [`interleaved`].
@@ -26,8 +27,10 @@ impl Samples {
     }
 }
 
-/// A closure to time and how many calls make one sample of it.
+/// A named closure to time and how many calls make one sample of it.
 pub struct Timed<'a> {
+    /// What it does, for the tables.
+    pub name: &'static str,
     /// Calls per sample (the time per call is the sample's time over this).
     pub calls: usize,
     /// The work.
@@ -35,16 +38,32 @@ pub struct Timed<'a> {
 }
 
 impl<'a> Timed<'a> {
-    /// `calls` calls of `run` per sample.
-    pub fn new(calls: usize, run: &'a mut dyn FnMut()) -> Self {
-        Self { calls, run }
+    /// `calls` calls of `run` per sample, named `name`.
+    pub fn new(name: &'static str, calls: usize, run: &'a mut dyn FnMut()) -> Self {
+        Self { name, calls, run }
     }
+}
+
+/// A timed closure's name and its per-call times (ns).
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// What was timed.
+    pub name: &'static str,
+    /// Its per-call times over the rounds.
+    pub samples: Samples,
+}
+
+/// The best time (ns) of the row named `name` (NaN if absent).
+pub fn best_of(rows: &[Row], name: &str) -> f64 {
+    rows.iter()
+        .find(|r| r.name == name)
+        .map_or(f64::NAN, |r| r.samples.best())
 }
 
 /// Time per call (ns) of each closure over `rounds` rounds; in each round every closure runs
 /// `calls` times in a row, the closures in turn, forwards in even rounds and backwards in odd
 /// ones.
-pub fn interleaved(rounds: usize, closures: &mut [Timed<'_>]) -> Vec<Samples> {
+pub fn interleaved(rounds: usize, closures: &mut [Timed<'_>]) -> Vec<Row> {
     let mut samples = vec![Samples::default(); closures.len()];
     let count = closures.len();
     for round in 0..rounds {
@@ -65,10 +84,45 @@ pub fn interleaved(rounds: usize, closures: &mut [Timed<'_>]) -> Vec<Samples> {
                 .push(start.elapsed().as_nanos() as f64 / calls as f64);
         }
     }
-    samples
+    closures
+        .iter()
+        .zip(samples)
+        .map(|(timed, samples)| Row {
+            name: timed.name,
+            samples,
+        })
+        .collect()
+}
+
+/// Writes `rows` as a markdown table headed `| <what> | time |`, best times.
+///
+/// # Errors
+/// The writer's.
+pub fn write_rows(out: &mut dyn Write, what: &str, rows: &[Row]) -> std::io::Result<()> {
+    writeln!(out, "| {what} | time |")?;
+    writeln!(out, "|---|---|")?;
+    for row in rows {
+        writeln!(out, "| {} | {} |", row.name, format_ns(row.samples.best()))?;
+    }
+    Ok(())
+}
+
+/// A time in ns as "77 ns", "3.6 µs", "655 µs" or "1.43 ms".
+pub fn format_ns(ns: f64) -> String {
+    if ns < 1e3 {
+        format!("{ns:.0} ns")
+    } else if ns < 1e5 {
+        format!("{:.1} µs", ns / 1e3)
+    } else if ns < 1e6 {
+        format!("{:.0} µs", ns / 1e3)
+    } else {
+        format!("{:.2} ms", ns / 1e6)
+    }
 }
 
 /// Best time per call (ns) over `batches` batches of `calls` calls of `f`.
 pub fn best_ns(batches: usize, calls: usize, mut f: impl FnMut()) -> f64 {
-    interleaved(batches, &mut [Timed::new(calls, &mut f)])[0].best()
+    interleaved(batches, &mut [Timed::new("", calls, &mut f)])[0]
+        .samples
+        .best()
 }

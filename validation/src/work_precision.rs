@@ -29,14 +29,14 @@ use crate::systems::{RigidBody, TAU, Z, paper_jet, paper_system};
 use crate::timing::{Timed, interleaved};
 
 /// How a sweep integrates.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Method {
     /// The midpoint rule (order 2) or its composition of `order` on the reduced stepper.
     Composed(u32),
     /// Strang's splitting composed to `order`, each stage a full `split_step` call.
     SplitPerStage(u32),
     /// A splitting method on the `SplitStepper`, the guard on or off.
-    Split(SplittingMethod, bool),
+    Split(Box<SplittingMethod>, bool),
     /// RK4 on the plain first-order system.
     Rk4,
     /// DOP853 on the plain first-order system; the points are tolerances.
@@ -44,6 +44,11 @@ pub enum Method {
 }
 
 impl Method {
+    /// [`Method::Split`] with `method`, the guard on or off.
+    pub fn split(method: SplittingMethod, guard: bool) -> Self {
+        Method::Split(Box::new(method), guard)
+    }
+
     /// Whether this is a `retract` method with the singularity guard on (the best of these is
     /// compared with DOP853).
     pub fn guarded(&self) -> bool {
@@ -106,43 +111,43 @@ pub fn series() -> Result<Vec<Series>, Error> {
         ),
         s(
             "splitting",
-            Method::Split(composition(2)?, true),
+            Method::split(composition(2)?, true),
             &[200, 400, 800, 1600, 3200, 6400, 12800],
         ),
         s(
             "splitting, order 4",
-            Method::Split(composition(4)?, true),
+            Method::split(composition(4)?, true),
             &[40, 80, 160, 320, 640, 1280],
         ),
         s(
             "splitting, order 6",
-            Method::Split(composition(6)?, true),
+            Method::split(composition(6)?, true),
             &[20, 40, 80, 160, 320],
         ),
         s(
             "splitting, order 8",
-            Method::Split(composition(8)?, true),
+            Method::split(composition(8)?, true),
             &[10, 20, 40, 80, 160],
         ),
         s(
             "splitting, BM SRKN6b",
-            Method::Split(SplittingMethod::blanes_moan_4(), true),
+            Method::split(SplittingMethod::blanes_moan_4(), true),
             &[20, 40, 80, 160, 320, 640],
         ),
         s(
             "splitting, BM SRKN11b",
-            Method::Split(SplittingMethod::blanes_moan_6(), true),
+            Method::split(SplittingMethod::blanes_moan_6(), true),
             &[10, 20, 40, 80, 160],
         ),
         s(
             "splitting, BM SRKN14a",
-            Method::Split(SplittingMethod::blanes_moan_6a(), true),
+            Method::split(SplittingMethod::blanes_moan_6a(), true),
             &[10, 20, 40, 80, 160],
         ),
         // the peers check nothing: the best splitting without the singularity guard, for scale
         s(
             "BM SRKN14a, guard off",
-            Method::Split(SplittingMethod::blanes_moan_6a(), false),
+            Method::split(SplittingMethod::blanes_moan_6a(), false),
             &[10, 20, 40, 80],
         ),
         s("RK4", Method::Rk4, &[100, 200, 400, 800, 1600, 3200]),
@@ -191,19 +196,19 @@ impl Ivp {
         let steps = point as usize;
         let h = t_end / steps as f64;
         let options = StepOptions::default();
-        Ok(match *method {
-            Method::Composed(order) => {
+        Ok(match method {
+            &Method::Composed(order) => {
                 let mut stepper = ReducedStepper::new(system);
                 repeat(&self.z0, steps, |z| {
                     Ok(compose(|z, h| stepper.step(z, h, &options), z, h, order)?.0)
                 })?
             }
-            Method::SplitPerStage(order) => repeat(&self.z0, steps, |z| {
+            &Method::SplitPerStage(order) => repeat(&self.z0, steps, |z| {
                 Ok(compose(|z, h| split_step(system, z, h, &options), z, h, order)?.0)
             })?,
             Method::Split(method, guard) => {
-                let options = options.with_domain_check(guard);
-                let mut stepper = SplitStepper::<_, 3, 2, 12>::new(system, method)?;
+                let options = options.with_domain_check(*guard);
+                let mut stepper = SplitStepper::<_, 3, 2, 12>::new(system, **method)?;
                 repeat(&self.z0, steps, |z| Ok(stepper.step(z, h, &options)?.0))?
             }
             Method::Rk4 => system.legendre(&self.plain.rk4(&self.jet, t_end, steps)),
@@ -258,13 +263,11 @@ impl Sweep {
 }
 
 /// The final error against `reference` of every point of every series, then their times in
-/// `rounds` interleaved rounds (every point once a round), best of the rounds.
-///
-/// # Errors
-/// None yet: a run that fails is kept as a stopped point.
+/// `rounds` interleaved rounds (every point once a round), best of the rounds. A run that
+/// fails is kept as a stopped point, with its error.
 pub fn sweeps(ivp: &Ivp, all: &[Series], reference: &Z, rounds: usize) -> Vec<Sweep> {
     let mut out: Vec<Sweep> = Vec::new();
-    let mut jobs: Vec<(usize, usize, Method, f64)> = Vec::new();
+    let mut jobs: Vec<(usize, usize, f64)> = Vec::new();
     for (s, series) in all.iter().enumerate() {
         let mut points = Vec::new();
         for &point in &series.points {
@@ -274,7 +277,7 @@ pub fn sweeps(ivp: &Ivp, all: &[Series], reference: &Z, rounds: usize) -> Vec<Sw
             };
             let outcome = match ivp.run(&series.method, point) {
                 Ok(end) => {
-                    jobs.push((s, points.len(), series.method, point));
+                    jobs.push((s, points.len(), point));
                     Ok(((end - reference).amax(), f64::NAN))
                 }
                 Err(e) => Err(e.to_string()),
@@ -289,17 +292,22 @@ pub fn sweeps(ivp: &Ivp, all: &[Series], reference: &Z, rounds: usize) -> Vec<Sw
     }
     let mut runs: Vec<Box<dyn FnMut() + '_>> = jobs
         .iter()
-        .map(|&(_, _, method, point)| {
+        .map(|&(s, _, point)| {
+            let method = &all[s].method;
             Box::new(move || {
-                black_box(ivp.run(&method, point).ok());
+                black_box(ivp.run(method, point).ok());
             }) as Box<dyn FnMut()>
         })
         .collect();
-    let mut timed: Vec<Timed<'_>> = runs.iter_mut().map(|f| Timed::new(1, &mut **f)).collect();
-    let samples = interleaved(rounds.max(1), &mut timed);
-    for (&(s, p, _, _), samples) in jobs.iter().zip(samples) {
+    let mut timed: Vec<Timed<'_>> = runs
+        .iter_mut()
+        .zip(&jobs)
+        .map(|(f, &(s, _, _))| Timed::new(all[s].label, 1, &mut **f))
+        .collect();
+    let rows = interleaved(rounds.max(1), &mut timed);
+    for (&(s, p, _), row) in jobs.iter().zip(rows) {
         if let Ok((_, time)) = &mut out[s].points[p].outcome {
-            *time = samples.best() * 1e-9;
+            *time = row.samples.best() * 1e-9;
         }
     }
     out
