@@ -46,6 +46,28 @@ pub fn free_flow<const N: usize, const K: usize, const S: usize>(
     t: f64,
     weight: f64,
 ) -> SVector<f64, S> {
+    let mut w = jet_of_state::<N, K, S>(z, weight);
+    flow_jet::<N, K, S>(&mut w, &taylor_powers::<K>(t));
+    state_of_jet::<N, K, S>(&w, weight)
+}
+
+/// The coefficients $t^m / m!$ for $m < 2k$ of the free flow $e^{tA}$ (the rest zero).
+pub(crate) fn taylor_powers<const K: usize>(t: f64) -> [f64; 2 * MAX_K] {
+    const { assert!(K <= MAX_K, "K at most 4") };
+    let mut c = [0.0; 2 * MAX_K];
+    c[0] = 1.0;
+    for m in 1..2 * K {
+        c[m] = c[m - 1] * t / m as f64;
+    }
+    c
+}
+
+/// $z \mapsto w$: the jet variables of the free motion (see [`free_flow`]), $w_j = x_j$ for
+/// $j < k$ and $w_{k+i} = (-1)^i p_{k-1-i}/c$.
+pub(crate) fn jet_of_state<const N: usize, const K: usize, const S: usize>(
+    z: &SVector<f64, S>,
+    weight: f64,
+) -> SVector<f64, S> {
     const {
         assert!(
             S == 2 * N * K && K <= MAX_K,
@@ -53,11 +75,10 @@ pub fn free_flow<const N: usize, const K: usize, const S: usize>(
         )
     };
     let inverse = 1.0 / weight;
-    // w_m: x_m for m < k; w_{k+i} = (-1)^i p_{k-1-i} / c, block 2k - 1 - i of z
-    let mut w = [SVector::<f64, N>::zeros(); 2 * MAX_K];
-    for (m, wm) in w.iter_mut().enumerate().take(2 * K) {
-        *wm = if m < K {
-            z.fixed_rows::<N>(m * N).into_owned()
+    SVector::from_fn(|r, _| {
+        let (m, a) = (r / N, r % N);
+        if m < K {
+            z[r]
         } else {
             let i = m - K;
             let sign = if i.is_multiple_of(2) {
@@ -65,30 +86,44 @@ pub fn free_flow<const N: usize, const K: usize, const S: usize>(
             } else {
                 -inverse
             };
-            z.fixed_rows::<N>((2 * K - 1 - i) * N) * sign
-        };
-    }
-    // t^i / i!
-    let mut c = [1.0; 2 * MAX_K];
-    for i in 1..2 * K {
-        c[i] = c[i - 1] * t / i as f64;
-    }
-    let mut out = SVector::<f64, S>::zeros();
-    for m in 0..2 * K {
-        let mut sum = w[m];
-        for i in 1..2 * K - m {
-            sum += w[m + i] * c[i];
+            z[(2 * K - 1 - i) * N + a] * sign
         }
+    })
+}
+
+/// $w \mapsto z$, the inverse of [`jet_of_state`].
+pub(crate) fn state_of_jet<const N: usize, const K: usize, const S: usize>(
+    w: &SVector<f64, S>,
+    weight: f64,
+) -> SVector<f64, S> {
+    SVector::from_fn(|r, _| {
+        let (m, a) = (r / N, r % N);
         if m < K {
-            out.fixed_rows_mut::<N>(m * N).copy_from(&sum);
+            w[r]
         } else {
-            let i = m - K;
+            // z block m = K + j holds p_j = (-1)^i c w_{K+i} with i = K - 1 - j
+            let i = 2 * K - 1 - m;
             let sign = if i.is_multiple_of(2) { weight } else { -weight };
-            out.fixed_rows_mut::<N>((2 * K - 1 - i) * N)
-                .copy_from(&(sum * sign));
+            w[(K + i) * N + a] * sign
+        }
+    })
+}
+
+/// $w \mapsto e^{tA} w$ in place, with `c[m]` $= t^m / m!$ ([`taylor_powers`]):
+/// $w_m \mathrel{+}= \sum_{i \ge 1} c_i w_{m+i}$ in increasing $m$ (each $w_m$ reads only
+/// blocks not yet updated).
+#[inline(always)]
+pub(crate) fn flow_jet<const N: usize, const K: usize, const S: usize>(
+    w: &mut SVector<f64, S>,
+    c: &[f64; 2 * MAX_K],
+) {
+    for m in 0..2 * K {
+        for i in 1..2 * K - m {
+            for a in 0..N {
+                w[m * N + a] += c[i] * w[(m + i) * N + a];
+            }
         }
     }
-    out
 }
 
 /// $e^{tA}$ as a matrix (the free flow's derivative).

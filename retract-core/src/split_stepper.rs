@@ -19,7 +19,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::split::{MAX_K, Separable, free_flow, free_flow_matrix, jet_of, weight_of};
+use crate::split::{
+    MAX_K, Separable, flow_jet, free_flow, free_flow_matrix, jet_of, jet_of_state, state_of_jet,
+    taylor_powers, weight_of,
+};
 use crate::split_methods::{MAX_KICKS, SplittingMethod};
 use crate::step::{StepOptions, StepReport, check_step_domain};
 use crate::{Error, LiftedSystem};
@@ -119,7 +122,7 @@ where
             });
         }
         let w = self.advance(z0);
-        let z1 = self.state_of(&w);
+        let z1 = state_of_jet::<N, K, S>(&w, self.weight);
         if !z1.iter().all(|v| v.is_finite()) {
             self.last_kick = None;
             return Err(Error::NonFinite {
@@ -139,11 +142,7 @@ where
     fn prepare(&mut self, h: f64) {
         let s = self.method.kicks().len();
         for (row, &a) in self.powers.iter_mut().zip(self.method.flows()) {
-            let t = a * h;
-            row[0] = 1.0;
-            for m in 1..2 * K {
-                row[m] = row[m - 1] * t / m as f64;
-            }
+            *row = taylor_powers::<K>(a * h);
         }
         let sign = if !K.is_multiple_of(2) { 1.0 } else { -1.0 };
         for (scale, &b) in self.kick_scale.iter_mut().zip(self.method.kicks()) {
@@ -155,14 +154,14 @@ where
 
     /// The method's map in the jet variables, from `z0`.
     fn advance(&mut self, z0: &SVector<f64, S>) -> SVector<f64, S> {
-        let mut w = self.jet_of_state(z0);
+        let mut w = jet_of_state::<N, K, S>(z0, self.weight);
         let flows = self.method.flows();
         let s = flows.len() - 1;
         let reuse = self.method.starts_with_kick();
         let top = (2 * K - 1) * N;
         for (i, &a) in flows[..s].iter().enumerate() {
             if a != 0.0 {
-                flow::<N, K, S>(&mut w, &self.powers[i]);
+                flow_jet::<N, K, S>(&mut w, &self.powers[i]);
             }
             let q = w.fixed_rows::<N>(0).into_owned();
             let g = match self.last_kick {
@@ -178,7 +177,7 @@ where
             }
         }
         if flows[s] != 0.0 {
-            flow::<N, K, S>(&mut w, &self.powers[s]);
+            flow_jet::<N, K, S>(&mut w, &self.powers[s]);
         }
         w
     }
@@ -188,41 +187,6 @@ where
         let x = core::array::from_fn(|j| w.fixed_rows::<N>(j * N).into_owned());
         let u = w.fixed_rows::<N>(K * N).into_owned();
         self.system.gradient(&x, &u).x[0]
-    }
-
-    /// $z \mapsto w$ (module docs).
-    fn jet_of_state(&self, z: &SVector<f64, S>) -> SVector<f64, S> {
-        let inverse = 1.0 / self.weight;
-        SVector::from_fn(|r, _| {
-            let (m, a) = (r / N, r % N);
-            if m < K {
-                z[r]
-            } else {
-                let i = m - K;
-                let sign = if i.is_multiple_of(2) {
-                    inverse
-                } else {
-                    -inverse
-                };
-                z[(2 * K - 1 - i) * N + a] * sign
-            }
-        })
-    }
-
-    /// $w \mapsto z$, the inverse of [`Self::jet_of_state`].
-    fn state_of(&self, w: &SVector<f64, S>) -> SVector<f64, S> {
-        let c = self.weight;
-        SVector::from_fn(|r, _| {
-            let (m, a) = (r / N, r % N);
-            if m < K {
-                w[r]
-            } else {
-                // z block m = K + j holds p_j = (-1)^i c w_{K+i} with i = K - 1 - j
-                let i = 2 * K - 1 - m;
-                let sign = if i.is_multiple_of(2) { c } else { -c };
-                w[(K + i) * N + a] * sign
-            }
-        })
     }
 
     /// The derivative $\partial z_1 / \partial z_0$ of [`Self::step`]: the product of the
@@ -262,22 +226,6 @@ where
                 iteration: 0,
                 location: "derivative of the splitting step",
             })
-        }
-    }
-}
-
-/// $w \mapsto e^{tA} w$ in place, with `c[m]` $= t^m / m!$: $w_m \mathrel{+}= \sum_{i \ge 1}
-/// c_i w_{m+i}$ in increasing $m$ (each $w_m$ reads only blocks not yet updated).
-#[inline(always)]
-fn flow<const N: usize, const K: usize, const S: usize>(
-    w: &mut SVector<f64, S>,
-    c: &[f64; 2 * MAX_K],
-) {
-    for m in 0..2 * K {
-        for i in 1..2 * K - m {
-            for a in 0..N {
-                w[m * N + a] += c[i] * w[(m + i) * N + a];
-            }
         }
     }
 }

@@ -19,17 +19,8 @@ use retract::bvp::{
     BoundaryValueProblem, BvpOptions, Guess, LinearSolver, OptimalControlProblem, PlanGuess,
     PlanOptions,
 };
-use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
-
-#[higher_order_lagrangian(order = 2)]
-fn scene(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], tau: f64, obstacles: &[[f64; 3]]) -> f64 {
-    let mut l = 0.5 * (ddq[0].powi(2) + ddq[1].powi(2) + ddq[2].powi(2));
-    for o in obstacles {
-        l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);
-    }
-    l
-}
+use retract_validation::models::{DISC_GOAL, DISC_START, OneDisc, Scene};
 
 const OBSTACLES: [[f64; 3]; 1] = [[0.0, -0.6, 1.0]];
 const START: [f64; 6] = [-2.0, 0.5, 0.0, 0.0, 0.0, 0.0];
@@ -95,14 +86,6 @@ fn print_table(system: &Scene<'_>) {
     );
 }
 
-/// The one-disc scene of `../shared/BENCHMARKS.md`.
-#[higher_order_lagrangian(order = 2)]
-fn one_disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64) -> f64 {
-    0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - 1.0)
-}
-
-const DISC_START: [f64; 4] = [-2.0, 0.2, 1.0, 0.0];
-const DISC_GOAL: [f64; 4] = [2.0, 0.2, 1.0, 0.0];
 const DISC_T: f64 = 4.0;
 const DISC_STEPS: usize = 400;
 

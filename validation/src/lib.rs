@@ -1,5 +1,26 @@
-//! Benchmarks (`benches/`), the work-precision comparison with ODE peers
-//! (`examples/work_precision.rs`) and the heavier test suites of `retract` (the property
-//! tests of the generated derivatives and the compile-fail tests of the macros, `tests/`).
-//! This crate has no API: it exists so that `cargo run --example ...` in `retract` does not
-//! build criterion, proptest, trybuild, num-dual or ode_solvers.
+//! Benchmarks (`benches/`), the speed report and the work-precision comparison with ODE
+//! peers (`examples/report.rs`, `examples/work_precision.rs`) and the heavier test suites of
+//! `retract` (the property tests of the generated derivatives and the compile-fail tests of
+//! the macros, `tests/`). It is kept apart so that `cargo run --example ...` in `retract`
+//! does not build criterion, proptest, trybuild, num-dual or ode_solvers.
+//!
+//! The library holds what the benches and the examples share, one implementation each: the
+//! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
+//! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
+//! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
+//! [`work_precision`], [`long_run`]), which [`report`] runs and prints in one go.
+
+mod error;
+pub mod guard_cost;
+pub mod long_run;
+/// The Lagrangians shared with `retract`'s integration tests (`tests/common/models.rs`).
+#[path = "../../tests/common/models.rs"]
+pub mod models;
+pub mod peers;
+pub mod report;
+pub mod step_speed;
+pub mod systems;
+pub mod timing;
+pub mod work_precision;
+
+pub use error::Error;

@@ -1,0 +1,175 @@
+//! The speed report: every figure of the README's "Speed against error" section from one run,
+//! the peers timed interleaved with `retract` (`examples/report.rs`).
+//!
+//! It writes, as markdown ready to paste: a header with the date (UTC) and the machine; the
+//! one-step table ([`crate::step_speed`]); the paper's 400-step run; the singularity guard
+//! ([`crate::guard_cost`]); the work-precision sweeps on the obstacle IVP with the times at
+//! a final error of 1e-8 and the line
+//! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <best/DOP853>`
+//! ([`crate::work_precision`]); and the long run ([`crate::long_run`]).
+
+use std::io::Write;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+use crate::Error;
+use crate::systems::{closest_approach, paper_system};
+use crate::{guard_cost, long_run, step_speed, work_precision};
+
+/// How much the report measures: rounds and calls per sample of each part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Size {
+    /// Interleaved rounds of the one-step table.
+    pub step_rounds: usize,
+    /// Calls per sample of the cheapest steps (the dense ones make a twentieth of that).
+    pub step_calls: usize,
+    /// Interleaved rounds of the 400-step runs and of the guard.
+    pub run_rounds: usize,
+    /// Runs per sample of the 400-step runs.
+    pub run_calls: usize,
+    /// Interleaved rounds of the work-precision sweeps.
+    pub sweep_rounds: usize,
+    /// The horizon of the long run.
+    pub long_run_end: f64,
+}
+
+impl Size {
+    /// The full report (about 10 s on a shared 2-core machine).
+    pub fn full() -> Self {
+        Self {
+            step_rounds: 300,
+            step_calls: 2000,
+            run_rounds: 300,
+            run_calls: 3,
+            sweep_rounds: 200,
+            long_run_end: 1e5,
+        }
+    }
+
+    /// The same lines at reduced size (a few seconds): for tests and CI; its figures are
+    /// noisy.
+    pub fn quick() -> Self {
+        Self {
+            step_rounds: 3,
+            step_calls: 200,
+            run_rounds: 3,
+            run_calls: 1,
+            sweep_rounds: 2,
+            long_run_end: 1e3,
+        }
+    }
+}
+
+/// The figures of a report the caller may want besides its text.
+#[derive(Clone, Debug)]
+pub struct Summary {
+    /// The times at a final error of 1e-8.
+    pub at_target: work_precision::AtTarget,
+    /// Wall time of the report in seconds.
+    pub seconds: f64,
+}
+
+/// Writes the whole report to `out` (module docs).
+///
+/// # Errors
+/// A measurement that fails ([`Error`]) or [`Error::Io`].
+pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
+    let started = Instant::now();
+    writeln!(out, "{}", header(size))?;
+    writeln!(
+        out,
+        "\nFigures are the best of several interleaved rounds (every variant once a round, the \
+         order reversed every other round); ratios come from the same rounds.\n"
+    )?;
+    let system = paper_system();
+    let z = closest_approach(&system)?;
+    step_speed::check_variants(&system, &z)?;
+    let steps = step_speed::steps(&system, &z, size.step_rounds, size.step_calls);
+    step_speed::write_steps(out, &steps, size.step_rounds)?;
+    let runs = step_speed::paper_runs(&system, size.run_rounds, size.run_calls)?;
+    step_speed::write_runs(out, &runs, size.run_rounds)?;
+    let guard = guard_cost::guard_costs(&system, size.run_rounds, size.step_calls)?;
+    guard_cost::write_guard(out, &guard, size.run_rounds)?;
+    let at_target = work_precision_part(size, out)?;
+    let long = long_run::long_runs(size.long_run_end)?;
+    long_run::write_long_runs(out, &long, size.long_run_end)?;
+    let seconds = started.elapsed().as_secs_f64();
+    writeln!(out, "\nreport: {seconds:.1} s")?;
+    Ok(Summary { at_target, seconds })
+}
+
+/// The work-precision part of [`run`]: the reference, the sweeps, the times at 1e-8.
+///
+/// # Errors
+/// A failed reference run or [`Error::Io`].
+fn work_precision_part(
+    size: &Size,
+    out: &mut dyn Write,
+) -> Result<work_precision::AtTarget, Error> {
+    let ivp = work_precision::Ivp::paper();
+    let (reference, distance) = work_precision::reference(&ivp)?;
+    writeln!(
+        out,
+        "\nObstacle IVP to T = 4; reference: order-8 composition, 4000 steps (its distance to \
+         DOP853 at tol 1e-14: {distance:.1e}); wall time best of {} interleaved rounds:\n",
+        size.sweep_rounds
+    )?;
+    let sweeps = work_precision::sweeps(
+        &ivp,
+        &work_precision::series()?,
+        &reference,
+        size.sweep_rounds,
+    );
+    work_precision::write_sweeps(out, &sweeps)?;
+    let at = work_precision::at_target(&sweeps, 1e-8);
+    work_precision::write_at_target(out, &at, size.sweep_rounds)?;
+    Ok(at)
+}
+
+/// `# retract speed report, <YYYY-MM-DD> UTC, <machine>` with the size (full or quick).
+pub fn header(size: &Size) -> String {
+    let kind = if *size == Size::full() {
+        "full"
+    } else {
+        "quick"
+    };
+    format!(
+        "# retract speed report, {} UTC, {} ({kind})",
+        utc_date(SystemTime::now()),
+        machine()
+    )
+}
+
+/// The UTC date of `time` as YYYY-MM-DD ("unknown date" before 1970).
+pub fn utc_date(time: SystemTime) -> String {
+    let Ok(since) = time.duration_since(UNIX_EPOCH) else {
+        return "unknown date".into();
+    };
+    let days = (since.as_secs() / 86_400) as i64;
+    // Howard Hinnant's civil_from_days
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}")
+}
+
+/// The CPU model (from /proc/cpuinfo, else "unknown CPU") and the number of threads the
+/// process may use.
+pub fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, model)| model.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let threads = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!("{model}, {threads} threads")
+}

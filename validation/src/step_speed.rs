@@ -1,0 +1,303 @@
+//! One step of the paper's SE(2) obstacle system (tau = 1e-2, h = 0.01, midpoint) near its
+//! closest approach to the disc, generated and hand-written, and the paper's 400-step run:
+//! the measurements of `benches/step.rs` and of the report.
+//!
+//! The variants of one step, timed in interleaved rounds ([`crate::timing`]):
+//! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`), with and without
+//!   the domain check;
+//! - generated, general (Newton on all 15 unknowns, `retract::step`);
+//! - the hand-written peers of [`crate::peers`]: dense 12x12 Newton (Jacobian by hand, by
+//!   dual numbers, by finite differences) and the reduced 3x3 Newton on $q_\theta$ (the
+//!   limit), without and with the generated step's domain check.
+
+use std::hint::black_box;
+use std::io::Write;
+
+use retract::nalgebra::SVector;
+use retract::newton::Problem;
+use retract::{LiftedSystem, ReducedFactors, ReducedScheme, ReducedStepper, StepOptions, step};
+
+use crate::Error;
+use crate::peers::{
+    Core, Dense, DenseJacobian, dense_jacobian, dense_residual, dense_step, hand_guarded_step,
+    hand_reduced_step,
+};
+use crate::systems::{H, PAPER_STEPS, RigidBody, Z, paper_start};
+use crate::timing::{Row, Timed, best_ns, best_of, format_ns, interleaved, write_rows};
+
+/// Generated, reduced step (domain check on).
+pub const REDUCED: &str = "generated, reduced (2 unknowns)";
+/// Generated, reduced step, domain check off.
+pub const REDUCED_UNCHECKED: &str = "generated, reduced, domain check off";
+/// Generated, general step.
+pub const GENERAL: &str = "generated, general (15 unknowns)";
+/// Hand-written dense Newton.
+pub const HAND_DENSE: &str = "hand-written dense 12x12 Newton";
+/// Hand-written reduced Newton.
+pub const HAND_REDUCED: &str = "hand-written reduced 3x3 Newton (the limit)";
+/// Hand-written reduced Newton with the domain check.
+pub const HAND_GUARDED: &str = "hand-written reduced 3x3 Newton, domain check";
+/// Dense Newton, dual-number Jacobian.
+pub const DUAL: &str = "dense 12x12, dual-number Jacobian (num-dual)";
+/// Dense Newton, finite-difference Jacobian.
+pub const FINITE_DIFFERENCES: &str = "dense 12x12, finite-difference Jacobian";
+
+/// Checks that every variant computes the general step's state from `z` (to 1e-12).
+///
+/// # Errors
+/// [`Error::Disagree`] for a variant that does not; the step's own errors.
+pub fn check_variants(system: &RigidBody, z: &Z) -> Result<(), Error> {
+    let options = StepOptions::default();
+    let reference = step(system, z, H, &options)?.0;
+    let mut reduced = ReducedStepper::new(system);
+    let variants: [(&'static str, Z); 6] = [
+        (REDUCED, reduced.step(z, H, &options)?.0),
+        (HAND_DENSE, dense_step(z, DenseJacobian::Hand)?),
+        (HAND_REDUCED, hand_reduced_step(z)?),
+        (HAND_GUARDED, hand_guarded_step(z)?),
+        (DUAL, dense_step(z, DenseJacobian::Dual)?),
+        (
+            FINITE_DIFFERENCES,
+            dense_step(z, DenseJacobian::FiniteDifferences)?,
+        ),
+    ];
+    for (variant, other) in variants {
+        let difference = (reference - other).amax();
+        if difference >= 1e-12 {
+            return Err(Error::Disagree {
+                variant,
+                difference,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The Newton system (residual and Jacobian) of one step, per variant: best time (ns) over
+/// `batches` batches.
+///
+/// # Errors
+/// The predictor's or the factors' errors.
+pub fn newton_systems(
+    system: &RigidBody,
+    z: &Z,
+    batches: usize,
+) -> Result<Vec<(&'static str, f64)>, Error> {
+    let w = system.predictor(z, H, 0.5)?;
+    let factors = ReducedFactors::new(system, H, 0.5)?;
+    let offset = system.core_offset(&factors, z);
+    let y = SVector::<f64, 2>::new(z[0], z[1]);
+    let w12 = w.fixed_rows::<12>(0).into_owned();
+    let core = Core {
+        c0: retract::nalgebra::Vector3::new(z[0], z[1], z[2]),
+    };
+    let dense = |jacobian| Dense { z0: z, jacobian };
+    let (dual, fd) = (
+        dense(DenseJacobian::Dual),
+        dense(DenseJacobian::FiniteDifferences),
+    );
+    Ok(vec![
+        (
+            GENERAL,
+            best_ns(batches, 20_000, || {
+                black_box(system.residual(black_box(z), &w, H, 0.5));
+                black_box(system.jacobian(black_box(z), &w, H, 0.5));
+            }),
+        ),
+        (
+            REDUCED,
+            best_ns(batches, 20_000, || {
+                black_box(system.core_system(&factors, &offset, black_box(&y), H, 0.5));
+            }),
+        ),
+        (
+            HAND_DENSE,
+            best_ns(batches, 20_000, || {
+                black_box(dense_residual(black_box(z), &w12));
+                black_box(dense_jacobian(black_box(z), &w12));
+            }),
+        ),
+        (
+            HAND_REDUCED,
+            best_ns(batches, 20_000, || {
+                black_box(core.residual(black_box(&core.c0)));
+                black_box(core.jacobian(black_box(&core.c0)));
+            }),
+        ),
+        (
+            DUAL,
+            best_ns(batches, 5_000, || {
+                black_box(dual.jacobian(black_box(&w12)));
+            }),
+        ),
+        (
+            FINITE_DIFFERENCES,
+            best_ns(batches, 5_000, || {
+                black_box(fd.jacobian(black_box(&w12)));
+            }),
+        ),
+    ])
+}
+
+/// One step from `z` per variant, timed in `rounds` interleaved rounds; the cheap variants
+/// make `calls` calls a sample, the dense ones a twentieth of that and the finite-difference
+/// one a hundredth.
+pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row> {
+    let options = StepOptions::default();
+    let unchecked = options.with_domain_check(false);
+    let (mut reduced, mut reduced_unchecked) =
+        (ReducedStepper::new(system), ReducedStepper::new(system));
+    let (slow, slowest) = ((calls / 20).max(1), (calls / 100).max(1));
+    interleaved(
+        rounds,
+        &mut [
+            Timed::new(REDUCED, calls, &mut || {
+                black_box(reduced.step(black_box(z), H, &options).map(|s| s.0[0]).ok());
+            }),
+            Timed::new(REDUCED_UNCHECKED, calls, &mut || {
+                let s = reduced_unchecked.step(black_box(z), H, &unchecked);
+                black_box(s.map(|s| s.0[0]).ok());
+            }),
+            Timed::new(GENERAL, slow, &mut || {
+                black_box(step(system, black_box(z), H, &options).map(|s| s.0[0]).ok());
+            }),
+            Timed::new(HAND_DENSE, slow, &mut || {
+                black_box(dense_step(black_box(z), DenseJacobian::Hand).ok());
+            }),
+            Timed::new(HAND_REDUCED, calls, &mut || {
+                black_box(hand_reduced_step(black_box(z)).ok());
+            }),
+            Timed::new(HAND_GUARDED, calls, &mut || {
+                black_box(hand_guarded_step(black_box(z)).ok());
+            }),
+            Timed::new(DUAL, slow, &mut || {
+                black_box(dense_step(black_box(z), DenseJacobian::Dual).ok());
+            }),
+            Timed::new(FINITE_DIFFERENCES, slowest, &mut || {
+                let s = dense_step(black_box(z), DenseJacobian::FiniteDifferences);
+                black_box(s.ok());
+            }),
+        ],
+    )
+}
+
+/// The reduced stepper's 400-step run from a fresh stepper (domain check on).
+pub const RUN_REDUCED: &str = "generated reduced, domain check on";
+/// The hand-written guarded 400-step run.
+pub const RUN_HAND_GUARDED: &str = "hand-written reduced, domain check on";
+/// The reduced stepper's 400-step run, domain check off.
+pub const RUN_REDUCED_UNCHECKED: &str = "generated reduced, domain check off";
+/// The hand-written 400-step run.
+pub const RUN_HAND: &str = "hand-written reduced, domain check off";
+/// The factors of one step size (a cache miss of the reduced stepper).
+pub const FACTORS: &str = "factors of a new step size (`ReducedFactors::new`)";
+
+/// The paper's 400-step run (each step waits on the last, the reduced runs from a fresh
+/// stepper), generated and hand-written, with and without the domain check, and the cost of
+/// the factors of a new step size: `rounds` interleaved rounds of `calls` runs each.
+///
+/// # Errors
+/// A run that fails (checked once before timing).
+pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec<Row>, Error> {
+    let options = StepOptions::default();
+    let unchecked = options.with_domain_check(false);
+    let z0 = paper_start(system);
+    let reduced_run = |options: &StepOptions| -> Result<Z, Error> {
+        let mut stepper = ReducedStepper::new(system);
+        let mut z = z0;
+        for _ in 0..PAPER_STEPS {
+            z = stepper.step(&z, H, options)?.0;
+        }
+        Ok(z)
+    };
+    let hand_run = |step: fn(&Z) -> Result<Z, Error>| -> Result<Z, Error> {
+        (0..PAPER_STEPS).try_fold(z0, |z, _| step(&z))
+    };
+    reduced_run(&options)?;
+    reduced_run(&unchecked)?;
+    hand_run(hand_guarded_step)?;
+    hand_run(hand_reduced_step)?;
+    Ok(interleaved(
+        rounds,
+        &mut [
+            Timed::new(RUN_REDUCED, calls, &mut || {
+                black_box(reduced_run(&options).ok());
+            }),
+            Timed::new(RUN_HAND_GUARDED, calls, &mut || {
+                black_box(hand_run(hand_guarded_step).ok());
+            }),
+            Timed::new(RUN_REDUCED_UNCHECKED, calls, &mut || {
+                black_box(reduced_run(&unchecked).ok());
+            }),
+            Timed::new(RUN_HAND, calls, &mut || {
+                black_box(hand_run(hand_reduced_step).ok());
+            }),
+            Timed::new(FACTORS, calls * 10, &mut || {
+                black_box(ReducedFactors::new(system, black_box(H), 0.5).ok());
+            }),
+        ],
+    ))
+}
+
+/// Writes the step table (time, ratio to the generated reduced step) and the like-for-like
+/// ratios of the generated and the hand-written reduced steps, as markdown.
+///
+/// # Errors
+/// [`Error::Io`].
+pub fn write_steps(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(), Error> {
+    writeln!(
+        out,
+        "One step, SE(2) obstacle system near its closest approach, h = 0.01 (best of {rounds} \
+         interleaved rounds):\n"
+    )?;
+    writeln!(out, "| one step | time | vs generated reduced |")?;
+    writeln!(out, "|---|---|---|")?;
+    let reduced = best_of(rows, REDUCED);
+    for row in rows.iter().filter(|r| r.name != HAND_GUARDED) {
+        let t = row.samples.best();
+        writeln!(
+            out,
+            "| {} | {} | {:.2}x |",
+            row.name,
+            format_ns(t),
+            t / reduced
+        )?;
+    }
+    let (unchecked, hand, guarded) = (
+        best_of(rows, REDUCED_UNCHECKED),
+        best_of(rows, HAND_REDUCED),
+        best_of(rows, HAND_GUARDED),
+    );
+    writeln!(
+        out,
+        "\nstep ratios: generated/hand-written reduced {:.2}x (check off), {:.2}x (check on; \
+         {:.2}x the hand-written step without it); dense/generated {:.1}x, dual/generated \
+         {:.1}x",
+        unchecked / hand,
+        reduced / guarded,
+        reduced / hand,
+        best_of(rows, HAND_DENSE) / reduced,
+        best_of(rows, DUAL) / reduced,
+    )?;
+    Ok(())
+}
+
+/// Writes the table of [`paper_runs`] and the ratios of generated to hand-written runs.
+///
+/// # Errors
+/// [`Error::Io`].
+pub fn write_runs(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(), Error> {
+    writeln!(
+        out,
+        "\nThe paper's 400-step run (tau = 1e-2, from a fresh stepper; best of {rounds} \
+         interleaved rounds):\n"
+    )?;
+    write_rows(out, "400-step run", rows)?;
+    writeln!(
+        out,
+        "\nrun ratios: generated/hand-written {:.2}x (check on), {:.2}x (check off)",
+        best_of(rows, RUN_REDUCED) / best_of(rows, RUN_HAND_GUARDED),
+        best_of(rows, RUN_REDUCED_UNCHECKED) / best_of(rows, RUN_HAND),
+    )?;
+    Ok(())
+}

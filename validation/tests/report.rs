@@ -1,0 +1,91 @@
+//! The speed report at quick size: it runs, prints its header and tables, and its
+//! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <r>` line parses with
+//! r = best / DOP853 within the rounding of the printed figures. No timing is asserted.
+
+use retract_validation::report::{self, Size, utc_date};
+use retract_validation::work_precision::time_at_error;
+
+/// (method, best, DOP853, ratio) from the line.
+fn parse_line(line: &str) -> Option<(&str, f64, f64, f64)> {
+    let rest = line.strip_prefix("work-precision 1e-8: best=")?;
+    let (best, rest) = rest.split_once(" us, DOP853 ")?;
+    let (method, best) = best.rsplit_once(' ')?;
+    let (dop, ratio) = rest.split_once(" us, ratio ")?;
+    Some((
+        method,
+        best.parse().ok()?,
+        dop.parse().ok()?,
+        ratio.parse().ok()?,
+    ))
+}
+
+#[test]
+fn quick_report_prints_the_work_precision_line() {
+    let mut out = Vec::new();
+    let summary = report::run(&Size::quick(), &mut out).expect("the quick report runs");
+    let text = String::from_utf8(out).expect("utf-8");
+    assert!(
+        text.starts_with("# retract speed report, "),
+        "header:\n{text}"
+    );
+    for table in [
+        "| one step | time | vs generated reduced |",
+        "| 400-step run | time |",
+        "| guard | time |",
+        "| method | steps / tol | final error | wall time |",
+        "| method | at 1e-8 |",
+        "| method | step size / tol | steps | wall time |",
+    ] {
+        assert!(text.contains(table), "missing `{table}` in:\n{text}");
+    }
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("work-precision 1e-8: "))
+        .collect();
+    assert_eq!(lines.len(), 1, "one work-precision line in:\n{text}");
+    let (method, best, dop, ratio) =
+        parse_line(lines[0]).unwrap_or_else(|| panic!("unparsed: {}", lines[0]));
+    assert!(!method.is_empty() && best > 0.0 && dop > 0.0);
+    // the printed times are rounded to 0.05 us, the ratio to 0.005
+    let (low, high) = ((best - 0.05) / (dop + 0.05), (best + 0.05) / (dop - 0.05));
+    assert!(
+        ratio >= low - 0.005 && ratio <= high + 0.005,
+        "ratio {ratio} is not {best} / {dop}"
+    );
+    let (label, t) = summary.at_target.best.expect("a best method");
+    assert_eq!(label, method);
+    assert!((t * 1e6 - best).abs() <= 0.05 + 1e-9);
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("work-precision 1e-8 without the guard: ")),
+        "{text}"
+    );
+}
+
+#[test]
+fn line_parser_reads_the_readme_example() {
+    let line =
+        "work-precision 1e-8: best=splitting, BM SRKN14a 14.5 us, DOP853 16.6 us, ratio 0.87";
+    assert_eq!(
+        parse_line(line),
+        Some(("splitting, BM SRKN14a", 14.5, 16.6, 0.87))
+    );
+}
+
+#[test]
+fn utc_dates() {
+    use std::time::{Duration, UNIX_EPOCH};
+    assert_eq!(utc_date(UNIX_EPOCH), "1970-01-01");
+    // 2000-02-29 and 2026-11-23, midday
+    let day = |d: u64| UNIX_EPOCH + Duration::from_secs(d * 86_400 + 43_200);
+    assert_eq!(utc_date(day(11_016)), "2000-02-29");
+    assert_eq!(utc_date(day(20_780)), "2026-11-23");
+}
+
+#[test]
+fn interpolation_between_sweep_points() {
+    // error 1e-6 at 1 s, 1e-10 at 100 s: 1e-8 halfway on the log scale, at 10 s
+    let t = time_at_error(&[(1.0, 1e-6), (100.0, 1e-10)], 1e-8).expect("bracketed");
+    assert!((t - 10.0).abs() < 1e-9);
+    assert_eq!(time_at_error(&[(1.0, 1e-6), (2.0, 1e-7)], 1e-8), None);
+}
