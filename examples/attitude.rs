@@ -11,7 +11,8 @@
 //!    charts against the midpoint rule in Euler angles, and a long run of the former.
 //! 4. A fully actuated rigid body in SE(3), written in body coordinates (`se3`) and planned in
 //!    the product chart at the identity, flying among spheres while it turns, each sphere a
-//!    hard constraint.
+//!    hard constraint; and a free body whose centre of mass is off the pose's origin, stepped
+//!    in moving SE(3) charts.
 //!
 //! Run: `cargo run --release --example attitude [-- boresight.svg torque.svg]`
 
@@ -27,8 +28,9 @@ use attitude::{
 };
 use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::map::{self, DiscretizationMap, TaylorLift};
-use retract::nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
+use retract::nalgebra::{Isometry3, Matrix3, SVector, UnitQuaternion, Vector3};
 use retract::plot::{self, Curve, Scale};
+use retract::se3::{self, Se3Midpoint1};
 use retract::so3::{
     CayleyMidpoint, CayleyMidpoint1, chart_quaternion, orientation, recentre, world_momentum,
 };
@@ -271,7 +273,65 @@ fn tumbling(long_steps: usize) -> Result<(), Box<dyn std::error::Error>> {
         "\nmoving charts, {long_steps} steps of {h} s: max abs(R^T R - I) = {orthogonality:.1e}, \
          spatial momentum drift {drift:.1e} (relative), {us:.2} us/step"
     );
+    let [rotation, mass_centre, orthogonality, drift, us] = se3_moving_charts(h, steps)?;
+    println!(
+        "\nSE(3), the free body with its centre of mass off the pose's origin, moving product \
+         charts (Se3Midpoint1), T = {t} s, h = {h}: rotation error {rotation:.2e} rad, centre of \
+         mass error {mass_centre:.2e}, max abs(R^T R - I) = {orthogonality:.1e}, spatial momentum \
+         drift {drift:.1e}, {us:.2} us/step"
+    );
+    let long = long_steps / 10;
+    let [_, mass_centre, orthogonality, drift, us] = se3_moving_charts(h, long)?;
+    println!(
+        "SE(3), {long} steps of {h} s: centre of mass error {mass_centre:.2e}, max abs(R^T R - I) \
+         = {orthogonality:.1e}, spatial momentum drift {drift:.1e}, {us:.2} us/step"
+    );
     Ok(())
+}
+
+/// The free body with an offset centre of mass ([`attitude::offset_body`]) in moving SE(3)
+/// charts from the identity with body velocity ([`TUMBLE`], `v`), `steps` steps of `h` with
+/// the generated map `Se3Midpoint1`: the errors of the rotation (rad) and of the centre of
+/// mass at the end against the exact motion (Euler's equations by RK4; a straight line), the
+/// largest |R^T R - I| and relative change of the spatial momentum, and the time per step in
+/// us.
+fn se3_moving_charts(h: f64, steps: usize) -> Result<[f64; 5], retract::Error> {
+    let (omega, v) = (Vector3::from(TUMBLE), Vector3::new(0.5, -0.2, 0.3));
+    let (mut system, mut centre) = (attitude::offset_body(), Isometry3::identity());
+    let mut jet = SVector::<f64, 12>::zeros();
+    for i in 0..3 {
+        (jet[6 + i], jet[9 + i]) = (omega[i] / 2.0, v[i]);
+    }
+    let (mut z, options) = (system.legendre(&jet), NewtonOptions::default());
+    let (l0, p0) = se3::spatial_momentum::<1, 12>(&centre, &z);
+    let (mut orthogonality, mut drift): (f64, f64) = (0.0, 0.0);
+    let clock = Instant::now();
+    for _ in 0..steps {
+        z = map::step(&system, &Se3Midpoint1, &z, h, &options)?.0;
+        se3::recentre_system::<_, 1, 12>(&mut system, &mut centre, &mut z)?;
+        let r = centre.rotation.to_rotation_matrix().into_inner();
+        orthogonality = orthogonality.max((r.transpose() * r - Matrix3::identity()).amax());
+        let (l, p) = se3::spatial_momentum::<1, 12>(&centre, &z);
+        drift = drift.max(((l - l0).amax() / l0.amax()).max((p - p0).amax() / p0.amax()));
+    }
+    let us = clock.elapsed().as_secs_f64() * 1e6 / steps as f64;
+    let t = h * steps as f64;
+    let offset = Vector3::from(attitude::OFFSET);
+    let end = se3::pose::<1, 12>(&centre, &z);
+    let mass_centre = end.translation.vector + end.rotation * offset;
+    let exact_centre = offset + (v + omega.cross(&offset)) * t;
+    let rotation_error = if steps <= 10_000 {
+        end.rotation.angle_to(&euler_reference(omega, t, 100_000))
+    } else {
+        f64::NAN
+    };
+    Ok([
+        rotation_error,
+        (mass_centre - exact_centre).norm(),
+        orthogonality,
+        drift,
+        us,
+    ])
 }
 
 /// The smallest clearance |p - c| - r from the spheres at the steps' evaluation points

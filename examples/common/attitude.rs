@@ -371,3 +371,31 @@ pub fn clear_of_sphere(
     let (a, b, c) = (g[9] - centre[0], g[10] - centre[1], g[11] - centre[2]);
     a * a + b * b + c * c - radius * radius
 }
+
+/// The free rigid body on SE(3) (`se3`) whose centre of mass sits at `r` in the body frame,
+/// so that rotation and translation of the pose couple: L = 1/2 Omega . J Omega +
+/// 1/2 m |v + Omega x r|^2, J the inertia about the centre of mass.
+#[higher_order_lagrangian(order = 1, se3)]
+pub fn offset_free_body(
+    _g: [f64; 12],
+    xi: [f64; 6],
+    j1: f64,
+    j2: f64,
+    j3: f64,
+    m: f64,
+    r: [f64; 3],
+) -> f64 {
+    let c0 = xi[3] + xi[1] * r[2] - xi[2] * r[1];
+    let c1 = xi[4] + xi[2] * r[0] - xi[0] * r[2];
+    let c2 = xi[5] + xi[0] * r[1] - xi[1] * r[0];
+    0.5 * (j1 * xi[0] * xi[0] + j2 * xi[1] * xi[1] + j3 * xi[2] * xi[2])
+        + 0.5 * m * (c0 * c0 + c1 * c1 + c2 * c2)
+}
+
+/// The centre of mass of [`offset_body`] in the body frame.
+pub const OFFSET: [f64; 3] = [0.3, -0.2, 0.5];
+
+/// [`offset_free_body`] with [`INERTIA`], mass 2 and its centre of mass at [`OFFSET`].
+pub fn offset_body() -> OffsetFreeBody {
+    OffsetFreeBody::new(INERTIA[0], INERTIA[1], INERTIA[2], 2.0, OFFSET)
+}

@@ -18,6 +18,7 @@ use retract::{
 };
 
 use super::so3::attitude;
+use super::so3_body::{random, unskew};
 
 /// A linear probe of the arguments: sum a_e g_e + b . xi + c . xi'.
 #[jet_function(order = 2, se3)]
@@ -32,21 +33,6 @@ fn probe(g: [f64; 12], xi: [f64; 6], dxi: [f64; 6], a: [f64; 12], b: [f64; 6], c
     acc
 }
 
-/// The free rigid body whose centre of mass sits at `r` in the body frame (so rotation and
-/// translation of the pose couple): L = 1/2 Omega . J Omega + 1/2 m |v + Omega x r|^2, J the
-/// inertia about the centre of mass.
-#[higher_order_lagrangian(order = 1, se3)]
-fn free_body(_g: [f64; 12], xi: [f64; 6], j1: f64, j2: f64, j3: f64, m: f64, r: [f64; 3]) -> f64 {
-    let c0 = xi[3] + xi[1] * r[2] - xi[2] * r[1];
-    let c1 = xi[4] + xi[2] * r[0] - xi[0] * r[2];
-    let c2 = xi[5] + xi[0] * r[1] - xi[1] * r[0];
-    0.5 * (j1 * xi[0] * xi[0] + j2 * xi[1] * xi[1] + j3 * xi[2] * xi[2])
-        + 0.5 * m * (c0 * c0 + c1 * c1 + c2 * c2)
-}
-
-/// The centre of mass of [`free_system`] in the body frame.
-const OFFSET: [f64; 3] = [0.3, -0.2, 0.5];
-
 /// A heavy top on a spring: the free body with the potential k/2 |p|^2 + mgl (R e_z) . e_z,
 /// invariant under rotations about the world z axis through the origin.
 #[higher_order_lagrangian(order = 1, se3)]
@@ -55,17 +41,6 @@ fn sprung_top(g: [f64; 12], xi: [f64; 6], j1: f64, j2: f64, j3: f64, k: f64, mgl
         + 0.5 * (xi[3] * xi[3] + xi[4] * xi[4] + xi[5] * xi[5])
         - 0.5 * k * (g[9] * g[9] + g[10] * g[10] + g[11] * g[11])
         - mgl * g[8]
-}
-
-/// A pseudo-random vector of entries in (-scale, scale).
-fn random(seed: u64, scale: f64) -> Vector3<f64> {
-    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
-    Vector3::from_fn(|_, _| {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * scale
-    })
 }
 
 /// A pseudo-random pose.
@@ -79,15 +54,6 @@ fn random_pose(seed: u64) -> Isometry3<f64> {
 /// The vector of 6 with rotation part `y` and position part `x`.
 fn six(y: &Vector3<f64>, x: &Vector3<f64>) -> SVector<f64, 6> {
     SVector::<f64, 6>::from_iterator(y.iter().chain(x.iter()).copied())
-}
-
-/// The unskew of a nearly skew matrix: w with [w]x = (M - M^T) / 2.
-fn unskew(m: &Matrix3<f64>) -> Vector3<f64> {
-    Vector3::new(
-        m[(2, 1)] - m[(1, 2)],
-        m[(0, 2)] - m[(2, 0)],
-        m[(1, 0)] - m[(0, 1)],
-    ) / 2.0
 }
 
 #[test]
@@ -212,20 +178,13 @@ fn the_change_of_chart_is_the_left_translation() {
     }
 }
 
-/// The free body of [`FreeBody`] with inertia `attitude::INERTIA`, mass 2 and its centre
-/// of mass at [`OFFSET`].
-fn free_system() -> FreeBody {
-    let [j1, j2, j3] = attitude::INERTIA;
-    FreeBody::new(j1, j2, j3, 2.0, OFFSET)
-}
-
 /// The order-1 state at a chart's centre with body velocity (omega, v): y' = omega / 2,
 /// x' = v.
 fn free_start(omega: &Vector3<f64>, v: &Vector3<f64>) -> SVector<f64, 12> {
     let mut jet = SVector::<f64, 12>::zeros();
     jet.fixed_rows_mut::<6>(6)
         .copy_from(&six(&(omega / 2.0), v));
-    free_system().legendre(&jet)
+    attitude::offset_body().legendre(&jet)
 }
 
 /// The free body from the pose `start` with body velocity (omega, v), `steps` steps of the
@@ -238,7 +197,7 @@ fn free_flight(
     t: f64,
     steps: usize,
 ) -> (Isometry3<f64>, f64, f64) {
-    let (mut system, mut centre) = (centred(&free_system(), start), *start);
+    let (mut system, mut centre) = (centred(&attitude::offset_body(), start), *start);
     let mut z = free_start(omega, v);
     let (l0, p0) = spatial_momentum::<1, 12>(&centre, &z);
     let (mut orthogonality, mut drift): (f64, f64) = (0.0, 0.0);
@@ -264,7 +223,7 @@ fn the_free_body_stays_on_the_group_conserves_its_momentum_and_converges_with_or
     // exact: Euler's equations for the rotation (left-invariant: from the identity, then
     // translated); the centre of mass p + R r on a straight line at the world velocity
     // R0 (v + omega x r)
-    let r = Vector3::from(OFFSET);
+    let r = Vector3::from(attitude::OFFSET);
     let rotation = start.rotation * attitude::euler_reference(omega, t, 100_000);
     let mass_centre =
         start.translation.vector + start.rotation * r + start.rotation * (v + omega.cross(&r)) * t;

@@ -50,7 +50,7 @@ fn cubic(_r: [f64; 9], w: [f64; 3], dw: [f64; 3], j1: f64, j2: f64, j3: f64) -> 
 }
 
 /// A pseudo-random vector of entries in (-scale, scale).
-fn random(seed: u64, scale: f64) -> Vector3<f64> {
+pub(crate) fn random(seed: u64, scale: f64) -> Vector3<f64> {
     let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
     Vector3::from_fn(|_, _| {
         s = s
@@ -61,7 +61,7 @@ fn random(seed: u64, scale: f64) -> Vector3<f64> {
 }
 
 /// The unskew of a nearly skew matrix: w with [w]x = (M - M^T) / 2.
-fn unskew(m: &Matrix3<f64>) -> Vector3<f64> {
+pub(crate) fn unskew(m: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(
         m[(2, 1)] - m[(1, 2)],
         m[(0, 2)] - m[(2, 0)],
