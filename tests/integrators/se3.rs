@@ -6,6 +6,7 @@
 //! moving charts stays on the group, conserves its spatial momentum and converges with order
 //! 2, and its compositions with orders 4, 6 and 8; and a pose-dependent Lagrangian steps the same in moving charts as in one chart.
 
+use retract::diagnostics::canonical_structure;
 use retract::map;
 use retract::nalgebra::{Isometry3, Matrix3, SVector, Translation3, UnitQuaternion, Vector3};
 use retract::se3::{
@@ -19,6 +20,7 @@ use retract::{
 
 use super::so3::attitude;
 use super::so3_body::{random, unskew};
+use super::so3_moving::jacobian;
 
 /// A linear probe of the arguments: sum a_e g_e + b . xi + c . xi'.
 #[jet_function(order = 2, se3)]
@@ -349,4 +351,35 @@ fn the_order_2_flight_recentres_exactly_and_conserves_its_spatial_momentum() {
         drift = drift.max(((l - l0).amax() / l0.amax()).max((p - p0).amax() / p0.amax()));
     }
     assert!(drift < 1e-11, "spatial momentum drift {drift:e}");
+}
+
+#[test]
+fn the_steps_and_the_change_of_chart_are_symplectic() {
+    let options = NewtonOptions::default();
+    // the step of the left-invariant map, k = 1 (offset free body) and k = 2 (the flight)
+    let system = centred(&attitude::offset_body(), &random_pose(4));
+    let z1 = system.legendre(&SVector::<f64, 12>::from_fn(|i, _| {
+        random(20 + i as u64 / 3, 0.8)[i % 3]
+    }));
+    let d = map::step_map_derivative(&system, &Se3Midpoint1, &z1, 0.1, &options).expect("regular");
+    let j12 = canonical_structure::<12>();
+    let e1 = (d.transpose() * j12 * d - j12).amax();
+    let flight = centred(&attitude::flight_body(), &random_pose(5));
+    let z2 = flight.legendre(&SVector::<f64, 24>::from_fn(|i, _| {
+        random(30 + i as u64 / 3, 0.5)[i % 3]
+    }));
+    let d = map::step_map_derivative(&flight, &Se3Midpoint2, &z2, 0.05, &options).expect("regular");
+    let j24 = canonical_structure::<24>();
+    let e2 = (d.transpose() * j24 * d - j24).amax();
+    assert!(e1 < 1e-12 && e2 < 1e-11, "|D^T J D - J| = {e1:e}, {e2:e}");
+    // the change of chart (central differences), inverted by the opposite one
+    let (a, b) = (random(40, 0.7), random(41, 2.0));
+    let d = jacobian(|z| transition::<2, 24>(&a, &b, z).expect("inside"), &z2);
+    let e = (d.transpose() * j24 * d - j24).amax();
+    assert!(e < 1e-8, "transition: |D^T J D - J| = {e:e}");
+    let moved = transition::<2, 24>(&a, &b, &z2).expect("inside");
+    // (C, c)(Q(a), b) (Q(-a), -Q(a)^T b) = (C, c)
+    let back_b = -(chart_quaternion(&a).inverse() * b);
+    let back = transition::<2, 24>(&-a, &back_b, &moved).expect("inside");
+    assert!((back - z2).amax() < 1e-12);
 }

@@ -113,7 +113,7 @@ fn the_transition_moves_jets_along_their_curves() {
 }
 
 /// The Jacobian of `f` at `z` by central differences.
-fn jacobian<const S: usize>(
+pub(crate) fn jacobian<const S: usize>(
     f: impl Fn(&SVector<f64, S>) -> SVector<f64, S>,
     z: &SVector<f64, S>,
 ) -> SMatrix<f64, S, S> {
