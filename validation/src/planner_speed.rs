@@ -20,6 +20,7 @@
 
 use std::hint::black_box;
 use std::io::Write;
+use std::time::Instant;
 
 use retract::bvp::{
     BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver, OptimalControlProblem,
@@ -30,7 +31,7 @@ use retract::{Lagrangian, LiftedSystem, ReducedScheme};
 
 use crate::Error;
 use crate::models::{DISC_GOAL, DISC_START, OneDisc, Scene};
-use crate::timing::{Row, Samples, Timed, format_ns, interleaved};
+use crate::timing::{Row, Samples, Timed, format_ns, interleaved, write_head};
 
 /// The SE(2) scene's obstacle (centre x, y, radius).
 pub const SE2_OBSTACLES: [[f64; 3]; 1] = [[0.0, -0.6, 1.0]];
@@ -106,6 +107,23 @@ fn measured(
         .collect()
 }
 
+/// One call a sample of each of `runs`, named in turn by `names`.
+fn named<'a>(
+    names: &[&'static str],
+    runs: impl IntoIterator<Item = &'a mut dyn FnMut()>,
+) -> Vec<Timed<'a>> {
+    names
+        .iter()
+        .zip(runs)
+        .map(|(&name, run)| Timed::new(name, 1, run))
+        .collect()
+}
+
+/// Each closure of `runs` as a trait object, for [`named`].
+fn each<F: FnMut()>(runs: &mut [F]) -> impl Iterator<Item = &mut dyn FnMut()> {
+    runs.iter_mut().map(|run| run as &mut dyn FnMut())
+}
+
 /// The optimizer's failure as the report's error.
 fn plan_failed<const N: usize, const X: usize>(e: PlanError<N, X>) -> Error {
     Error::Plan(e.to_string())
@@ -136,12 +154,11 @@ pub fn against_n(measure: Measure<'_>) -> Result<Vec<Solve>, Error> {
             }
         })
         .collect();
-    let mut closures: Vec<Timed<'_>> = AGAINST_N_NAMES
-        .iter()
-        .zip(runs.iter_mut())
-        .map(|(&name, run)| Timed::new(name, 1, run))
-        .collect();
-    Ok(measured(measure, &mut closures, solves))
+    Ok(measured(
+        measure,
+        &mut named(&AGAINST_N_NAMES, each(&mut runs)),
+        solves,
+    ))
 }
 
 /// The condensed solve with the reduced step maps (`solve_reduced`), N = 400.
@@ -189,12 +206,15 @@ pub fn at_400(measure: Measure<'_>) -> Result<Vec<Solve>, Error> {
     let mut rewarm = || cost(warm.solve_reduced(Guess::Solution(&shifted)));
     Ok(measured(
         measure,
-        &mut [
-            Timed::new(REDUCED, 1, &mut reduced),
-            Timed::new(DENSE, 1, &mut dense),
-            Timed::new(BANDED, 1, &mut band),
-            Timed::new(WARM, 1, &mut rewarm),
-        ],
+        &mut named(
+            &[REDUCED, DENSE, BANDED, WARM],
+            [
+                &mut reduced as &mut dyn FnMut(),
+                &mut dense,
+                &mut band,
+                &mut rewarm,
+            ],
+        ),
         solves.to_vec(),
     ))
 }
@@ -374,18 +394,13 @@ where
     let mut root_cold = || root_cost(root.solve_reduced(root_guess));
     let mut optimizer_rewarm = || plan_cost(optimizer_warm.solve(PlanGuess::Plan(&shifted_plan)));
     let mut root_rewarm = || root_cost(root_warm.solve_reduced(Guess::Solution(&shifted_solution)));
-    let [a, b, c, d] = scenario.names;
-    let mut solves = measured(
-        measure,
-        &mut [
-            Timed::new(a, 1, &mut optimizer_cold),
-            Timed::new(b, 1, &mut root_cold),
-            Timed::new(c, 1, &mut optimizer_rewarm),
-            Timed::new(d, 1, &mut root_rewarm),
-        ],
-        solves,
-    )
-    .into_iter();
+    let runs: [&mut dyn FnMut(); 4] = [
+        &mut optimizer_cold,
+        &mut root_cold,
+        &mut optimizer_rewarm,
+        &mut root_rewarm,
+    ];
+    let mut solves = measured(measure, &mut named(&scenario.names, runs), solves).into_iter();
     let mut races = Vec::new();
     for case in scenario.cases {
         let (Some(optimizer), Some(root)) = (solves.next(), solves.next()) else {
@@ -482,12 +497,8 @@ pub fn extrapolation(measure: Measure<'_>) -> Result<Vec<Extrapolation>, Error> 
             }
         })
         .collect();
-    let mut closures: Vec<Timed<'_>> = EXTRAPOLATED_NAMES
-        .iter()
-        .zip(runs.iter_mut())
-        .map(|(&name, run)| Timed::new(name, 1, run))
-        .collect();
-    for (result, row) in results.iter_mut().zip(measure(&mut closures)) {
+    let rows = measure(&mut named(&EXTRAPOLATED_NAMES, each(&mut runs)));
+    for (result, row) in results.iter_mut().zip(rows) {
         result.samples = row.samples;
     }
     Ok(results)
@@ -506,6 +517,8 @@ pub struct PlannerSpeed {
     pub extrapolation: Vec<Extrapolation>,
     /// The rounds of each.
     pub rounds: usize,
+    /// Wall time of all of them in seconds (the solves before timing included).
+    pub seconds: f64,
 }
 
 /// Runs every measurement, each in `rounds` interleaved rounds.
@@ -513,6 +526,7 @@ pub struct PlannerSpeed {
 /// # Errors
 /// The measurements'.
 pub fn measure_all(rounds: usize) -> Result<PlannerSpeed, Error> {
+    let started = Instant::now();
     let mut measure = |closures: &mut [Timed<'_>]| interleaved(rounds, closures);
     Ok(PlannerSpeed {
         against_n: against_n(&mut measure)?,
@@ -520,6 +534,7 @@ pub fn measure_all(rounds: usize) -> Result<PlannerSpeed, Error> {
         races: races(&mut measure)?,
         extrapolation: extrapolation(&mut measure)?,
         rounds,
+        seconds: started.elapsed().as_secs_f64(),
     })
 }
 
@@ -541,7 +556,9 @@ pub fn write_all(out: &mut dyn Write, speed: &PlannerSpeed) -> Result<(), Error>
     write_against_n(out, &speed.against_n, speed.rounds)?;
     write_at_400(out, &speed.at_400)?;
     write_races(out, &speed.races, speed.rounds)?;
-    write_extrapolation(out, &speed.extrapolation, speed.rounds)
+    write_extrapolation(out, &speed.extrapolation, speed.rounds)?;
+    writeln!(out, "\nplanner: {:.1} s", speed.seconds)?;
+    Ok(())
 }
 
 /// The table of solve time and time per step against N, and a line with the iterations and
@@ -561,8 +578,12 @@ pub fn write_against_n(out: &mut dyn Write, solves: &[Solve], rounds: usize) -> 
             .map(|&(n, s)| format!(" {} |", f(n, s)))
             .collect::<String>()
     };
-    writeln!(out, "| N |{}", cells(&|n, _| n.to_string()))?;
-    writeln!(out, "|---|{}", "---|".repeat(rows.len()))?;
+    let steps: Vec<String> = rows.iter().map(|(n, _)| n.to_string()).collect();
+    let head: Vec<&str> = ["N"]
+        .into_iter()
+        .chain(steps.iter().map(String::as_str))
+        .collect();
+    write_head(out, &head)?;
     writeln!(
         out,
         "| solve |{}",
@@ -608,11 +629,10 @@ pub fn write_at_400(out: &mut dyn Write, solves: &[Solve]) -> Result<(), Error> 
         "\nPlanner: the linear solvers and the warm re-solve at N = 400 (same scene, same \
          rounds):\n"
     )?;
-    writeln!(
+    write_head(
         out,
-        "| N = 400 | Newton iterations | time | vs `solve_reduced` |"
+        &["N = 400", "Newton iterations", "time", "vs `solve_reduced`"],
     )?;
-    writeln!(out, "|---|---|---|---|")?;
     let best = |name: &str| {
         solves
             .iter()
@@ -658,12 +678,17 @@ pub fn write_races(out: &mut dyn Write, races: &[Race], rounds: usize) -> Result
          same guess, interleaved, best of {rounds} rounds each; ratio = optimizer / root \
          finder:\n"
     )?;
-    writeln!(
+    write_head(
         out,
-        "| N = 400 | optimizer | root finder | ratio | iterations (optimizer, root finder) | \
-         cost difference |"
+        &[
+            "N = 400",
+            "optimizer",
+            "root finder",
+            "ratio",
+            "iterations (optimizer, root finder)",
+            "cost difference",
+        ],
     )?;
-    writeln!(out, "|---|---|---|---|---|---|")?;
     for r in races {
         writeln!(
             out,
@@ -699,11 +724,17 @@ pub fn write_extrapolation(
         "\nPlanner: Richardson extrapolation (N, 2N, 4N) on the one-disc scene, tolerance 1e-9, \
          against N = 400 extrapolated at 1e-10 (time best of {rounds} interleaved rounds):\n"
     )?;
-    writeln!(
+    write_head(
         out,
-        "| N | cost error | estimate | $p(0)$ error | iterations ($N$, $2N$, $4N$) | time |"
+        &[
+            "N",
+            "cost error",
+            "estimate",
+            "$p(0)$ error",
+            "iterations ($N$, $2N$, $4N$)",
+            "time",
+        ],
     )?;
-    writeln!(out, "|---|---|---|---|---|---|")?;
     for e in rows {
         let [a, b, c] = e.iterations;
         writeln!(

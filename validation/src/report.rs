@@ -40,7 +40,7 @@ pub struct Size {
 }
 
 impl Size {
-    /// The full report (about 10 s on a shared 2-core machine).
+    /// The full report (10 to 30 s on a shared 2-core machine, the planner 2 to 9 s of it).
     pub fn full() -> Self {
         Self {
             step_rounds: 300,

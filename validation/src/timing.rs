@@ -94,13 +94,21 @@ pub fn interleaved(rounds: usize, closures: &mut [Timed<'_>]) -> Vec<Row> {
         .collect()
 }
 
+/// Writes the head of a markdown table: `| a | b | ... |` and its rule `|---|---|...`.
+///
+/// # Errors
+/// The writer's.
+pub fn write_head(out: &mut dyn Write, columns: &[&str]) -> std::io::Result<()> {
+    writeln!(out, "| {} |", columns.join(" | "))?;
+    writeln!(out, "|{}", "---|".repeat(columns.len()))
+}
+
 /// Writes `rows` as a markdown table headed `| <what> | time |`, best times.
 ///
 /// # Errors
 /// The writer's.
 pub fn write_rows(out: &mut dyn Write, what: &str, rows: &[Row]) -> std::io::Result<()> {
-    writeln!(out, "| {what} | time |")?;
-    writeln!(out, "|---|---|")?;
+    write_head(out, &[what, "time"])?;
     for row in rows {
         writeln!(out, "| {} | {} |", row.name, format_ns(row.samples.best()))?;
     }
