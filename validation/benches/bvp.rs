@@ -19,7 +19,9 @@ use retract_validation::report::Size;
 use retract_validation::timing::{Row, Timed};
 
 fn solve(c: &mut Criterion) {
-    let speed = measure_all(Size::full().planner_rounds).expect("the planner's problems solve");
+    let size = Size::full();
+    let speed =
+        measure_all(size.planner_rounds, size.race_rounds).expect("the planner's problems solve");
     planner_speed::write_all(&mut std::io::stdout(), &speed).expect("stdout");
     println!();
     let mut group = c.benchmark_group("bvp");

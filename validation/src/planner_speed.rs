@@ -31,7 +31,7 @@ use retract::{Lagrangian, LiftedSystem, ReducedScheme};
 
 use crate::Error;
 use crate::models::{DISC_GOAL, DISC_START, OneDisc, Scene};
-use crate::timing::{Row, Samples, Timed, format_ns, interleaved, write_head};
+use crate::timing::{Row, Samples, Timed, format_ns, interleaved, paired_ratio, write_head};
 
 /// The SE(2) scene's obstacle (centre x, y, radius).
 pub const SE2_OBSTACLES: [[f64; 3]; 1] = [[0.0, -0.6, 1.0]];
@@ -231,8 +231,14 @@ pub struct Race {
 }
 
 impl Race {
-    /// Best time of the optimizer over that of the root finder.
+    /// The optimizer's time over the root finder's: the median over the rounds of the ratio in
+    /// each round ([`paired_ratio`]).
     pub fn ratio(&self) -> f64 {
+        paired_ratio(&self.optimizer.samples, &self.root.samples)
+    }
+
+    /// Best time of the optimizer over best time of the root finder.
+    pub fn best_ratio(&self) -> f64 {
         self.optimizer.samples.best() / self.root.samples.best()
     }
 
@@ -515,25 +521,32 @@ pub struct PlannerSpeed {
     pub races: Vec<Race>,
     /// [`extrapolation`].
     pub extrapolation: Vec<Extrapolation>,
-    /// The rounds of each.
+    /// The rounds of [`against_n`] and [`at_400`].
     pub rounds: usize,
+    /// The rounds of [`races`] and [`extrapolation`].
+    pub race_rounds: usize,
     /// Wall time of all of them in seconds (the solves before timing included).
     pub seconds: f64,
 }
 
-/// Runs every measurement, each in `rounds` interleaved rounds.
+/// Runs every measurement: [`against_n`] and [`at_400`] in `rounds` interleaved rounds,
+/// the cheaper [`races`] and [`extrapolation`] in `race_rounds`.
 ///
 /// # Errors
 /// The measurements'.
-pub fn measure_all(rounds: usize) -> Result<PlannerSpeed, Error> {
+pub fn measure_all(rounds: usize, race_rounds: usize) -> Result<PlannerSpeed, Error> {
     let started = Instant::now();
     let mut measure = |closures: &mut [Timed<'_>]| interleaved(rounds, closures);
+    let against_n = against_n(&mut measure)?;
+    let at_400 = at_400(&mut measure)?;
+    let mut measure = |closures: &mut [Timed<'_>]| interleaved(race_rounds, closures);
     Ok(PlannerSpeed {
-        against_n: against_n(&mut measure)?,
-        at_400: at_400(&mut measure)?,
+        against_n,
+        at_400,
         races: races(&mut measure)?,
         extrapolation: extrapolation(&mut measure)?,
         rounds,
+        race_rounds,
         seconds: started.elapsed().as_secs_f64(),
     })
 }
@@ -555,8 +568,8 @@ pub fn format_ms(ns: f64) -> String {
 pub fn write_all(out: &mut dyn Write, speed: &PlannerSpeed) -> Result<(), Error> {
     write_against_n(out, &speed.against_n, speed.rounds)?;
     write_at_400(out, &speed.at_400)?;
-    write_races(out, &speed.races, speed.rounds)?;
-    write_extrapolation(out, &speed.extrapolation, speed.rounds)?;
+    write_races(out, &speed.races, speed.race_rounds)?;
+    write_extrapolation(out, &speed.extrapolation, speed.race_rounds)?;
     writeln!(out, "\nplanner: {:.1} s", speed.seconds)?;
     Ok(())
 }
@@ -619,7 +632,8 @@ fn at_400_label(name: &str) -> &'static str {
     }
 }
 
-/// The table of [`at_400`] (time and ratio to `solve_reduced`) and a line with the ratios.
+/// The table of [`at_400`] (best time and ratio to `solve_reduced`, the median of the ratios
+/// within a round) and a line with the ratios.
 ///
 /// # Errors
 /// [`Error::Io`].
@@ -627,42 +641,40 @@ pub fn write_at_400(out: &mut dyn Write, solves: &[Solve]) -> Result<(), Error> 
     writeln!(
         out,
         "\nPlanner: the linear solvers and the warm re-solve at N = 400 (same scene, same \
-         rounds):\n"
+         rounds; ratio: the median of the ratios within a round):\n"
     )?;
     write_head(
         out,
         &["N = 400", "Newton iterations", "time", "vs `solve_reduced`"],
     )?;
-    let best = |name: &str| {
-        solves
-            .iter()
-            .find(|s| s.name == name)
-            .map_or(f64::NAN, |s| s.samples.best())
+    let empty = Solve {
+        name: "",
+        iterations: 0,
+        cost: f64::NAN,
+        samples: Samples::default(),
     };
-    let reduced = best(REDUCED);
+    let find = |name: &str| solves.iter().find(|s| s.name == name).unwrap_or(&empty);
+    let reduced = &find(REDUCED).samples;
     for s in solves {
-        let t = s.samples.best();
         writeln!(
             out,
             "| {} | {} | {} | {:.2}x |",
             at_400_label(s.name),
             s.iterations,
-            format_ms(t),
-            t / reduced
+            format_ms(s.samples.best()),
+            paired_ratio(&s.samples, reduced)
         )?;
     }
-    let warm_iterations = solves
-        .iter()
-        .find(|s| s.name == WARM)
-        .map_or(0, |s| s.iterations);
+    let ratio = |name: &str| paired_ratio(&find(name).samples, reduced);
     writeln!(
         out,
         "\nlinear solvers N=400: dense step maps {:.1}x, banded LU {:.1}x the reduced step maps \
-         ({}); warm re-solve {warm_iterations} iterations, {}",
-        best(DENSE) / reduced,
-        best(BANDED) / reduced,
-        format_ms(reduced),
-        format_ms(best(WARM)),
+         ({}); warm re-solve {} iterations, {}",
+        ratio(DENSE),
+        ratio(BANDED),
+        format_ms(reduced.best()),
+        find(WARM).iterations,
+        format_ms(find(WARM).samples.best()),
     )?;
     Ok(())
 }
@@ -676,7 +688,7 @@ pub fn write_races(out: &mut dyn Write, races: &[Race], rounds: usize) -> Result
         out,
         "\nPlanner: the optimizer against the root finder (`solve_reduced`) at N = 400 from the \
          same guess, interleaved, best of {rounds} rounds each; ratio = optimizer / root \
-         finder:\n"
+         finder, the median of the ratios within a round (and of the best times):\n"
     )?;
     write_head(
         out,
@@ -685,6 +697,7 @@ pub fn write_races(out: &mut dyn Write, races: &[Race], rounds: usize) -> Result
             "optimizer",
             "root finder",
             "ratio",
+            "best / best",
             "iterations (optimizer, root finder)",
             "cost difference",
         ],
@@ -692,11 +705,12 @@ pub fn write_races(out: &mut dyn Write, races: &[Race], rounds: usize) -> Result
     for r in races {
         writeln!(
             out,
-            "| {} | {} | {} | {:.2}x | {}, {} | {:.1e} |",
+            "| {} | {} | {} | {:.2}x | {:.2}x | {}, {} | {:.1e} |",
             r.case,
             format_ms(r.optimizer.samples.best()),
             format_ms(r.root.samples.best()),
             r.ratio(),
+            r.best_ratio(),
             r.optimizer.iterations,
             r.root.iterations,
             r.cost_difference()

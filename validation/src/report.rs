@@ -35,8 +35,10 @@ pub struct Size {
     pub sweep_rounds: usize,
     /// The horizon of the long run.
     pub long_run_end: f64,
-    /// Interleaved rounds of each of the planner's measurements.
+    /// Interleaved rounds of the planner's solve times against N and at N = 400.
     pub planner_rounds: usize,
+    /// Interleaved rounds of the optimizer against the root finder and of the extrapolation.
+    pub race_rounds: usize,
 }
 
 impl Size {
@@ -49,7 +51,8 @@ impl Size {
             run_calls: 3,
             sweep_rounds: 200,
             long_run_end: 1e5,
-            planner_rounds: 40,
+            planner_rounds: 60,
+            race_rounds: 200,
         }
     }
 
@@ -64,6 +67,7 @@ impl Size {
             sweep_rounds: 2,
             long_run_end: 1e3,
             planner_rounds: 2,
+            race_rounds: 2,
         }
     }
 }
@@ -103,7 +107,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     let at_target = work_precision_part(size, out)?;
     let long = long_run::long_runs(size.long_run_end)?;
     long_run::write_long_runs(out, &long, size.long_run_end)?;
-    let planner = planner_speed::measure_all(size.planner_rounds)?;
+    let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
     let seconds = started.elapsed().as_secs_f64();
     writeln!(out, "\nreport: {seconds:.1} s")?;

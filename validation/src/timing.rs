@@ -44,6 +44,16 @@ impl<'a> Timed<'a> {
     }
 }
 
+/// The median over the rounds of `a`'s time over `b`'s in the same round, for two closures
+/// timed in the same [`interleaved`] rounds (a slower machine in some rounds cancels); the
+/// ratio of the best times if the samples do not pair up.
+pub fn paired_ratio(a: &Samples, b: &Samples) -> f64 {
+    if a.0.is_empty() || a.0.len() != b.0.len() {
+        return a.best() / b.best();
+    }
+    Samples(a.0.iter().zip(&b.0).map(|(a, b)| a / b).collect()).median()
+}
+
 /// A timed closure's name and its per-call times (ns).
 #[derive(Clone, Debug)]
 pub struct Row {

@@ -39,7 +39,7 @@ fn quick_report_prints_the_work_precision_line() {
         "| method | step size / tol | steps | wall time |",
         "| N | 100 | 200 | 400 | 800 | 1600 | 3200 |",
         "| N = 400 | Newton iterations | time | vs `solve_reduced` |",
-        "| N = 400 | optimizer | root finder | ratio | iterations (optimizer, root finder) | \
+        "| N = 400 | optimizer | root finder | ratio | best / best | iterations (optimizer, root finder) | \
          cost difference |",
         "| N | cost error | estimate | $p(0)$ error | iterations ($N$, $2N$, $4N$) | time |",
     ] {
@@ -85,17 +85,21 @@ fn planner_lines(text: &str, planner: &PlannerSpeed) {
         assert!(lines[0].contains(&printed), "`{printed}` in {}", lines[0]);
         assert!(race.cost_difference() < 1e-8, "{race:?}");
     }
+    let size = Size::quick();
     let solves = planner
         .against_n
         .iter()
         .chain(&planner.at_400)
-        .chain(planner.races.iter().flat_map(|r| [&r.optimizer, &r.root]));
-    for solve in solves {
-        assert_eq!(
-            solve.samples.0.len(),
-            Size::quick().planner_rounds,
-            "{solve:?}"
+        .map(|s| (s, size.planner_rounds))
+        .chain(
+            planner
+                .races
+                .iter()
+                .flat_map(|r| [&r.optimizer, &r.root])
+                .map(|s| (s, size.race_rounds)),
         );
+    for (solve, rounds) in solves {
+        assert_eq!(solve.samples.0.len(), rounds, "{solve:?}");
         assert!(solve.samples.best() > 0.0, "{solve:?}");
     }
     assert_eq!(planner.extrapolation.len(), 3);
