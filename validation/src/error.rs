@@ -1,5 +1,6 @@
-//! The one error type of the measurements: a failed step or solve of `retract`, a peer that
-//! failed, two variants of a step that disagree, or output that could not be written.
+//! The one error type of the measurements: a failed step or solve of `retract`, a plan the
+//! optimizer could not make, a peer that failed, two variants of a step or two planners that
+//! disagree, or output that could not be written.
 
 use std::fmt;
 
@@ -8,6 +9,9 @@ use std::fmt;
 pub enum Error {
     /// A step, solve or run of `retract` failed.
     Retract(retract::Error),
+    /// The optimizer (`OptimalControlProblem`) failed; its message (the failure and the last
+    /// iterate).
+    Plan(String),
     /// A peer (ode_solvers' DOP853) failed; its message.
     Peer(String),
     /// A variant of the step computes another state than the generated general step.
@@ -15,6 +19,13 @@ pub enum Error {
         /// The variant.
         variant: &'static str,
         /// Its max-norm distance to the general step.
+        difference: f64,
+    },
+    /// The optimizer and the root finder reach costs that differ by 1e-8 (relative) or more.
+    CostsDiffer {
+        /// The problem.
+        case: &'static str,
+        /// The relative difference of the costs.
         difference: f64,
     },
     /// A hand-written step left the domain of the potential (x^2 + y^2 = 1 crossed).
@@ -27,6 +38,7 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Retract(e) => write!(f, "retract: {e}"),
+            Error::Plan(message) => write!(f, "optimizer: {message}"),
             Error::Peer(message) => write!(f, "peer: {message}"),
             Error::Disagree {
                 variant,
@@ -34,6 +46,11 @@ impl fmt::Display for Error {
             } => write!(
                 f,
                 "{variant} differs from the general step by {difference:e} (more than 1e-12)"
+            ),
+            Error::CostsDiffer { case, difference } => write!(
+                f,
+                "{case}: the optimizer's and the root finder's costs differ by {difference:e} \
+                 (relative; more than 1e-8)"
             ),
             Error::Domain(variant) => write!(f, "{variant} left the domain of the potential"),
             Error::Io(e) => write!(f, "writing the report: {e}"),

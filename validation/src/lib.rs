@@ -8,7 +8,8 @@
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
 //! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
 //! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
-//! [`work_precision`], [`long_run`]), which [`report`] runs and prints in one go.
+//! [`work_precision`], [`long_run`], [`planner_speed`]), which [`report`] runs and prints in
+//! one go.
 
 mod error;
 pub mod guard_cost;
@@ -17,6 +18,7 @@ pub mod long_run;
 #[path = "../../tests/common/models.rs"]
 pub mod models;
 pub mod peers;
+pub mod planner_speed;
 pub mod report;
 pub mod step_speed;
 pub mod systems;

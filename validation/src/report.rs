@@ -1,19 +1,24 @@
-//! The speed report: every figure of the README's "Speed against error" section from one run,
-//! the peers timed interleaved with `retract` (`examples/report.rs`).
+//! The speed report: every figure of the README's "Speed against error" section and the
+//! planner's speed figures from one run, the peers timed interleaved with `retract`
+//! (`examples/report.rs`).
 //!
 //! It writes, as markdown ready to paste: a header with the date (UTC) and the machine; the
 //! one-step table ([`crate::step_speed`]); the paper's 400-step run; the singularity guard
 //! ([`crate::guard_cost`]); the work-precision sweeps on the obstacle IVP with the times at
 //! a final error of 1e-8 and the line
 //! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <best/DOP853>`
-//! ([`crate::work_precision`]); and the long run ([`crate::long_run`]).
+//! ([`crate::work_precision`]); the long run ([`crate::long_run`]); and the planner
+//! ([`crate::planner_speed`]): solve time against N, the linear solvers and the warm re-solve
+//! at N = 400, the optimizer against the root finder with the line
+//! `ratios: one-disc cold <r>x, one-disc warm <r>x, se2 cold <r>x, se2 warm <r>x (target <= 1.2)`,
+//! and Richardson extrapolation.
 
 use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
 use crate::systems::{closest_approach, paper_system};
-use crate::{guard_cost, long_run, step_speed, work_precision};
+use crate::{guard_cost, long_run, planner_speed, step_speed, work_precision};
 
 /// How much the report measures: rounds and calls per sample of each part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,10 +35,14 @@ pub struct Size {
     pub sweep_rounds: usize,
     /// The horizon of the long run.
     pub long_run_end: f64,
+    /// Interleaved rounds of the planner's solve times against N and at N = 400.
+    pub planner_rounds: usize,
+    /// Interleaved rounds of the optimizer against the root finder and of the extrapolation.
+    pub race_rounds: usize,
 }
 
 impl Size {
-    /// The full report (about 10 s on a shared 2-core machine).
+    /// The full report (10 to 30 s on a shared 2-core machine, the planner 2 to 9 s of it).
     pub fn full() -> Self {
         Self {
             step_rounds: 300,
@@ -42,6 +51,8 @@ impl Size {
             run_calls: 3,
             sweep_rounds: 200,
             long_run_end: 1e5,
+            planner_rounds: 60,
+            race_rounds: 200,
         }
     }
 
@@ -55,6 +66,8 @@ impl Size {
             run_calls: 1,
             sweep_rounds: 2,
             long_run_end: 1e3,
+            planner_rounds: 2,
+            race_rounds: 2,
         }
     }
 }
@@ -64,6 +77,8 @@ impl Size {
 pub struct Summary {
     /// The times at a final error of 1e-8.
     pub at_target: work_precision::AtTarget,
+    /// The planner's measurements.
+    pub planner: planner_speed::PlannerSpeed,
     /// Wall time of the report in seconds.
     pub seconds: f64,
 }
@@ -92,9 +107,15 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     let at_target = work_precision_part(size, out)?;
     let long = long_run::long_runs(size.long_run_end)?;
     long_run::write_long_runs(out, &long, size.long_run_end)?;
+    let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
+    planner_speed::write_all(out, &planner)?;
     let seconds = started.elapsed().as_secs_f64();
     writeln!(out, "\nreport: {seconds:.1} s")?;
-    Ok(Summary { at_target, seconds })
+    Ok(Summary {
+        at_target,
+        planner,
+        seconds,
+    })
 }
 
 /// The work-precision part of [`run`]: the reference, the sweeps, the times at 1e-8.

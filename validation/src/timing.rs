@@ -44,6 +44,16 @@ impl<'a> Timed<'a> {
     }
 }
 
+/// The median over the rounds of `a`'s time over `b`'s in the same round, for two closures
+/// timed in the same [`interleaved`] rounds (a slower machine in some rounds cancels); the
+/// ratio of the best times if the samples do not pair up.
+pub fn paired_ratio(a: &Samples, b: &Samples) -> f64 {
+    if a.0.is_empty() || a.0.len() != b.0.len() {
+        return a.best() / b.best();
+    }
+    Samples(a.0.iter().zip(&b.0).map(|(a, b)| a / b).collect()).median()
+}
+
 /// A timed closure's name and its per-call times (ns).
 #[derive(Clone, Debug)]
 pub struct Row {
@@ -94,13 +104,21 @@ pub fn interleaved(rounds: usize, closures: &mut [Timed<'_>]) -> Vec<Row> {
         .collect()
 }
 
+/// Writes the head of a markdown table: `| a | b | ... |` and its rule `|---|---|...`.
+///
+/// # Errors
+/// The writer's.
+pub fn write_head(out: &mut dyn Write, columns: &[&str]) -> std::io::Result<()> {
+    writeln!(out, "| {} |", columns.join(" | "))?;
+    writeln!(out, "|{}", "---|".repeat(columns.len()))
+}
+
 /// Writes `rows` as a markdown table headed `| <what> | time |`, best times.
 ///
 /// # Errors
 /// The writer's.
 pub fn write_rows(out: &mut dyn Write, what: &str, rows: &[Row]) -> std::io::Result<()> {
-    writeln!(out, "| {what} | time |")?;
-    writeln!(out, "|---|---|")?;
+    write_head(out, &[what, "time"])?;
     for row in rows {
         writeln!(out, "| {} | {} |", row.name, format_ns(row.samples.best()))?;
     }

@@ -1,7 +1,9 @@
 //! The speed report at quick size: it runs, prints its header and tables, and its
 //! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <r>` line parses with
-//! r = best / DOP853 within the rounding of the printed figures. No timing is asserted.
+//! r = best / DOP853 within the rounding of the printed figures; the planner's tables and its
+//! `ratios: ...` line are there, with one ratio per race. No timing is asserted.
 
+use retract_validation::planner_speed::PlannerSpeed;
 use retract_validation::report::{self, Size, utc_date};
 use retract_validation::work_precision::time_at_error;
 
@@ -35,6 +37,11 @@ fn quick_report_prints_the_work_precision_line() {
         "| method | steps / tol | final error | wall time |",
         "| method | at 1e-8 |",
         "| method | step size / tol | steps | wall time |",
+        "| N | 100 | 200 | 400 | 800 | 1600 | 3200 |",
+        "| N = 400 | Newton iterations | time | vs `solve_reduced` |",
+        "| N = 400 | optimizer | root finder | ratio | best / best | iterations (optimizer, root finder) | \
+         cost difference |",
+        "| N | cost error | estimate | $p(0)$ error | iterations ($N$, $2N$, $4N$) | time |",
     ] {
         assert!(text.contains(table), "missing `{table}` in:\n{text}");
     }
@@ -60,6 +67,45 @@ fn quick_report_prints_the_work_precision_line() {
             .any(|l| l.starts_with("work-precision 1e-8 without the guard: ")),
         "{text}"
     );
+    planner_lines(&text, &summary.planner);
+}
+
+/// The planner's lines: one `ratios: ` line naming every race, the races as solved (both
+/// solvers to the same cost), every time measured.
+fn planner_lines(text: &str, planner: &PlannerSpeed) {
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("ratios: ")).collect();
+    assert_eq!(lines.len(), 1, "one ratios line in:\n{text}");
+    let cases: Vec<&str> = planner.races.iter().map(|r| r.case).collect();
+    assert_eq!(
+        cases,
+        ["one-disc cold", "one-disc warm", "se2 cold", "se2 warm"]
+    );
+    for race in &planner.races {
+        let printed = format!("{} {:.2}x", race.case, race.ratio());
+        assert!(lines[0].contains(&printed), "`{printed}` in {}", lines[0]);
+        assert!(race.cost_difference() < 1e-8, "{race:?}");
+    }
+    let size = Size::quick();
+    let solves = planner
+        .against_n
+        .iter()
+        .chain(&planner.at_400)
+        .map(|s| (s, size.planner_rounds))
+        .chain(
+            planner
+                .races
+                .iter()
+                .flat_map(|r| [&r.optimizer, &r.root])
+                .map(|s| (s, size.race_rounds)),
+        );
+    for (solve, rounds) in solves {
+        assert_eq!(solve.samples.0.len(), rounds, "{solve:?}");
+        assert!(solve.samples.best() > 0.0, "{solve:?}");
+    }
+    assert_eq!(planner.extrapolation.len(), 3);
+    for e in &planner.extrapolation {
+        assert!(e.cost_error < 1e-8 && e.samples.best() > 0.0, "{e:?}");
+    }
 }
 
 #[test]
