@@ -327,6 +327,20 @@ pub fn total_derivative(g: &mut Graph, d: &mut Differentiator, f: Id, n: usize, 
     acc
 }
 
+/// `roots` rewritten in the chart jet: every `Var::Jet { order: j, index: a }` of the function
+/// as written becomes `jet[j][a]`, an expression in the chart jet.
+pub fn substitute_jet(g: &mut Graph, roots: &[Id], jet: Vec<Vec<Id>>) -> Vec<Id> {
+    let map = move |_: &mut Graph, v: Var| match v {
+        Var::Jet { order, index } => Some(jet[order as usize][index as usize]),
+        _ => None,
+    };
+    let mut memo = HashMap::new();
+    roots
+        .iter()
+        .map(|&root| substitute(g, root, &map, &mut memo))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,11 +13,10 @@
 //! left-invariant L (one that reads only xi, ..., xi^(k-1)) is the same function of the chart
 //! jet for every centre.
 
+use crate::diff::substitute_jet;
 use crate::graph::{Graph, Id};
 use crate::signature::Signature;
-use crate::so3::{
-    body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates, substitute_body,
-};
+use crate::so3::{body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates};
 
 /// `roots` (L and its guarded expressions, in the arguments g, xi, ... of `sig`) rewritten
 /// in the chart jet: `Var::Jet { order: 0, index: e }` becomes g_e of the pose (R, p) and
@@ -49,6 +48,7 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
         }
         xi.push(acc);
     }
-    let rates = rates(g, xi, 6, sig.order);
-    substitute_body(g, roots, pose, rates)
+    let mut jet = vec![pose];
+    jet.extend(rates(g, xi, 6, sig.order));
+    substitute_jet(g, roots, jet)
 }

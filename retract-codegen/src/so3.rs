@@ -14,9 +14,7 @@
 //! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard. The
 //! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::se3`).
 
-use std::collections::HashMap;
-
-use crate::diff::{Differentiator, substitute, total_derivative};
+use crate::diff::{Differentiator, substitute_jet, total_derivative};
 use crate::graph::{Graph, Id, Var};
 use crate::signature::Signature;
 
@@ -128,26 +126,6 @@ pub(crate) fn rates(g: &mut Graph, xi: Vec<Id>, dim: usize, k: usize) -> Vec<Vec
     rates
 }
 
-/// `roots` rewritten by `arguments`: `Var::Jet { order: 0, index: e }` becomes
-/// `element[e]` and `Var::Jet { order: j, index: a }` (j >= 1) becomes `rates[j - 1][a]`.
-pub(crate) fn substitute_body(
-    g: &mut Graph,
-    roots: &[Id],
-    element: Vec<Id>,
-    rates: Vec<Vec<Id>>,
-) -> Vec<Id> {
-    let map = move |_: &mut Graph, v: Var| match v {
-        Var::Jet { order: 0, index } => Some(element[index as usize]),
-        Var::Jet { order, index } => Some(rates[order as usize - 1][index as usize]),
-        _ => None,
-    };
-    let mut memo = HashMap::new();
-    roots
-        .iter()
-        .map(|&root| substitute(g, root, &map, &mut memo))
-        .collect()
-}
-
 /// `roots` (L and its guarded expressions, in the arguments R, Omega, ... of `sig`)
 /// rewritten in the chart jet: `Var::Jet { order: 0, index: e }` becomes R_e of
 /// R = C Q(y) and `Var::Jet { order: j, index: a }` (j >= 1) becomes Omega^(j-1)_a. The
@@ -158,6 +136,7 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
     let q = chart_rotation(g, y);
     let r = mat_mul(g, &centre, &q).to_vec();
     let omega = body_angular_velocity(g, y, dy).to_vec();
-    let rates = rates(g, omega, 3, sig.order);
-    substitute_body(g, roots, r, rates)
+    let mut jet = vec![r];
+    jet.extend(rates(g, omega, 3, sig.order));
+    substitute_jet(g, roots, jet)
 }

@@ -11,9 +11,7 @@
 //! chart jet (D y^(i) = y^(i+1)). Every ambient jet variable of L (and of its guards) is
 //! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
 
-use std::collections::HashMap;
-
-use crate::diff::{Differentiator, substitute, total_derivative};
+use crate::diff::{Differentiator, substitute_jet, total_derivative};
 use crate::graph::{Func, Graph, Id, Var};
 use crate::signature::Signature;
 
@@ -58,15 +56,7 @@ fn ambient_jet(g: &mut Graph, chart: u32, k: usize) -> Vec<[Id; 3]> {
 pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
     let chart = sig.params.len() as u32;
     let jet = ambient_jet(g, chart, sig.order);
-    let map = move |_: &mut Graph, v: Var| match v {
-        Var::Jet { order, index } => Some(jet[order as usize][index as usize]),
-        _ => None,
-    };
-    let mut memo = HashMap::new();
-    roots
-        .iter()
-        .map(|&root| substitute(g, root, &map, &mut memo))
-        .collect()
+    substitute_jet(g, roots, jet.into_iter().map(|q| q.to_vec()).collect())
 }
 
 #[cfg(test)]
