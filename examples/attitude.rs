@@ -7,12 +7,13 @@
 //!    `docs/attitude_torque.svg`.
 //! 2. The same slew in Z-Y-X Euler angles, whose pitch passes 90 degrees, where the rates no
 //!    longer determine the rotation's velocity (gimbal lock).
-//! 3. The free rigid body through the same singularity: the Cayley midpoint map in moving
-//!    charts against the midpoint rule in Euler angles, and a long run of the former.
+//! 3. The free rigid body through the same singularity: the Cayley and the exponential
+//!    midpoint maps in moving charts against the midpoint rule in Euler angles, and long runs
+//!    of the former.
 //! 4. A fully actuated rigid body in SE(3), written in body coordinates (`se3`) and planned in
 //!    the product chart at the identity, flying among spheres while it turns, each sphere a
 //!    hard constraint; and a free body whose centre of mass is off the pose's origin, stepped
-//!    in moving SE(3) charts.
+//!    in moving SE(3) charts by the Cayley-midpoint and the exponential maps.
 //!
 //! Run: `cargo run --release --example attitude [-- boresight.svg torque.svg]`
 
@@ -30,9 +31,10 @@ use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::map::{self, DiscretizationMap, TaylorLift};
 use retract::nalgebra::{Isometry3, Matrix3, SVector, UnitQuaternion, Vector3};
 use retract::plot::{self, Curve, Scale};
-use retract::se3::{self, Se3Midpoint1};
+use retract::se3::{self, Se3ExpMidpoint1, Se3Midpoint1};
 use retract::so3::{
-    CayleyMidpoint, CayleyMidpoint1, chart_quaternion, orientation, recentre, world_momentum,
+    CayleyMidpoint, CayleyMidpoint1, ExpMidpoint, ExpMidpoint1, chart_quaternion, orientation,
+    recentre, world_momentum,
 };
 use retract::{LiftedSystem, NewtonOptions, StepOptions};
 
@@ -247,15 +249,30 @@ fn tumbling(long_steps: usize) -> Result<(), Box<dyn std::error::Error>> {
     );
     println!("|---|---|---|---|---|");
     let runs = [
-        ("generated", moving_charts(&CayleyMidpoint1, h, steps)?),
         (
+            "Cayley",
+            "generated",
+            moving_charts(&CayleyMidpoint1, h, steps)?,
+        ),
+        (
+            "Cayley",
             "run-time Taylor lift",
             moving_charts(&TaylorLift(CayleyMidpoint), h, steps)?,
         ),
+        (
+            "exponential",
+            "generated",
+            moving_charts(&ExpMidpoint1, h, steps)?,
+        ),
+        (
+            "exponential",
+            "run-time Taylor lift",
+            moving_charts(&TaylorLift(ExpMidpoint), h, steps)?,
+        ),
     ];
-    for (name, (end, orthogonality, drift, us)) in runs {
+    for (map, name, (end, orthogonality, drift, us)) in runs {
         println!(
-            "| Cayley midpoint ({name}), moving Gibbs charts | {:.2e} | {orthogonality:.1e} | {drift:.1e} | {us:.2} |",
+            "| {map} midpoint ({name}), moving Gibbs charts | {:.2e} | {orthogonality:.1e} | {drift:.1e} | {us:.2} |",
             end.angle_to(&exact)
         );
     }
@@ -268,34 +285,61 @@ fn tumbling(long_steps: usize) -> Result<(), Box<dyn std::error::Error>> {
             "| midpoint rule, Euler angles | failed at t = {at:.2} s (pitch {pitch:.2} deg): {e} | - | - | - |"
         ),
     }
-    let (_, orthogonality, drift, us) = moving_charts(&CayleyMidpoint1, h, long_steps)?;
-    println!(
-        "\nmoving charts, {long_steps} steps of {h} s: max abs(R^T R - I) = {orthogonality:.1e}, \
-         spatial momentum drift {drift:.1e} (relative), {us:.2} us/step"
-    );
-    let [rotation, mass_centre, orthogonality, drift, us] = se3_moving_charts(h, steps)?;
+    println!();
+    for (name, run) in [
+        ("Cayley", moving_charts(&CayleyMidpoint1, h, long_steps)?),
+        ("exponential", moving_charts(&ExpMidpoint1, h, long_steps)?),
+    ] {
+        let (_, orthogonality, drift, us) = run;
+        println!(
+            "{name} midpoint, moving charts, {long_steps} steps of {h} s: max abs(R^T R - I) = \
+             {orthogonality:.1e}, spatial momentum drift {drift:.1e} (relative), {us:.2} us/step"
+        );
+    }
     println!(
         "\nSE(3), the free body with its centre of mass off the pose's origin, moving product \
-         charts (Se3Midpoint1), T = {t} s, h = {h}: rotation error {rotation:.2e} rad, centre of \
-         mass error {mass_centre:.2e}, max abs(R^T R - I) = {orthogonality:.1e}, spatial momentum \
-         drift {drift:.1e}, {us:.2} us/step"
+         charts, T = {t} s, h = {h}:\n"
     );
-    let long = long_steps / 10;
-    let [_, mass_centre, orthogonality, drift, us] = se3_moving_charts(h, long)?;
     println!(
-        "SE(3), {long} steps of {h} s: centre of mass error {mass_centre:.2e}, max abs(R^T R - I) \
-         = {orthogonality:.1e}, spatial momentum drift {drift:.1e}, {us:.2} us/step"
+        "| map | rotation error (rad) | centre of mass error | max abs(R^T R - I) | momentum drift | us/step |"
     );
+    println!("|---|---|---|---|---|---|");
+    let long = long_steps / 10;
+    for (name, run, long_run) in [
+        (
+            "Se3Midpoint1 (Cayley x midpoint)",
+            se3_moving_charts(&Se3Midpoint1, h, steps)?,
+            se3_moving_charts(&Se3Midpoint1, h, long)?,
+        ),
+        (
+            "Se3ExpMidpoint1 (exponential)",
+            se3_moving_charts(&Se3ExpMidpoint1, h, steps)?,
+            se3_moving_charts(&Se3ExpMidpoint1, h, long)?,
+        ),
+    ] {
+        let [rotation, mass_centre, orthogonality, drift, us] = run;
+        println!(
+            "| {name}, {steps} steps | {rotation:.2e} | {mass_centre:.2e} | {orthogonality:.1e} | {drift:.1e} | {us:.2} |"
+        );
+        let [_, mass_centre, orthogonality, drift, us] = long_run;
+        println!(
+            "| {name}, {long} steps | - | {mass_centre:.2e} | {orthogonality:.1e} | {drift:.1e} | {us:.2} |"
+        );
+    }
     Ok(())
 }
 
 /// The free body with an offset centre of mass ([`attitude::offset_body`]) in moving SE(3)
 /// charts from the identity with body velocity ([`TUMBLE`], `v`), `steps` steps of `h` with
-/// the generated map `Se3Midpoint1`: the errors of the rotation (rad) and of the centre of
+/// the generated `map`: the errors of the rotation (rad) and of the centre of
 /// mass at the end against the exact motion (Euler's equations by RK4; a straight line), the
 /// largest |R^T R - I| and relative change of the spatial momentum, and the time per step in
 /// us.
-fn se3_moving_charts(h: f64, steps: usize) -> Result<[f64; 5], retract::Error> {
+fn se3_moving_charts(
+    map: &impl DiscretizationMap<6, 1>,
+    h: f64,
+    steps: usize,
+) -> Result<[f64; 5], retract::Error> {
     let (omega, v) = (Vector3::from(TUMBLE), Vector3::new(0.5, -0.2, 0.3));
     let (mut system, mut centre) = (attitude::offset_body(), Isometry3::identity());
     let mut jet = SVector::<f64, 12>::zeros();
@@ -307,7 +351,7 @@ fn se3_moving_charts(h: f64, steps: usize) -> Result<[f64; 5], retract::Error> {
     let (mut orthogonality, mut drift): (f64, f64) = (0.0, 0.0);
     let clock = Instant::now();
     for _ in 0..steps {
-        z = map::step(&system, &Se3Midpoint1, &z, h, &options)?.0;
+        z = map::step(&system, map, &z, h, &options)?.0;
         se3::recentre_system::<_, 1, 12>(&mut system, &mut centre, &mut z)?;
         let r = centre.rotation.to_rotation_matrix().into_inner();
         orthogonality = orthogonality.max((r.transpose() * r - Matrix3::identity()).amax());

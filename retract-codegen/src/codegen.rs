@@ -661,6 +661,10 @@ impl Emitter<'_> {
                 let (a, b) = (r(a), r(b));
                 quote!(#a.powf(#b))
             }
+            Node::Unary(Func::Stumpff(k), a) => {
+                let (a, k) = (r(a), u32::from(k));
+                quote!(::retract::__private::retract_core::stumpff(#k, #a))
+            }
             Node::Unary(f, a) => {
                 let a = r(a);
                 let m = format_ident!("{}", f.method());

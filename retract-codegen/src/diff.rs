@@ -140,6 +140,16 @@ impl Differentiator {
                     }
                     Func::Abs => g.unary(Func::Signum, a),
                     Func::Signum => return g.constant(0.0),
+                    // c_k' = (k c_{k+2} - c_{k+1}) / 2
+                    Func::Stumpff(k) => {
+                        let next = g.unary(Func::Stumpff(k + 1), a);
+                        let after = g.unary(Func::Stumpff(k + 2), a);
+                        let scaled = g.constant(f64::from(k));
+                        let scaled = g.mul(scaled, after);
+                        let difference = g.sub(scaled, next);
+                        let half = g.constant(0.5);
+                        g.mul(half, difference)
+                    }
                     _ => inverse_and_hyperbolic(g, f, node, a),
                 };
                 g.mul(outer, da)

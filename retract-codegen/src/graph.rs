@@ -58,6 +58,8 @@ pub enum Func {
     ExpM1,
     Log2,
     Log10,
+    /// The Stumpff function c_k (`retract::stumpff(k, s)`), entire in s.
+    Stumpff(u8),
 }
 
 impl Func {
@@ -83,6 +85,7 @@ impl Func {
             Func::ExpM1 => "exp_m1",
             Func::Log2 => "log2",
             Func::Log10 => "log10",
+            Func::Stumpff(_) => "stumpff",
         }
     }
 
@@ -107,8 +110,26 @@ impl Func {
             Func::ExpM1 => x.exp_m1(),
             Func::Log2 => x.log2(),
             Func::Log10 => x.log10(),
+            Func::Stumpff(k) => stumpff_series(k, x),
         }
     }
+}
+
+/// c_k(s) = sum_m (-s)^m / (2m + k)!, summed until a term no longer changes the sum: the
+/// compile-time value of a constant argument (which the generated code does not need; it
+/// calls `retract::stumpff`).
+fn stumpff_series(k: u8, s: f64) -> f64 {
+    let mut term = 1.0 / (2..=u32::from(k)).fold(1.0, |f, j| f * f64::from(j));
+    let mut sum = term;
+    for m in 0..500u32 {
+        let a = f64::from(2 * m + u32::from(k) + 1);
+        term *= -s / (a * (a + 1.0));
+        if sum + term == sum {
+            break;
+        }
+        sum += term;
+    }
+    sum
 }
 
 /// A node of the DAG.

@@ -34,7 +34,7 @@ pub(crate) use values::helper_signature_problem;
 /// The supported f64 methods.
 pub const METHODS: &str = "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2, hypot, recip, \
      abs, asin, acos, atan, sinh, cosh, cbrt, ln_1p, exp_m1, log2, log10, mul_add (and the \
-     functions smooth_max(a, b, eps) and smooth_min(a, b, eps) of `retract`)";
+     functions smooth_max(a, b, eps), smooth_min(a, b, eps) and stumpff(k, s) of `retract`)";
 
 /// Unrolled iterations allowed in one function (a guard against runaway expansion).
 const MAX_UNROLLED: usize = 10_000;
@@ -1014,6 +1014,9 @@ impl<'a> Lower<'a> {
         {
             return self.smooth_extremum(last == "smooth_max", c);
         }
+        if segments.last().is_some_and(|last| last == "stumpff") {
+            return self.stumpff(c);
+        }
         if segments.len() == 2 && segments[0] == "f64" && !c.args.is_empty() {
             let args: Vec<&Expr> = c.args.iter().collect();
             let receiver = self.expr(args[0]);
@@ -1061,6 +1064,29 @@ impl<'a> Lower<'a> {
         };
         let half = self.g.constant(0.5);
         self.g.mul(half, twice)
+    }
+
+    /// `stumpff(k, s)`: the Stumpff function c_k(s) (`retract::stumpff`) for an integer
+    /// literal k <= 100; entire, so without a guard.
+    fn stumpff(&mut self, c: &syn::ExprCall) -> Id {
+        if c.args.len() != 2 {
+            return self.error(c.span(), "`stumpff` takes 2 arguments: (k, s)");
+        }
+        let k = match &c.args[0] {
+            Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Int(k),
+                ..
+            }) => k.base10_parse::<u8>().ok().filter(|k| *k <= 100),
+            _ => None,
+        };
+        let Some(k) = k else {
+            return self.error(
+                c.args[0].span(),
+                "the order k of `stumpff(k, s)` must be an integer literal from 0 to 100",
+            );
+        };
+        let s = self.expr(&c.args[1]);
+        self.g.unary(Func::Stumpff(k), s)
     }
 
     fn apply(

@@ -72,6 +72,7 @@ pub mod output;
 pub mod reduced;
 pub mod se3;
 pub mod so3;
+pub mod special;
 pub mod sphere;
 pub mod split;
 pub mod split_methods;
@@ -100,6 +101,8 @@ pub use nalgebra;
 /// The float methods (`sqrt`, `powi`, ...) for `no_std` code: generated code imports it, and
 /// a `no_std` crate can too (with std the inherent methods take precedence).
 pub use num_traits::Float;
+
+pub use special::stumpff;
 
 /// A smooth maximum, $\max_\epsilon(a, b) = \tfrac12\big(a + b + \sqrt{(a - b)^2 +
 /// \epsilon^2}\big)$: within $|\epsilon|/2$ of $\max(a, b)$, smooth for $\epsilon \ne 0$. A

@@ -35,6 +35,9 @@ pub trait Scalar:
     fn constant(c: f64) -> Self;
     /// $1 / x$.
     fn recip(self) -> Self;
+    /// The Stumpff function $c_k(x)$ ([`crate::special`]), differentiated by
+    /// $c_k' = \tfrac12 (k\, c_{k+2} - c_{k+1})$.
+    fn stumpff(self, k: u32) -> Self;
 }
 
 impl Scalar for f64 {
@@ -46,6 +49,22 @@ impl Scalar for f64 {
     fn recip(self) -> Self {
         1.0 / self
     }
+    #[inline(always)]
+    fn stumpff(self, k: u32) -> Self {
+        crate::special::stumpff(k, self)
+    }
+}
+
+/// $c_k(s)$, $c_k'(s) = \tfrac12 (k c_{k+2} - c_{k+1})$ and
+/// $c_k''(s) = \tfrac14 (k (k+2) c_{k+4} - (2k+1) c_{k+3} + c_{k+2})$.
+fn stumpff_and_derivatives(k: u32, s: f64) -> [f64; 3] {
+    let c = |i: u32| crate::special::stumpff(k + i, s);
+    let kf = k as f64;
+    [
+        c(0),
+        0.5 * (kf * c(2) - c(1)),
+        0.25 * (kf * (kf + 2.0) * c(4) - (2.0 * kf + 1.0) * c(3) + c(2)),
+    ]
 }
 
 /// A second-order dual number in $V$ variables: $f$, its gradient $g$ and its Hessian $H$
@@ -124,6 +143,10 @@ impl<const V: usize> Scalar for Hyper<V> {
     fn recip(self) -> Self {
         let r = 1.0 / self.f;
         self.chain(r, -r * r, 2.0 * r * r * r)
+    }
+    fn stumpff(self, k: u32) -> Self {
+        let [c, d1, d2] = stumpff_and_derivatives(k, self.f);
+        self.chain(c, d1, d2)
     }
 }
 
@@ -228,6 +251,13 @@ impl<const V: usize> Scalar for Dual<V> {
             g: self.g.map(|g| -r * r * g),
         }
     }
+    fn stumpff(self, k: u32) -> Self {
+        let [c, d1, _] = stumpff_and_derivatives(k, self.f);
+        Self {
+            f: c,
+            g: self.g.map(|g| d1 * g),
+        }
+    }
 }
 
 impl<const V: usize> Add for Dual<V> {
@@ -279,6 +309,9 @@ impl<const V: usize> Neg for Dual<V> {
         self.scaled(-1.0)
     }
 }
+
+/// The longest series [`Scalar::stumpff`] lifts.
+const MAX_SERIES: usize = 16;
 
 /// A truncated Taylor series $\sum_{j < D} c_j t^j$ with coefficients in a [`Scalar`]:
 /// `c[j]` is $f^{(j)}(0) / j!$. Products are Cauchy products; the reciprocal follows
@@ -333,6 +366,39 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
             r[j] = -(r0 * sum);
         }
         Self { c: r }
+    }
+    /// $\sum_{j < D} c_k^{(j)}(a_0)\, \delta^j / j!$ for the series $a_0 + \delta$, with
+    /// $c_k^{(j)} = \sum_i \alpha_{j,i} c_{k+i}$ from the derivative rule.
+    fn stumpff(self, k: u32) -> Self {
+        const { assert!(D <= MAX_SERIES, "series of up to 16 terms") };
+        let a0 = self.c[0];
+        let mut delta = self;
+        delta.c[0] = T::constant(0.0);
+        // alpha[i]: the coefficient of c_{k+i} in c_k^(j), for i <= 2 j
+        let mut alpha = [0.0; 2 * MAX_SERIES + 1];
+        alpha[0] = 1.0;
+        let (mut power, mut factorial) = (Self::constant(1.0), 1.0);
+        let mut out = Self::constant(0.0);
+        for j in 0..D {
+            let mut derivative = T::constant(0.0);
+            for (i, a) in alpha.iter().enumerate().take(2 * j + 1) {
+                if *a != 0.0 {
+                    derivative = derivative + a0.stumpff(k + i as u32) * *a;
+                }
+            }
+            for (o, p) in out.c.iter_mut().zip(power.c) {
+                *o = *o + p * derivative / factorial;
+            }
+            power = power * delta;
+            factorial *= (j + 1) as f64;
+            // c_m -> (m c_{m+2} - c_{m+1}) / 2, from the top down
+            for i in (0..=2 * j).rev() {
+                let a = core::mem::take(&mut alpha[i]);
+                alpha[i + 2] += 0.5 * (k + i as u32) as f64 * a;
+                alpha[i + 1] -= 0.5 * a;
+            }
+        }
+        out
     }
 }
 
@@ -529,5 +595,61 @@ mod tests {
         let one = b * b.recip();
         assert!((one.c[0] - 1.0).abs() < 1e-15);
         assert!(one.c[1..].iter().all(|c| c.abs() < 1e-14), "{:?}", one.c);
+    }
+
+    /// The angle theta0 + t as a series, and its square.
+    fn angle<const D: usize>(theta0: f64) -> (Taylor<f64, D>, Taylor<f64, D>) {
+        let mut theta = Taylor::<f64, D>::constant(theta0);
+        theta.c[1] = 1.0;
+        (theta, theta * theta)
+    }
+
+    #[test]
+    fn stumpff_series_are_the_trigonometric_series() {
+        // c_0(theta^2) = cos theta and c_2(theta^2) theta^2 = 1 - cos theta along
+        // theta = theta0 + t: the coefficients are cos^(j)(theta0) / j!
+        for theta0 in [0.0, 0.4, 1.3, 2.9] {
+            let (theta, s) = angle::<8>(theta0);
+            let (c0, c2) = (s.stumpff(0), s.stumpff(2) * s);
+            let mut factorial = 1.0;
+            for j in 0..8 {
+                if j > 0 {
+                    factorial *= j as f64;
+                }
+                // cos^(j)(x) = cos(x + j pi / 2)
+                let exact = (theta0 + j as f64 * core::f64::consts::FRAC_PI_2).cos() / factorial;
+                assert!((c0.c[j] - exact).abs() < 1e-14, "{theta0} {j}: {}", c0.c[j]);
+                let one_minus = if j == 0 { 1.0 - theta0.cos() } else { -exact };
+                assert!((c2.c[j] - one_minus).abs() < 1e-14, "{theta0} {j}");
+            }
+            // c_1(theta^2) theta = sin theta, through the series' own product
+            let c1 = s.stumpff(1) * theta;
+            let exact = (theta0 + 3.0 * core::f64::consts::FRAC_PI_2).sin() / 6.0;
+            assert!((c1.c[3] - exact).abs() < 1e-14, "{theta0}");
+        }
+    }
+
+    #[test]
+    fn stumpff_of_dual_and_hyper_numbers_match_finite_differences() {
+        // c_3(x^2 + x y) at (0.8, -1.9)
+        let g = |x: f64, y: f64| (x * x + x * y).stumpff(3);
+        let (x0, y0) = (0.8, -1.9);
+        let v = {
+            let (x, y) = (Hyper::<2>::variable(x0, 0), Hyper::variable(y0, 1));
+            (x * x + x * y).stumpff(3)
+        };
+        let d = {
+            let (x, y) = (Dual::<2>::variable(x0, 0), Dual::variable(y0, 1));
+            (x * x + x * y).stumpff(3)
+        };
+        let e = 1e-4;
+        let gx = (g(x0 + e, y0) - g(x0 - e, y0)) / (2.0 * e);
+        let gy = (g(x0, y0 + e) - g(x0, y0 - e)) / (2.0 * e);
+        let gxy = (g(x0 + e, y0 + e) - g(x0 + e, y0 - e) - g(x0 - e, y0 + e) + g(x0 - e, y0 - e))
+            / (4.0 * e * e);
+        assert!((v.f - g(x0, y0)).abs() < 1e-16 && d.f == v.f);
+        assert!((v.g[0] - gx).abs() < 1e-8 && (v.g[1] - gy).abs() < 1e-8);
+        assert!(d.g == v.g, "{:?} {:?}", d.g, v.g);
+        assert!((v.h[0][1] - gxy).abs() < 1e-6 && v.h[0][1] == v.h[1][0]);
     }
 }

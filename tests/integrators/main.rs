@@ -11,6 +11,7 @@ mod compositions;
 mod core_scheme;
 mod discretization_maps;
 mod docs_figures;
+mod exp_maps;
 mod forced;
 mod fuzz_corpus;
 mod guard;

@@ -10,8 +10,8 @@ use retract::diagnostics::canonical_structure;
 use retract::map;
 use retract::nalgebra::{Isometry3, Matrix3, SVector, Translation3, UnitQuaternion, Vector3};
 use retract::se3::{
-    Se3Midpoint1, Se3Midpoint2, Se3System, centre_pose, centred, chart_point, pose,
-    recentre_system, spatial_momentum, transition,
+    Se3ExpMidpoint1, Se3ExpMidpoint2, Se3Midpoint1, Se3Midpoint2, Se3System, centre_pose, centred,
+    chart_point, pose, recentre_system, spatial_momentum, transition,
 };
 use retract::so3::{chart_quaternion, rotation};
 use retract::{
@@ -190,7 +190,7 @@ fn free_start(omega: &Vector3<f64>, v: &Vector3<f64>) -> SVector<f64, 12> {
 }
 
 /// The free body from the pose `start` with body velocity (omega, v), `steps` steps to `t`
-/// in moving charts, each a composition of order `order` of steps of the left-invariant map
+/// in moving charts, each a composition of order `order` of steps of the left-invariant `map`
 /// with the chart recentred after every stage: the final pose, the largest |R^T R - I| and
 /// the largest relative change of the spatial momentum (angular, linear).
 fn free_flight(
@@ -198,7 +198,7 @@ fn free_flight(
     (omega, v): (&Vector3<f64>, &Vector3<f64>),
     t: f64,
     steps: usize,
-    order: u32,
+    (order, map): (u32, &impl map::DiscretizationMap<6, 1>),
 ) -> (Isometry3<f64>, f64, f64) {
     let (mut system, mut centre) = (centred(&attitude::offset_body(), start), *start);
     let mut z = free_start(omega, v);
@@ -207,7 +207,7 @@ fn free_flight(
     let options = NewtonOptions::default();
     for _ in 0..steps {
         let mut stage = |z: &SVector<f64, 12>, h: f64| {
-            let (mut next, report) = map::step(&system, &Se3Midpoint1, z, h, &options)?;
+            let (mut next, report) = map::step(&system, map, z, h, &options)?;
             recentre_system::<_, 1, 12>(&mut system, &mut centre, &mut next)?;
             Ok((next, report))
         };
@@ -235,32 +235,55 @@ fn the_free_body_stays_on_the_group_conserves_its_momentum_and_converges_with_or
     let mass_centre =
         start.translation.vector + start.rotation * r + start.rotation * (v + omega.cross(&r)) * t;
     let position = mass_centre - rotation * r;
-    for (order, sizes) in [
-        (2, [50, 100, 200]),
-        (4, [10, 20, 40]),
-        (6, [10, 20, 40]),
-        (8, [5, 10, 20]),
-    ] {
+    let cases = [
+        ("Cayley", 2, [50, 100, 200]),
+        ("Cayley", 4, [10, 20, 40]),
+        ("Cayley", 6, [10, 20, 40]),
+        ("Cayley", 8, [5, 10, 20]),
+        ("exp", 2, [50, 100, 200]),
+        ("exp", 4, [10, 20, 40]),
+    ];
+    for (name, order, sizes) in cases {
         let errors = sizes.map(|steps| {
-            let (g, _, _) = free_flight(&start, (&omega, &v), t, steps, order);
+            let (g, _, _) = if name == "exp" {
+                free_flight(&start, (&omega, &v), t, steps, (order, &Se3ExpMidpoint1))
+            } else {
+                free_flight(&start, (&omega, &v), t, steps, (order, &Se3Midpoint1))
+            };
             g.rotation.angle_to(&rotation) + (g.translation.vector - position).norm()
         });
         println!(
-            "free body, order {order}, steps {sizes:?}: errors {:.3e}, {:.3e}, {:.3e}",
+            "free body, {name}, order {order}, steps {sizes:?}: errors {:.3e}, {:.3e}, {:.3e}",
             errors[0], errors[1], errors[2]
         );
         for w in errors.windows(2) {
             let observed = (w[0] / w[1]).log2();
             assert!(
                 (observed - f64::from(order)).abs() < 0.3,
-                "order {order}: observed {observed} from {errors:?}"
+                "{name}, order {order}: observed {observed} from {errors:?}"
             );
         }
     }
-    let (_, orthogonality, drift) = free_flight(&start, (&omega, &v), 100.0, 20_000, 2);
-    println!("20000 steps: |R^T R - I| <= {orthogonality:.1e}, momentum drift {drift:.1e}");
-    assert!(orthogonality <= 1e-13, "|R^T R - I| = {orthogonality:e}");
-    assert!(drift < 1e-11, "spatial momentum drift {drift:e}");
+    for (name, run) in [
+        (
+            "Cayley",
+            free_flight(&start, (&omega, &v), 100.0, 20_000, (2, &Se3Midpoint1)),
+        ),
+        (
+            "exp",
+            free_flight(&start, (&omega, &v), 100.0, 20_000, (2, &Se3ExpMidpoint1)),
+        ),
+    ] {
+        let (_, orthogonality, drift) = run;
+        println!(
+            "{name}, 20000 steps: |R^T R - I| <= {orthogonality:.1e}, momentum drift {drift:.1e}"
+        );
+        assert!(
+            orthogonality <= 1e-13,
+            "{name}: |R^T R - I| = {orthogonality:e}"
+        );
+        assert!(drift < 1e-11, "{name}: spatial momentum drift {drift:e}");
+    }
 }
 
 #[test]
@@ -353,25 +376,45 @@ fn the_order_2_flight_recentres_exactly_and_conserves_its_spatial_momentum() {
     assert!(drift < 1e-11, "spatial momentum drift {drift:e}");
 }
 
-#[test]
-fn the_steps_and_the_change_of_chart_are_symplectic() {
+/// |D^T J D - J| of the steps of `maps` (orders 1 and 2) for the offset free body and the
+/// flight at random states, and the flight's state.
+fn symplecticity(
+    maps: (
+        &impl map::DiscretizationMap<6, 1>,
+        &impl map::DiscretizationMap<6, 2>,
+    ),
+) -> (f64, f64, SVector<f64, 24>) {
     let options = NewtonOptions::default();
-    // the step of the left-invariant map, k = 1 (offset free body) and k = 2 (the flight)
     let system = centred(&attitude::offset_body(), &random_pose(4));
     let z1 = system.legendre(&SVector::<f64, 12>::from_fn(|i, _| {
         random(20 + i as u64 / 3, 0.8)[i % 3]
     }));
-    let d = map::step_map_derivative(&system, &Se3Midpoint1, &z1, 0.1, &options).expect("regular");
+    let d = map::step_map_derivative(&system, maps.0, &z1, 0.1, &options).expect("regular");
     let j12 = canonical_structure::<12>();
     let e1 = (d.transpose() * j12 * d - j12).amax();
     let flight = centred(&attitude::flight_body(), &random_pose(5));
     let z2 = flight.legendre(&SVector::<f64, 24>::from_fn(|i, _| {
         random(30 + i as u64 / 3, 0.5)[i % 3]
     }));
-    let d = map::step_map_derivative(&flight, &Se3Midpoint2, &z2, 0.05, &options).expect("regular");
+    let d = map::step_map_derivative(&flight, maps.1, &z2, 0.05, &options).expect("regular");
     let j24 = canonical_structure::<24>();
-    let e2 = (d.transpose() * j24 * d - j24).amax();
-    assert!(e1 < 1e-12 && e2 < 1e-11, "|D^T J D - J| = {e1:e}, {e2:e}");
+    (e1, (d.transpose() * j24 * d - j24).amax(), z2)
+}
+
+#[test]
+fn the_steps_and_the_change_of_chart_are_symplectic() {
+    // the steps of the left-invariant maps, k = 1 (offset free body) and k = 2 (the flight)
+    let (e1, e2, z2) = symplecticity((&Se3Midpoint1, &Se3Midpoint2));
+    assert!(
+        e1 < 1e-12 && e2 < 1e-11,
+        "Cayley: |D^T J D - J| = {e1:e}, {e2:e}"
+    );
+    let (e1, e2, _) = symplecticity((&Se3ExpMidpoint1, &Se3ExpMidpoint2));
+    assert!(
+        e1 < 1e-12 && e2 < 1e-11,
+        "exp: |D^T J D - J| = {e1:e}, {e2:e}"
+    );
+    let j24 = canonical_structure::<24>();
     // the change of chart (central differences), inverted by the opposite one
     let (a, b) = (random(40, 0.7), random(41, 2.0));
     let d = jacobian(|z| transition::<2, 24>(&a, &b, z).expect("inside"), &z2);

@@ -1,9 +1,9 @@
 //! SO(3) in one Gibbs chart: the free rigid body L = 1/2 Omega . J Omega written with the
 //! chart's body velocity Omega = 2 (y' - y x y') / (1 + |y|^2), stepped by the Cayley
-//! midpoint map of the group (`retract::so3::CayleyMidpoint`, lifted by `TaylorLift`). The
-//! map is a discretization map, the step is symplectic, conserves the spatial angular
-//! momentum to rounding (left equivariance), and converges with order 2 to an RK4 solution
-//! of Euler's equations with quaternion kinematics.
+//! midpoint map of the group (`retract::so3::CayleyMidpoint`, lifted by `TaylorLift`) and by
+//! the exponential one (`ExpMidpoint1`). The Cayley map is a discretization map; both steps
+//! are symplectic, conserve the spatial angular momentum to rounding (left equivariance), and
+//! converge with order 2 to an RK4 solution of Euler's equations with quaternion kinematics.
 
 #[path = "../../examples/common/attitude.rs"]
 pub(crate) mod attitude;
@@ -11,8 +11,8 @@ pub(crate) mod attitude;
 use retract::diagnostics::canonical_structure;
 use retract::lifted::Blocks;
 use retract::map::{self, DiscretizationMap, TaylorLift};
-use retract::nalgebra::{SVector, Vector3};
-use retract::so3::{CayleyMidpoint, parts, rotation, spatial_momentum};
+use retract::nalgebra::{SMatrix, SVector, Vector3};
+use retract::so3::{CayleyMidpoint, ExpMidpoint1, parts, rotation, spatial_momentum};
 use retract::{LiftedSystem, NewtonOptions};
 
 const J: [f64; 3] = attitude::INERTIA;
@@ -111,38 +111,53 @@ fn the_spatial_momentum_is_conserved_and_the_step_is_symplectic() {
             .fold(0.0, f64::max);
         largest / m0.amax()
     };
+    // the Cayley and the exponential midpoint maps
     let states = run(0.005, 400);
     let cayley = drift(&states);
-    assert!(cayley < 1e-12, "momentum drift {cayley:e}");
+    let exp = drift(&run_with(&ExpMidpoint1, 0.005, 400));
+    assert!(
+        cayley < 1e-12 && exp < 1e-12,
+        "momentum drift {cayley:e}, {exp:e}"
+    );
     // the chart's own midpoint rule is symplectic too, but not equivariant: it drifts
     let theta = drift(&run_with(&map::ThetaMap { theta: 0.5 }, 0.005, 400));
     assert!(theta > 1e-8, "theta map drift {theta:e}");
-    let d = map::step_map_derivative(
-        &system(),
-        &TaylorLift(CayleyMidpoint),
-        &states[7],
-        0.1,
-        &NewtonOptions::default(),
-    )
-    .expect("regular");
-    let j = canonical_structure::<6>();
-    let error = (d.transpose() * j * d - j).amax();
-    assert!(error < 1e-12, "|D^T J D - J| = {error:e}");
+    let symplecticity = |map: &dyn Fn(&SVector<f64, 6>) -> SMatrix<f64, 6, 6>| {
+        let (d, j) = (map(&states[7]), canonical_structure::<6>());
+        (d.transpose() * j * d - j).amax()
+    };
+    let options = NewtonOptions::default();
+    let errors = [
+        symplecticity(&|z| {
+            map::step_map_derivative(&system(), &TaylorLift(CayleyMidpoint), z, 0.1, &options)
+                .expect("regular")
+        }),
+        symplecticity(&|z| {
+            map::step_map_derivative(&system(), &ExpMidpoint1, z, 0.1, &options).expect("regular")
+        }),
+    ];
+    assert!(
+        errors.iter().all(|e| *e < 1e-12),
+        "|D^T J D - J| = {errors:?}"
+    );
 }
 
 #[test]
-fn the_cayley_midpoint_step_has_order_2() {
+fn the_cayley_and_exponential_midpoint_steps_have_order_2() {
     let t = 1.0;
     let exact = reference(t, 20_000);
-    let errors = [20, 40, 80].map(|n| {
-        let z = run(t / n as f64, n)[n];
+    let cayley = [20, 40, 80].map(|n| (parts(&run(t / n as f64, n)[n]).0 - exact).amax());
+    let exp = [20, 40, 80].map(|n| {
+        let z = run_with(&ExpMidpoint1, t / n as f64, n)[n];
         (parts(&z).0 - exact).amax()
     });
-    for pair in errors.windows(2) {
-        let observed = (pair[0] / pair[1]).log2();
-        assert!(
-            (observed - 2.0).abs() < 0.1,
-            "order {observed} ({errors:?})"
-        );
+    for errors in [cayley, exp] {
+        for pair in errors.windows(2) {
+            let observed = (pair[0] / pair[1]).log2();
+            assert!(
+                (observed - 2.0).abs() < 0.1,
+                "order {observed} ({errors:?})"
+            );
+        }
     }
 }
