@@ -463,6 +463,50 @@ impl Graph {
     }
 }
 
+impl Graph {
+    /// The degree of `id` as a polynomial in the jet (`Var::Jet`), with parameters, slice
+    /// elements and named constants as constants: `None` where it is not a polynomial
+    /// (a jet-dependent denominator, function, `powf`, `atan2`, `hypot`, a negative power, a
+    /// sum over a slice or another symbol) or its degree exceeds `cap`.
+    pub fn jet_degree(&self, id: Id, cap: u32) -> Option<u32> {
+        let mut memo: HashMap<Id, Option<u32>> = HashMap::new();
+        self.degree_memo(id, cap, &mut memo)
+    }
+
+    fn degree_memo(&self, id: Id, cap: u32, memo: &mut HashMap<Id, Option<u32>>) -> Option<u32> {
+        if let Some(d) = memo.get(&id) {
+            return *d;
+        }
+        let mut of = |c: Id| self.degree_memo(c, cap, memo);
+        let degree = match *self.node(id) {
+            Node::Const(_) | Node::Named(_) => Some(0),
+            Node::Var(Var::Jet { .. }) => Some(1),
+            Node::Var(Var::Param { .. } | Var::Elem { .. }) => Some(0),
+            Node::Var(_) | Node::Sum { .. } => None,
+            Node::Add(a, b) | Node::Sub(a, b) => of(a).zip(of(b)).map(|(a, b)| a.max(b)),
+            Node::Mul(a, b) => of(a).zip(of(b)).map(|(a, b)| a + b),
+            Node::Neg(a) => of(a),
+            Node::Powi(a, n) => match (of(a), u32::try_from(n)) {
+                (Some(0), _) => Some(0),
+                (Some(d), Ok(n)) => d.checked_mul(n),
+                _ => None,
+            },
+            Node::Div(a, b) => match (of(a), of(b)) {
+                (Some(d), Some(0)) => Some(d),
+                _ => None,
+            },
+            Node::Unary(_, a) => of(a).filter(|d| *d == 0),
+            Node::Powf(a, b) | Node::Atan2(a, b) | Node::Hypot(a, b) => of(a)
+                .zip(of(b))
+                .filter(|(a, b)| *a == 0 && *b == 0)
+                .map(|_| 0),
+        };
+        let degree = degree.filter(|d| *d <= cap);
+        memo.insert(id, degree);
+        degree
+    }
+}
+
 /// The children of a node, in order.
 pub fn children(node: &Node) -> Vec<Id> {
     match *node {
@@ -506,6 +550,35 @@ pub mod tests {
 
     fn q(g: &mut Graph, i: u32) -> Id {
         g.var(Var::Jet { order: 0, index: i })
+    }
+
+    #[test]
+    fn jet_degrees_of_polynomials_and_the_rest() {
+        let mut g = Graph::default();
+        let (x, y) = (q(&mut g, 0), q(&mut g, 1));
+        let r = g.var(Var::Param { param: 0, index: 0 });
+        // x^2 + y^2 - r^2, and (x - r) / r
+        let (x2, y2, r2) = (g.powi(x, 2), g.powi(y, 2), g.powi(r, 2));
+        let sum = g.add_op(x2, y2);
+        let disc = g.sub(sum, r2);
+        let shifted = g.sub(x, r);
+        let scaled = g.div(shifted, r);
+        assert_eq!(g.jet_degree(disc, 2), Some(2));
+        assert_eq!(g.jet_degree(scaled, 2), Some(1));
+        // x^3 is above the cap; 1 / x, sin x and x^-1 are not polynomials; sin r is constant
+        let cube = g.powi(x, 3);
+        assert_eq!(g.jet_degree(cube, 2), None);
+        assert_eq!(g.jet_degree(cube, 3), Some(3));
+        let one = g.constant(1.0);
+        let inverse = g.div(one, x);
+        let sine = g.unary(Func::Sin, x);
+        let negative = g.powi(x, -1);
+        let constant = g.unary(Func::Sin, r);
+        assert_eq!(g.jet_degree(inverse, 2), None);
+        assert_eq!(g.jet_degree(sine, 2), None);
+        assert_eq!(g.jet_degree(negative, 2), None);
+        let product = g.mul(constant, disc);
+        assert_eq!(g.jet_degree(product, 2), Some(2));
     }
 
     #[test]

@@ -43,6 +43,11 @@ pub struct StepOptions {
     /// continuous motion between $x_0$ and $x_1$ is not checked. A step shorter than the
     /// spacing (the common case for small $h$) costs one max-norm of $x_1 - x_0$ beyond the
     /// three points; a longer one about one more `check_domain` per piece.
+    ///
+    /// Where every guarded expression is a polynomial of degree at most 2 in the jet
+    /// ([`LiftedSystem::guards_quadratic`], e.g. $x^2 + y^2 - r^2$ of a disc), the three points
+    /// decide the chord exactly (the quadratic through them is the expression) and no piece
+    /// is checked.
     pub chord_spacing: f64,
     /// The most pieces a step's chord is cut into (see [`Self::chord_spacing`]); 16 by
     /// default, at most [`MAX_CHORD_PIECES`]; 0 or 1 check only the three points.
@@ -156,7 +161,9 @@ pub const MAX_CHORD_PIECES: u32 = 1024;
 
 /// The domain check of a step from `z0` to the unknowns `w`: the three points of
 /// [`LiftedSystem::check_domain`], then the pieces of the chord of
-/// [`StepOptions::chord_spacing`] when the chord is longer than the spacing.
+/// [`StepOptions::chord_spacing`] when the chord is longer than the spacing, unless the
+/// three points decide the chord ([`LiftedSystem::guards_quadratic`], with $\theta$ not
+/// within $10^{-3}$ of an end).
 ///
 /// # Errors
 /// The first violated condition.
@@ -171,6 +178,10 @@ where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     system.check_domain(z0, w, options.theta)?;
+    // quadratic guards: the three points decide the chord (`guards_quadratic`)
+    if system.guards_quadratic() && options.theta > 1e-3 && options.theta < 1.0 - 1e-3 {
+        return Ok(());
+    }
     // |x1 - x0|_inf over the jet (the first half of the state); NaN compares false and is
     // caught by the three points above
     let half = S / 2;

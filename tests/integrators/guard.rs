@@ -8,12 +8,18 @@ use retract::nalgebra::SVector;
 use retract::{DomainKind, Error, LiftedSystem, StepOptions, step, trajectory};
 
 #[higher_order_lagrangian(order = 2)]
-fn disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64, r: f64) -> f64 {
+pub(crate) fn disc(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64, r: f64) -> f64 {
     0.5 * (ddq[0].powi(2) + ddq[1].powi(2)) + tau / (q[0].powi(2) + q[1].powi(2) - r * r)
 }
 
 #[higher_order_lagrangian(order = 2)]
-fn discs(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64, obstacles: &[[f64; 3]]) -> f64 {
+pub(crate) fn discs(
+    q: [f64; 2],
+    _dq: [f64; 2],
+    ddq: [f64; 2],
+    tau: f64,
+    obstacles: &[[f64; 3]],
+) -> f64 {
     let mut l = 0.5 * (ddq[0].powi(2) + ddq[1].powi(2));
     for o in obstacles {
         l += tau / ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) - o[2] * o[2]);

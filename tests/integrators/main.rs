@@ -15,6 +15,7 @@ mod exp_maps;
 mod forced;
 mod fuzz_corpus;
 mod guard;
+mod guard_quadratic;
 mod guard_singular;
 mod hard_cases;
 mod helpers;

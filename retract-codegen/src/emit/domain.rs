@@ -43,7 +43,21 @@ pub(crate) fn check_domain(e: &Emission<'_>) -> Option<TokenStream> {
          sign, and arguments of sqrt (>= 0), ln and powf (> 0): {}.",
         list.join(", ")
     );
+    // every guard quadratic (or linear) in the jet: the three samples decide the chord
+    let quadratic = guards
+        .iter()
+        .all(|(guard, _)| e.g.jet_degree(guard.node, 2).is_some());
+    let guards_quadratic = quadratic.then(|| {
+        quote! {
+            /// Every guarded expression is a polynomial of degree at most 2 in the jet: the
+            /// three samples of `check_domain` decide the chord.
+            fn guards_quadratic(&self) -> bool {
+                true
+            }
+        }
+    });
     Some(quote! {
+        #guards_quadratic
         #[doc = #doc]
         fn check_domain(
             &self,
