@@ -8,10 +8,11 @@
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
 //! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
 //! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
-//! [`work_precision`], [`long_run`], [`planner_speed`]), which [`report`] runs and prints in
-//! one go.
+//! [`work_precision`], [`long_run`], [`planner_speed`], [`expansion_cost`]), which [`report`]
+//! runs and prints in one go.
 
 mod error;
+pub mod expansion_cost;
 pub mod guard_cost;
 pub mod long_run;
 /// The Lagrangians shared with `retract`'s integration tests (`tests/common/models.rs`).

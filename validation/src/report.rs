@@ -11,14 +11,15 @@
 //! ([`crate::planner_speed`]): solve time against N, the linear solvers and the warm re-solve
 //! at N = 400, the optimizer against the root finder with the line
 //! `ratios: one-disc cold <r>x, one-disc warm <r>x, se2 cold <r>x, se2 warm <r>x (target <= 1.2)`,
-//! and Richardson extrapolation.
+//! and Richardson extrapolation; and the compile-time cost of the expansion
+//! ([`crate::expansion_cost`]).
 
 use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
 use crate::systems::{closest_approach, paper_system};
-use crate::{guard_cost, long_run, planner_speed, step_speed, work_precision};
+use crate::{expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision};
 
 /// How much the report measures: rounds and calls per sample of each part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +40,8 @@ pub struct Size {
     pub planner_rounds: usize,
     /// Interleaved rounds of the optimizer against the root finder and of the extrapolation.
     pub race_rounds: usize,
+    /// Expansions of each case of the compile-time cost.
+    pub expansion_rounds: usize,
 }
 
 impl Size {
@@ -53,6 +56,7 @@ impl Size {
             long_run_end: 1e5,
             planner_rounds: 60,
             race_rounds: 200,
+            expansion_rounds: 5,
         }
     }
 
@@ -68,6 +72,7 @@ impl Size {
             long_run_end: 1e3,
             planner_rounds: 2,
             race_rounds: 2,
+            expansion_rounds: 1,
         }
     }
 }
@@ -109,6 +114,8 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     long_run::write_long_runs(out, &long, size.long_run_end)?;
     let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
+    let expansions = expansion_cost::expansions(size.expansion_rounds)?;
+    expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
     let seconds = started.elapsed().as_secs_f64();
     writeln!(out, "\nreport: {seconds:.1} s")?;
     Ok(Summary {

@@ -1,7 +1,8 @@
 //! The speed report at quick size: it runs, prints its header and tables, and its
 //! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <r>` line parses with
 //! r = best / DOP853 within the rounding of the printed figures; the planner's tables and its
-//! `ratios: ...` line are there, with one ratio per race. No timing is asserted.
+//! `ratios: ...` line are there, with one ratio per race; the compile-time table is there. No
+//! timing is asserted.
 
 use retract_validation::planner_speed::PlannerSpeed;
 use retract_validation::report::{self, Size, utc_date};
@@ -42,6 +43,7 @@ fn quick_report_prints_the_work_precision_line() {
         "| N = 400 | optimizer | root finder | ratio | best / best | iterations (optimizer, root finder) | \
          cost difference |",
         "| N | cost error | estimate | $p(0)$ error | iterations ($N$, $2N$, $4N$) | time |",
+        "| n | barrier terms | lines | expansion |",
     ] {
         assert!(text.contains(table), "missing `{table}` in:\n{text}");
     }
