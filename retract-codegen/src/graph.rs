@@ -110,26 +110,49 @@ impl Func {
             Func::ExpM1 => x.exp_m1(),
             Func::Log2 => x.log2(),
             Func::Log10 => x.log10(),
-            Func::Stumpff(k) => stumpff_series(k, x),
+            Func::Stumpff(k) => stumpff_value(k, x),
         }
     }
 }
 
-/// c_k(s) = sum_m (-s)^m / (2m + k)!, summed until a term no longer changes the sum: the
-/// compile-time value of a constant argument (which the generated code does not need; it
-/// calls `retract::stumpff`).
-fn stumpff_series(k: u8, s: f64) -> f64 {
-    let mut term = 1.0 / (2..=u32::from(k)).fold(1.0, |f, j| f * f64::from(j));
-    let mut sum = term;
-    for m in 0..500u32 {
-        let a = f64::from(2 * m + u32::from(k) + 1);
-        term *= -s / (a * (a + 1.0));
-        if sum + term == sum {
-            break;
+/// c_k(s) = sum_m (-s)^m / (2m + k)! at compile time (a constant argument; the generated
+/// code calls `retract::stumpff`): the series, summed until a term no longer changes the sum,
+/// where |s| <= max(4, (k+1)(k+2)) (its terms fall from the first, little cancels); beyond,
+/// c_0 = cos x, c_1 = sin x / x or c_2 = 2 sin(x/2)^2 / s (x = sqrt s; cosh and sinh for
+/// s < 0) raised by c_{j+2} = (1/j! - c_j) / s, stable there.
+fn stumpff_value(k: u8, s: f64) -> f64 {
+    let k = u32::from(k);
+    let inverse_factorial = |j: u32| 1.0 / (2..=j).fold(1.0, |f, i| f * f64::from(i));
+    let kf = f64::from(k);
+    if s.abs() <= 4f64.max((kf + 1.0) * (kf + 2.0)) || s.is_nan() {
+        let mut term = inverse_factorial(k);
+        let mut sum = term;
+        for m in 0..500u32 {
+            let a = f64::from(2 * m + k + 1);
+            term *= -s / (a * (a + 1.0));
+            if sum + term == sum {
+                break;
+            }
+            sum += term;
         }
-        sum += term;
+        return sum;
     }
-    sum
+    let x = s.abs().sqrt();
+    let (c0, c1, c2) = if s > 0.0 {
+        (x.cos(), x.sin() / x, 2.0 * (x / 2.0).sin().powi(2) / s)
+    } else {
+        (x.cosh(), x.sinh() / x, -2.0 * (x / 2.0).sinh().powi(2) / s)
+    };
+    let (mut j, mut c) = match k {
+        0 => (0, c0),
+        _ if k % 2 == 1 => (1, c1),
+        _ => (2, c2),
+    };
+    while j < k {
+        c = (inverse_factorial(j) - c) / s;
+        j += 2;
+    }
+    c
 }
 
 /// A node of the DAG.
@@ -550,6 +573,17 @@ pub mod tests {
 
     fn q(g: &mut Graph, i: u32) -> Id {
         g.var(Var::Jet { order: 0, index: i })
+    }
+
+    #[test]
+    fn compile_time_stumpff_values_are_the_closed_forms() {
+        let value = |k, s| Func::Stumpff(k).eval(s);
+        assert!((value(0, 2500.0) - 50f64.cos()).abs() < 1e-14);
+        assert!((value(1, 1e4) - 100f64.sin() / 100.0).abs() < 1e-16);
+        assert!((value(2, 0.49) - (1.0 - 0.7f64.cos()) / 0.49).abs() < 1e-15);
+        assert!((value(3, -16.0) - (4f64.sinh() - 4.0) / 64.0).abs() < 1e-15);
+        assert!((value(4, 1e6) - (1.0 / 2.0 - value(2, 1e6)) / 1e6).abs() < 1e-20);
+        assert_eq!(value(3, 0.0), 1.0 / 6.0);
     }
 
     #[test]

@@ -44,8 +44,9 @@ const INVERSE_FACTORIALS: [f64; TABLE] = {
     t
 };
 
-/// The Stumpff function $c_k(s)$ (module docs), to a few units in the last place for
-/// $|s| \le 100$.
+/// The Stumpff function $c_k(s)$ (module docs): to a few units in the last place where it is
+/// well conditioned, for $|s| \le 100$; for $s < -709^2$ the closed forms overflow and the
+/// value is $+\infty$.
 ///
 /// Where $|s| \le \max(4, (k+1)(k+2))$ the series is summed until its terms no longer change
 /// the sum: its terms fall from the first or nearly so, so little cancels. Beyond, $c_0$ and
@@ -73,11 +74,11 @@ pub fn stumpff(k: u32, s: f64) -> f64 {
 /// $\sum_m (-s)^m / (2m + k)!$ until a term no longer changes the sum.
 fn series(k: u32, s: f64) -> f64 {
     let k = k as usize;
-    let mut term = if k < TABLE {
-        INVERSE_FACTORIALS[k]
-    } else {
-        0.0
+    // 1/k! underflows from k = 171 on, and the terms with it
+    let Some(&first) = INVERSE_FACTORIALS.get(k) else {
+        return 0.0;
     };
+    let mut term = first;
     let mut sum = term;
     for m in 0..200 {
         let a = 2 * m + k + 1;
@@ -100,13 +101,20 @@ fn series(k: u32, s: f64) -> f64 {
 fn raised(k: u32, s: f64) -> f64 {
     use num_traits::Float;
     let x = Float::sqrt(s.abs());
-    let (c0, c1) = if s > 0.0 {
-        (Float::cos(x), Float::sin(x) / x)
+    // c_0 and c_1 in closed form, and c_2 = 2 sin(x/2)^2 / s (2 sinh(x/2)^2 / |s| for s < 0),
+    // which does not cancel where cos x is near 1
+    let (c0, c1, c2) = if s > 0.0 {
+        let half = Float::sin(x / 2.0);
+        (Float::cos(x), Float::sin(x) / x, 2.0 * half * half / s)
     } else {
-        (Float::cosh(x), Float::sinh(x) / x)
+        let half = Float::sinh(x / 2.0);
+        (Float::cosh(x), Float::sinh(x) / x, -2.0 * half * half / s)
     };
-    let mut j = k % 2;
-    let mut c = if j == 0 { c0 } else { c1 };
+    let (mut j, mut c) = match k {
+        0 => (0, c0),
+        _ if k % 2 == 1 => (1, c1),
+        _ => (2, c2),
+    };
     while j < k {
         let inverse = if (j as usize) < TABLE {
             INVERSE_FACTORIALS[j as usize]

@@ -36,7 +36,8 @@ pub trait Scalar:
     /// $1 / x$.
     fn recip(self) -> Self;
     /// The Stumpff function $c_k(x)$ ([`crate::special`]), differentiated by
-    /// $c_k' = \tfrac12 (k\, c_{k+2} - c_{k+1})$.
+    /// $c_k' = \tfrac12 (k\, c_{k+2} - c_{k+1})$. On [`Taylor`] series of up to 16 terms
+    /// (a longer series does not compile).
     fn stumpff(self, k: u32) -> Self;
 }
 
@@ -58,7 +59,7 @@ impl Scalar for f64 {
 /// $c_k(s)$, $c_k'(s) = \tfrac12 (k c_{k+2} - c_{k+1})$ and
 /// $c_k''(s) = \tfrac14 (k (k+2) c_{k+4} - (2k+1) c_{k+3} + c_{k+2})$.
 fn stumpff_and_derivatives(k: u32, s: f64) -> [f64; 3] {
-    let c = |i: u32| crate::special::stumpff(k + i, s);
+    let c = |i: u32| crate::special::stumpff(k.saturating_add(i), s);
     let kf = k as f64;
     [
         c(0),
@@ -383,7 +384,7 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
             let mut derivative = T::constant(0.0);
             for (i, a) in alpha.iter().enumerate().take(2 * j + 1) {
                 if *a != 0.0 {
-                    derivative = derivative + a0.stumpff(k + i as u32) * *a;
+                    derivative = derivative + a0.stumpff(k.saturating_add(i as u32)) * *a;
                 }
             }
             for (o, p) in out.c.iter_mut().zip(power.c) {
@@ -394,7 +395,7 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
             // c_m -> (m c_{m+2} - c_{m+1}) / 2, from the top down
             for i in (0..=2 * j).rev() {
                 let a = core::mem::take(&mut alpha[i]);
-                alpha[i + 2] += 0.5 * (k + i as u32) as f64 * a;
+                alpha[i + 2] += 0.5 * (f64::from(k) + i as f64) * a;
                 alpha[i + 1] -= 0.5 * a;
             }
         }

@@ -97,3 +97,23 @@ fn quadratic_guards_decide_the_chord_as_dense_sampling_does() {
         );
     }
 }
+
+#[test]
+fn a_chord_from_the_boundary_into_the_disc_is_rejected_and_one_leaving_it_is_not() {
+    // the first sample within rounding of the circle (|q|^2 - 1 = 1e-13), where the fit
+    // cannot tell a touch from rounding: a chord that dips to -0.0099 is still rejected
+    let system = Disc::new(0.01, 1.0);
+    let edge = 1.0 + 5e-14;
+    let z0 = SVector::<f64, 8>::from([edge, 0.0, 0.1, 0.2, 0.3, 0.1, 0.2, 0.3]);
+    let to = |end: [f64; 2]| {
+        let mut w = SVector::<f64, 10>::from_element(0.1);
+        (w[0], w[1]) = (end[0], end[1]);
+        w
+    };
+    let inward = to([edge - 0.2, 2.0]);
+    assert!(check_step_domain(&system, &z0, &inward, &StepOptions::default()).is_err());
+    assert!(dense(&system, &z0, &inward).is_err());
+    // leaving the circle outward (the minimum at the start) passes
+    let outward = to([edge + 0.5, 0.3]);
+    assert!(check_step_domain(&system, &z0, &outward, &StepOptions::default()).is_ok());
+}

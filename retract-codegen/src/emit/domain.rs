@@ -7,6 +7,9 @@
 //! `ln` and `powf` arguments `> 0`; and every irreducible factor must stay clear of zero
 //! between them: the quadratic through the three samples may not come within
 //! `VANISH_TOLERANCE` of the largest sample of zero inside the step (`clear_of_zero_fn`).
+//! Where every guard is a polynomial of degree at most 2 in the jet, that quadratic is the
+//! guard along the chord, and the impl also says `guards_quadratic` (the step's check then
+//! skips the chord's pieces).
 //! The first violation is returned as a `DomainViolation` naming the expression as written.
 
 use proc_macro2::{Literal, TokenStream};
@@ -84,10 +87,12 @@ const FIT_NOISE: f64 = 1e-13;
 /// rule) has its extremum towards zero inside the step, it must stay more than
 /// `VANISH_TOLERANCE` times the largest sample away from zero. The fit is exact for a factor
 /// quadratic along the step (`x^2 + y^2 - r^2`, `|q'|^2`, `x^2 + y^2` of `atan2` and
-/// `hypot`), so a step that passes through such a zero between the samples is caught. It is
-/// skipped (only the sign rule applies) for `theta` within `1e-3` of an end and when the
-/// smallest sample is below the fit's rounding error (a factor growing by 13 orders of
-/// magnitude within one step), where it cannot resolve a zero.
+/// `hypot`), so a step that passes through such a zero between the samples is caught. When
+/// the smallest sample is below the fit's rounding error `margin` (a step starting on the
+/// boundary, or a factor growing by 13 orders of magnitude within one step), the fit cannot
+/// tell a touch from rounding: then only a minimum below `-margin` (a clear dip through zero)
+/// is rejected. It is skipped (only the sign rule applies) for `theta` within `1e-3` of an
+/// end.
 fn clear_of_zero_fn() -> TokenStream {
     let tol = Literal::f64_suffixed(VANISH_TOLERANCE);
     let noise = Literal::f64_suffixed(FIT_NOISE);
@@ -101,15 +106,20 @@ fn clear_of_zero_fn() -> TokenStream {
             let sign = if a < 0.0 { -1.0 } else { 1.0 };
             let (a, b, c) = (sign * a, sign * b, sign * c);
             let scale = a.max(b).max(c);
-            if a.min(b).min(c) <= #noise * scale / theta.min(1.0 - theta) {
-                return true;
-            }
+            let margin = #noise * scale / theta.min(1.0 - theta);
             // p(s) = a + beta s + alpha s^2 through the three samples
             let alpha = ((c - a) - theta * (b - a)) / (theta * theta - theta);
             let beta = (b - a) - alpha;
             let vertex = -beta / (2.0 * alpha);
-            !(alpha > 0.0 && vertex > 0.0 && vertex < 1.0)
-                || a + 0.5 * beta * vertex > #tol * scale
+            if !(alpha > 0.0 && vertex > 0.0 && vertex < 1.0) {
+                return true;
+            }
+            let minimum = a + 0.5 * beta * vertex;
+            if a.min(b).min(c) <= margin {
+                minimum > -margin
+            } else {
+                minimum > #tol * scale
+            }
         }
     }
 }

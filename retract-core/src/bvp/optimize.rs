@@ -19,8 +19,8 @@
 //! backtracking line search on the exact penalty $J + \pi \|c\|_1$ ($c$: all constraints),
 //! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
 //! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
-//! and on pieces of its chord no longer than `chord_spacing`, as
-//! [`crate::step::check_step_domain`]) is rejected. A point is returned only
+//! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
+//! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
 //! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
 //! without correction; its [`Certificate`] holds the residuals and the smallest eigenvalue of
 //! the reduced Hessian (Lanczos on the inverse, [`super::certificate`]).
@@ -894,7 +894,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     }
 
     /// The singularity guard on every step ([`crate::step::check_step_domain`]): at its ends,
-    /// its evaluation point and, for a chord longer than `chord_spacing`, on its pieces.
+    /// its evaluation point and, for a chord longer than `chord_spacing`, on its pieces (none
+    /// where the guards are quadratic: the three points decide the chord).
     pub(super) fn guard<const S: usize, const M: usize>(
         &self,
         iterate: &Iterate<N, X>,

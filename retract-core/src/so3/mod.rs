@@ -20,7 +20,7 @@
 //! It is symmetric ($R_d(y, -v) = (R_2, R_1)(y, v)$), so of order 2, and equivariant under
 //! left multiplication, so a left-invariant Lagrangian's spatial momentum
 //! ([`spatial_momentum`]) is conserved by its cotangent lift; [`crate::map::TaylorLift`]
-//! lifts it to every order.
+//! lifts it to every order (and [`ExpMidpoint`], through [`Scalar::stumpff`], to order 16).
 //!
 //! [`ExpMidpoint`] is the map with the group's exponential, $R_d(g, \xi) = (g \exp(-\xi/2),
 //! g \exp(\xi/2))$: the same products with $w = \tan(\theta/2)\, \phi/\theta$, $\phi = \xi/2$,

@@ -8,7 +8,7 @@ fn variable_order(q: [f64; 1], dq: [f64; 1]) -> f64 {
     stumpff(k, dq[0] * dq[0]) * q[0]
 }
 
-// and a small one
+// and at most 100
 #[discretization_map(order = 1)]
 fn huge_order(q: [f64; 1], v: [f64; 1]) -> ([f64; 1], [f64; 1]) {
     ([q[0] - 0.5 * v[0] * stumpff(101, v[0])], [q[0] + 0.5 * v[0]])
