@@ -253,7 +253,9 @@ impl<const V: usize> Scalar for Dual<V> {
         }
     }
     fn stumpff(self, k: u32) -> Self {
-        let [c, d1, _] = stumpff_and_derivatives(k, self.f);
+        // c_k and c_k' = (k c_{k+2} - c_{k+1}) / 2 (no second derivative)
+        let c = |i: u32| crate::special::stumpff(k.saturating_add(i), self.f);
+        let (c, d1) = (c(0), 0.5 * (f64::from(k) * c(2) - c(1)));
         Self {
             f: c,
             g: self.g.map(|g| d1 * g),
@@ -378,13 +380,18 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
         // alpha[i]: the coefficient of c_{k+i} in c_k^(j), for i <= 2 j
         let mut alpha = [0.0; 2 * MAX_SERIES + 1];
         alpha[0] = 1.0;
+        // c_{k+i}(a0) for every i <= 2 (D - 1), once each
+        let mut values = [T::constant(0.0); 2 * MAX_SERIES + 1];
+        for (i, v) in values.iter_mut().enumerate().take(2 * D.max(1) - 1) {
+            *v = a0.stumpff(k.saturating_add(i as u32));
+        }
         let (mut power, mut factorial) = (Self::constant(1.0), 1.0);
         let mut out = Self::constant(0.0);
         for j in 0..D {
             let mut derivative = T::constant(0.0);
-            for (i, a) in alpha.iter().enumerate().take(2 * j + 1) {
+            for (a, v) in alpha.iter().zip(values).take(2 * j + 1) {
                 if *a != 0.0 {
-                    derivative = derivative + a0.stumpff(k.saturating_add(i as u32)) * *a;
+                    derivative = derivative + v * *a;
                 }
             }
             for (o, p) in out.c.iter_mut().zip(power.c) {
