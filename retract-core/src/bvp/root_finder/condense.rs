@@ -1,0 +1,212 @@
+//! The condensed Newton direction: each step's linearised map $\delta w_i = \Phi_i \delta z_i + c_i$
+//! (a dense LU per step, or the cached factors of a [`ReducedScheme`]) and the sweeps that
+//! eliminate the steps' unknowns, leaving an $nk \times nk$ system for the free initial momenta.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use super::{BoundaryValueProblem, all_finite};
+use crate::{Error, LiftedSystem, ReducedFactors, ReducedScheme};
+/// The linearisation of step $i$ from $z_i$, $w_i$ and the step's residual $F_i$; `None` if
+/// singular.
+pub(super) type StepMap<'a, const S: usize, const M: usize> =
+    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<Linearized<S, M>>;
+
+/// The linearised map of one step at the current iterate, $\delta w = \Phi \delta z + c$, with
+/// $\Phi$ and $c$ solving $\partial_z F\thinspace \delta z + \partial_w F\thinspace \delta w = -F$.
+pub(super) struct Linearized<const S: usize, const M: usize> {
+    phi: SMatrix<f64, M, S>,
+    c: SVector<f64, M>,
+}
+
+impl<const S: usize, const M: usize> Linearized<S, M> {
+    /// $\Phi\thinspace \delta z + c$.
+    fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M> {
+        let mut out = self.c;
+        self.add_product(&mut out, dz);
+        out
+    }
+
+    /// The $z$ rows of $\Phi x$.
+    fn linear_z(&self, x: &SVector<f64, S>) -> SVector<f64, S> {
+        let mut out = SVector::<f64, S>::zeros();
+        self.add_product(&mut out, x);
+        out
+    }
+
+    /// `out += ` the first `LEN` rows of $\Phi x$, column by column over slices of constant
+    /// length: the inner loop runs down a contiguous column and vectorises (nalgebra's generic
+    /// product on a row view does not).
+    fn add_product<const LEN: usize>(&self, out: &mut SVector<f64, LEN>, x: &SVector<f64, S>) {
+        for (column, &weight) in self.phi.as_slice().chunks_exact(M).zip(x.iter()) {
+            for (o, p) in out.as_mut_slice().iter_mut().zip(column) {
+                *o += p * weight;
+            }
+        }
+    }
+}
+
+/// $\Phi = -(\partial_w F)^{-1} \partial_z F$ and $c = -(\partial_w F)^{-1} F$ by one dense LU.
+pub(super) fn general_step_map<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    f: &SVector<f64, M>,
+    h: f64,
+    theta: f64,
+) -> Option<Linearized<S, M>>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let mut phi = -system.jacobian_initial(z, w, h, theta);
+    let mut c = -f;
+    crate::linalg::solve_pair_in_place(system.jacobian(z, w, h, theta), &mut phi, &mut c)
+        .then_some(Linearized { phi, c })
+}
+
+/// The step maps of a [`ReducedScheme`]. With $F = A w + B z + n(y)$,
+/// $y = \theta E w + (1-\theta) E z$, $N = \partial n / \partial y$ at the iterate,
+/// $g = A^{-1} F$ and $H = A^{-1} N$, the linearised step is
+/// $(I + \theta E H)\thinspace \delta y = G \delta z - \theta E g$ and
+/// $\delta w = T \delta z - g - H \delta y$ (notation of [`crate::reduced`]): a rank-$R$ change
+/// of the constant map $T$ (formed densely: the dense products vectorise, an index list of
+/// the nonzeros of $T$ measured slower).
+pub(super) struct ReducedStepMap<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
+    system: &'a Sys,
+    factors: ReducedFactors<S, M, R>,
+    a_inv: SMatrix<f64, M, M>,
+}
+
+impl<'a, Sys, const S: usize, const M: usize, const R: usize> ReducedStepMap<'a, Sys, S, M, R>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    pub(super) fn new(system: &'a Sys, h: f64, theta: f64) -> Result<Self, Error> {
+        let factors = ReducedFactors::new(system, h, theta)?;
+        let a_inv = crate::linalg::solve(
+            &system.linear_part(h, theta),
+            &SMatrix::<f64, M, M>::identity(),
+        )
+        .ok_or(Error::SingularJacobian { iteration: 0 })?;
+        Ok(Self {
+            system,
+            factors,
+            a_inv,
+        })
+    }
+
+    pub(super) fn linearize(
+        &self,
+        z: &SVector<f64, S>,
+        w: &SVector<f64, M>,
+        f: &SVector<f64, M>,
+    ) -> Option<Linearized<S, M>> {
+        let ReducedFactors { h, theta, .. } = self.factors;
+        let y = SVector::<f64, R>::from_fn(|m, _| {
+            let c = Sys::CORE[m];
+            (1.0 - theta) * z[c] + theta * w[c]
+        });
+        let n = self.system.forcing_jacobian(&y, h, theta);
+        // g = A^{-1} F over the blocks of A (A^{-1} is block diagonal after permutation)
+        let mut g = SVector::<f64, M>::zeros();
+        for &(rows, cols) in Sys::BLOCKS {
+            for &c in cols {
+                g[c] = rows.iter().map(|&r| self.a_inv[(c, r)] * f[r]).sum();
+            }
+        }
+        let mut hm = SMatrix::<f64, M, R>::zeros();
+        for &q in Sys::FORCED {
+            for m in 0..R {
+                let nq = n[(q, m)];
+                if nq != 0.0 {
+                    for r in 0..M {
+                        hm[(r, m)] += self.a_inv[(r, q)] * nq;
+                    }
+                }
+            }
+        }
+        let mut lhs = SMatrix::<f64, R, R>::identity();
+        let mut x = self.factors.g;
+        let mut x0 = SVector::<f64, R>::zeros();
+        for (m, &c) in Sys::CORE.iter().enumerate() {
+            for l in 0..R {
+                lhs[(m, l)] += theta * hm[(c, l)];
+            }
+            x0[m] = -theta * g[c];
+        }
+        // delta y = X delta z + x0, so Phi = T - H X and c = -g - H x0
+        if !crate::linalg::solve_small_pair_in_place(lhs, &mut x, &mut x0) {
+            return None;
+        }
+        let (mut phi, mut c) = (self.factors.t, -g);
+        for m in 0..R {
+            for col in 0..S {
+                let weight = x[(m, col)];
+                for r in 0..M {
+                    phi[(r, col)] -= hm[(r, m)] * weight;
+                }
+            }
+            for r in 0..M {
+                c[r] -= hm[(r, m)] * x0[m];
+            }
+        }
+        Some(Linearized { phi, c })
+    }
+}
+
+/// The condensed Newton direction.
+///
+/// Eliminating $\delta w_i = \Phi_i \delta z_i + c_i$ step by step leaves the recursion
+/// $\delta z_{i+1} = \Phi^z_i \delta z_i + c^z_i$ ($z$ rows), with $\delta x_0 = -(x_0 - a)$ known and
+/// $\delta p_0 = \xi$ free: $\delta z_i = Z_i \xi + \zeta_i$, and $\xi$ solves the $nk \times nk$
+/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\thinspace nk\thinspace S M)$, no
+/// banded matrix. Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or
+/// the end system is singular or the direction is not finite.
+pub(super) fn condensed_direction<Sys, const S: usize, const M: usize>(
+    problem: &BoundaryValueProblem<'_, Sys, S, M>,
+    v: &[f64],
+    r: &[f64],
+    delta: &mut [f64],
+    linearize: StepMap<'_, S, M>,
+    maps: &mut Vec<Linearized<S, M>>,
+) -> bool
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let layout = problem.layout();
+    let (nk, steps) = (layout.nk, problem.steps);
+    maps.clear();
+    for i in 0..steps {
+        let f = SVector::<f64, M>::from_column_slice(&r[layout.row(i)..layout.row(i) + M]);
+        match linearize(&problem.state(v, i), &problem.unknowns(v, i), &f) {
+            Some(map) => maps.push(map),
+            None => return false,
+        }
+    }
+    // forward sweep of the sensitivity Z_i (nk columns) and the offset zeta_i
+    let mut sensitivity: Vec<SVector<f64, S>> = (0..nk)
+        .map(|j| SVector::from_fn(|row, _| if row == nk + j { 1.0 } else { 0.0 }))
+        .collect();
+    let mut zeta = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { 0.0 });
+    for map in maps.iter() {
+        for column in &mut sensitivity {
+            *column = map.linear_z(column);
+        }
+        zeta = map.affine(&zeta).fixed_rows::<S>(0).into_owned();
+    }
+    let end = layout.row(steps);
+    let lhs = DMatrix::<f64>::from_fn(nk, nk, |row, j| sensitivity[j][row]);
+    let rhs = DVector::<f64>::from_fn(nk, |row, _| -r[end + row] - zeta[row]);
+    let Some(xi) = lhs.lu().solve(&rhs) else {
+        return false;
+    };
+    // second sweep: delta z_i and delta u_i
+    let mut dz = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { xi[row - nk] });
+    delta[layout.z(0)..layout.z(0) + S].copy_from_slice(dz.as_slice());
+    for (i, map) in maps.iter().enumerate() {
+        let dw = map.affine(&dz);
+        delta[layout.z(i + 1)..layout.z(i + 1) + S].copy_from_slice(&dw.as_slice()[..S]);
+        delta[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&dw.as_slice()[S..]);
+        dz = dw.fixed_rows::<S>(0).into_owned();
+    }
+    all_finite(delta)
+}
