@@ -10,8 +10,9 @@ use crate::Error;
 /// $q_0 + (q_T - q_0)(3s^2 - 2s^3)$, $s = t/T$.
 pub(crate) struct Hermite {
     n: usize,
-    /// `coefficients[i][m]`: coefficient of $t^m$ in coordinate $i$.
-    coefficients: Vec<Vec<f64>>,
+    /// `derivatives[j * n + i][m]`: coefficient of $t^m$ in $q_i^{(j)}$, $j < 2k$ (the
+    /// polynomial's derivatives formed once, so that a value is one Horner sweep).
+    derivatives: Vec<Vec<f64>>,
 }
 
 /// $m (m-1) \cdots (m-j+1)$.
@@ -45,19 +46,57 @@ impl Hermite {
             })?;
             c[k..2 * k].copy_from_slice(upper.as_slice());
         }
-        Ok(Self { n, coefficients })
+        // q_i^(j) = sum_{m >= j} c_m m!/(m-j)! t^(m-j)
+        let derivatives = (0..2 * k * n)
+            .map(|index| {
+                let (j, c) = (index / n, &coefficients[index % n]);
+                (j..2 * k).map(|m| c[m] * falling(m, j)).collect()
+            })
+            .collect();
+        Ok(Self { n, derivatives })
     }
 
-    /// $q_i^{(j)}(t)$.
+    /// $q_i^{(j)}(t)$ (zero for $j \ge 2k$).
     pub fn derivative(&self, i: usize, j: usize, t: f64) -> f64 {
-        let c = &self.coefficients[i];
-        (j..c.len())
-            .map(|m| c[m] * falling(m, j) * t.powi((m - j) as i32))
-            .sum()
+        self.derivatives
+            .get(j * self.n + i)
+            .map_or(0.0, |d| d.iter().rev().fold(0.0, |acc, &c| acc * t + c))
     }
 
     /// Entry `r` of the derivative data $(q, q', \dots)$ at $t$ (blocks of $n$).
     pub fn jet_entry(&self, r: usize, t: f64) -> f64 {
         self.derivative(r % self.n, r / self.n, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_polynomial_matches_both_jets_and_its_derivatives_are_consistent() {
+        // n = 2, k = 3: jets (q, q', q'') in blocks of two
+        let start = [0.3, -1.0, 2.0, 0.5, -0.7, 1.1];
+        let goal = [1.5, 0.2, -0.4, 0.9, 0.6, -2.0];
+        let t_end = 1.7;
+        let spline = Hermite::new(&start, &goal, t_end, 2, 3).unwrap();
+        for r in 0..6 {
+            assert!((spline.jet_entry(r, 0.0) - start[r]).abs() < 1e-13);
+            assert!((spline.jet_entry(r, t_end) - goal[r]).abs() < 1e-12);
+        }
+        // q^(j+1) is the derivative of q^(j) (central differences), and q^(6) = 0
+        let (t, e) = (0.61, 1e-5);
+        for i in 0..2 {
+            for j in 0..5 {
+                let difference =
+                    (spline.derivative(i, j, t + e) - spline.derivative(i, j, t - e)) / (2.0 * e);
+                let exact = spline.derivative(i, j + 1, t);
+                assert!(
+                    (difference - exact).abs() < 1e-6 * (1.0 + exact.abs()),
+                    "{i} {j}"
+                );
+            }
+            assert_eq!(spline.derivative(i, 6, t), 0.0);
+        }
     }
 }

@@ -33,7 +33,7 @@ use nalgebra::SVector;
 use super::guess::Hermite;
 use crate::banded::BandMatrix;
 use crate::{Error, LiftedSystem, ReducedScheme};
-use condense::{ReducedStepMap, StepMap, condensed_direction, general_step_map};
+use condense::{Linearized, ReducedStepMap, StepMap, condensed_direction, general_step_map};
 
 /// Options of the boundary-value solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -310,12 +310,43 @@ where
     .map_err(|violation| Error::given(Given::Separated, violation))
 }
 
+/// Whether every entry is finite: $\sum_i 0 \cdot v_i = 0$, NaN exactly when some $v_i$ is
+/// not finite (four independent sums, so the loop vectorises and does not branch).
 fn all_finite(v: &[f64]) -> bool {
-    v.iter().all(|x| x.is_finite())
+    lanes(v, 0.0, |acc, x| acc + x * 0.0, |a, b| a + b) == 0.0
 }
 
+/// $\max_i |v_i|$ (NaN entries are skipped by `f64::max`; callers check finiteness).
 fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+    lanes(v, 0.0, |m, x| m.max(x.abs()), f64::max)
+}
+
+/// $\sum_i v_i^2$: not finite if an entry is not (or the sum overflows).
+fn squared_norm(v: &[f64]) -> f64 {
+    lanes(v, 0.0, |acc, x| acc + x * x, |a, b| a + b)
+}
+
+/// A fold of `v` by `step` in four interleaved lanes from `init`, joined by `join`: the
+/// lanes do not wait on each other, so the loop vectorises (a single running sum cannot be
+/// reordered by the compiler).
+fn lanes(
+    v: &[f64],
+    init: f64,
+    step: impl Fn(f64, f64) -> f64,
+    join: impl Fn(f64, f64) -> f64,
+) -> f64 {
+    let mut acc = [init; 4];
+    let chunks = v.chunks_exact(4);
+    let tail = chunks.remainder();
+    for chunk in chunks {
+        for (a, &x) in acc.iter_mut().zip(chunk) {
+            *a = step(*a, x);
+        }
+    }
+    for (a, &x) in acc.iter_mut().zip(tail) {
+        *a = step(*a, x);
+    }
+    join(join(acc[0], acc[1]), join(acc[2], acc[3]))
 }
 
 impl<'a, Sys, const S: usize, const M: usize> BoundaryValueProblem<'a, Sys, S, M>
@@ -562,8 +593,11 @@ where
         let (h, theta) = (self.h(), self.options.theta);
         self.solve_with(
             guess,
-            &|z: &SVector<f64, S>, w: &SVector<f64, M>, f: &SVector<f64, M>| {
-                general_step_map(system, z, w, f, h, theta)
+            &|z: &SVector<f64, S>,
+              w: &SVector<f64, M>,
+              f: &SVector<f64, M>,
+              out: &mut Linearized<S, M>| {
+                general_step_map(system, z, w, f, h, theta, out)
             },
         )
     }
@@ -586,7 +620,10 @@ where
         let map = ReducedStepMap::new(self.system, h, theta)?;
         self.solve_with(
             guess,
-            &|z: &SVector<f64, S>, w: &SVector<f64, M>, f: &SVector<f64, M>| map.linearize(z, w, f),
+            &|z: &SVector<f64, S>,
+              w: &SVector<f64, M>,
+              f: &SVector<f64, M>,
+              out: &mut Linearized<S, M>| map.linearize(z, w, f, out),
         )
     }
 
@@ -603,8 +640,7 @@ where
         let mut delta = filled(size, 0.0, "steps")?;
         let mut trial = filled(size, 0.0, "steps")?;
         let mut r_trial = filled(size, 0.0, "steps")?;
-        let mut maps = Vec::new();
-        maps.try_reserve_exact(self.steps).map_err(|_| TOO_LARGE)?;
+        let mut maps = filled(self.steps, Linearized::zeros(), "steps")?;
         let mut buffer = filled(self.obstacles(), 0.0, "obstacles")?;
         let mut v = match guess {
             Guess::Spline => self.spline_guess()?,
@@ -701,18 +737,17 @@ where
         r_trial: &mut [f64],
     ) -> bool {
         let options = &self.options;
-        let phi: f64 = r.iter().map(|x| x * x).sum();
+        let phi = squared_norm(r);
         let mut alpha = 1.0;
         for _ in 0..=options.max_backtracks {
             for ((t, vi), di) in trial.iter_mut().zip(v).zip(delta) {
                 *t = vi + alpha * di;
             }
             self.residual(trial, r_trial);
-            if all_finite(r_trial) {
-                let phi_trial: f64 = r_trial.iter().map(|x| x * x).sum();
-                if phi_trial <= (1.0 - 2.0 * options.armijo * alpha) * phi {
-                    return true;
-                }
+            // one pass: a residual with a non-finite entry has a non-finite |r|^2
+            let phi_trial = squared_norm(r_trial);
+            if phi_trial.is_finite() && phi_trial <= (1.0 - 2.0 * options.armijo * alpha) * phi {
+                return true;
             }
             alpha *= 0.5;
         }
@@ -871,9 +906,31 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::condense::Linearized;
     use super::*;
     use crate::models::PlanarBarrier;
+
+    #[test]
+    fn the_one_pass_norms_see_every_entry() {
+        // lengths around the four lanes, the odd entry at every position
+        for len in 1..11 {
+            for at in 0..len {
+                let mut v: Vec<f64> = (0..len).map(|i| i as f64 - 3.5).collect();
+                let max = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let sum: f64 = v.iter().map(|x| x * x).sum();
+                assert!(all_finite(&v));
+                assert_eq!(max_abs(&v), max);
+                assert!((squared_norm(&v) - sum).abs() <= 1e-14 * sum);
+                v[at] = -9.0;
+                assert_eq!(max_abs(&v), 9.0);
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    v[at] = bad;
+                    assert!(!all_finite(&v), "{len} {at} {bad}");
+                    assert!(!squared_norm(&v).is_finite(), "{len} {at} {bad}");
+                }
+            }
+        }
+        assert!(all_finite(&[]));
+    }
 
     #[test]
     fn a_failing_condensation_falls_back_to_the_banded_solve() {
@@ -884,9 +941,10 @@ mod tests {
         };
         let (start, goal) = ([-2.0, 1.5, 1.0, 0.0], [2.0, 1.5, 1.0, 0.0]);
         let problem = BoundaryValueProblem::new(&system, &start, &goal, 4.0, 100);
-        let never = |_: &SVector<f64, 8>, _: &SVector<f64, 10>, _: &SVector<f64, 10>| {
-            None::<Linearized<8, 10>>
-        };
+        let never = |_: &SVector<f64, 8>,
+                     _: &SVector<f64, 10>,
+                     _: &SVector<f64, 10>,
+                     _: &mut Linearized<8, 10>| false;
         let fallback = problem.solve_with(Guess::Spline, &never).unwrap();
         let condensed = problem.solve(Guess::Spline).unwrap();
         assert_eq!(fallback.iterations, condensed.iterations);

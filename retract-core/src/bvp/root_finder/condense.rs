@@ -6,19 +6,28 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use super::{BoundaryValueProblem, all_finite};
 use crate::{Error, LiftedSystem, ReducedFactors, ReducedScheme};
-/// The linearisation of step $i$ from $z_i$, $w_i$ and the step's residual $F_i$; `None` if
-/// singular.
+/// The linearisation of step $i$ from $z_i$, $w_i$ and the step's residual $F_i$, written into
+/// the last argument in place (no copy of the map); `false` if singular.
 pub(super) type StepMap<'a, const S: usize, const M: usize> =
-    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>) -> Option<Linearized<S, M>>;
+    &'a dyn Fn(&SVector<f64, S>, &SVector<f64, M>, &SVector<f64, M>, &mut Linearized<S, M>) -> bool;
 
 /// The linearised map of one step at the current iterate, $\delta w = \Phi \delta z + c$, with
 /// $\Phi$ and $c$ solving $\partial_z F\thinspace \delta z + \partial_w F\thinspace \delta w = -F$.
+#[derive(Clone)]
 pub(super) struct Linearized<const S: usize, const M: usize> {
     phi: SMatrix<f64, M, S>,
     c: SVector<f64, M>,
 }
 
 impl<const S: usize, const M: usize> Linearized<S, M> {
+    /// $\Phi = 0$, $c = 0$: a slot for [`StepMap`] to fill.
+    pub(super) fn zeros() -> Self {
+        Self {
+            phi: SMatrix::zeros(),
+            c: SVector::zeros(),
+        }
+    }
+
     /// $\Phi\thinspace \delta z + c$.
     fn affine(&self, dz: &SVector<f64, S>) -> SVector<f64, M> {
         let mut out = self.c;
@@ -53,14 +62,14 @@ pub(super) fn general_step_map<Sys, const S: usize, const M: usize>(
     f: &SVector<f64, M>,
     h: f64,
     theta: f64,
-) -> Option<Linearized<S, M>>
+    out: &mut Linearized<S, M>,
+) -> bool
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
-    let mut phi = -system.jacobian_initial(z, w, h, theta);
-    let mut c = -f;
-    crate::linalg::solve_pair_in_place(system.jacobian(z, w, h, theta), &mut phi, &mut c)
-        .then_some(Linearized { phi, c })
+    out.phi = -system.jacobian_initial(z, w, h, theta);
+    out.c = -f;
+    crate::linalg::solve_pair_in_place(system.jacobian(z, w, h, theta), &mut out.phi, &mut out.c)
 }
 
 /// The step maps of a [`ReducedScheme`]. With $F = A w + B z + n(y)$,
@@ -68,8 +77,10 @@ where
 /// $g = A^{-1} F$ and $H = A^{-1} N$, the linearised step is
 /// $(I + \theta E H)\thinspace \delta y = G \delta z - \theta E g$ and
 /// $\delta w = T \delta z - g - H \delta y$ (notation of [`crate::reduced`]): a rank-$R$ change
-/// of the constant map $T$ (formed densely: the dense products vectorise, an index list of
-/// the nonzeros of $T$ measured slower).
+/// of the constant map $T$, formed densely into the step's slot. (Kept factored, as $H$,
+/// $(I + \theta E H)^{-1}$ and $g$, and applied column by column over the nonzero rows of $T$,
+/// the maps made the SE(2) solve 1.5x slower: the dense products vectorise, the factored ones
+/// do not, and they need more arithmetic per column than they save in forming $\Phi$.)
 pub(super) struct ReducedStepMap<'a, Sys: ?Sized, const S: usize, const M: usize, const R: usize> {
     system: &'a Sys,
     factors: ReducedFactors<S, M, R>,
@@ -99,7 +110,8 @@ where
         z: &SVector<f64, S>,
         w: &SVector<f64, M>,
         f: &SVector<f64, M>,
-    ) -> Option<Linearized<S, M>> {
+        out: &mut Linearized<S, M>,
+    ) -> bool {
         let ReducedFactors { h, theta, .. } = self.factors;
         let y = SVector::<f64, R>::from_fn(|m, _| {
             let c = Sys::CORE[m];
@@ -125,7 +137,7 @@ where
             }
         }
         let mut lhs = SMatrix::<f64, R, R>::identity();
-        let mut x = self.factors.g;
+        let mut inverse = SMatrix::<f64, R, R>::identity();
         let mut x0 = SVector::<f64, R>::zeros();
         for (m, &c) in Sys::CORE.iter().enumerate() {
             for l in 0..R {
@@ -133,23 +145,32 @@ where
             }
             x0[m] = -theta * g[c];
         }
-        // delta y = X delta z + x0, so Phi = T - H X and c = -g - H x0
-        if !crate::linalg::solve_small_pair_in_place(lhs, &mut x, &mut x0) {
-            return None;
+        // delta y = X delta z + x0 with X = (I + theta E H)^{-1} G, so Phi = T - H X and
+        // c = -g - H x0 (the inverse, not X, from the small solve: its finiteness check then
+        // reads R (R + 1) numbers, not R (S + 1); the direction's is the final word)
+        if !crate::linalg::solve_small_pair_in_place(lhs, &mut inverse, &mut x0) {
+            return false;
         }
-        let (mut phi, mut c) = (self.factors.t, -g);
-        for m in 0..R {
-            for col in 0..S {
-                let weight = x[(m, col)];
-                for r in 0..M {
-                    phi[(r, col)] -= hm[(r, m)] * weight;
+        let x = inverse * self.factors.g;
+        out.phi.copy_from(&self.factors.t);
+        out.c = -g;
+        let h_columns = hm.as_slice().chunks_exact(M);
+        for (m, h_column) in h_columns.enumerate() {
+            for (phi_column, &weight) in out
+                .phi
+                .as_mut_slice()
+                .chunks_exact_mut(M)
+                .zip(x.row(m).iter())
+            {
+                for (p, hr) in phi_column.iter_mut().zip(h_column) {
+                    *p -= hr * weight;
                 }
             }
-            for r in 0..M {
-                c[r] -= hm[(r, m)] * x0[m];
+            for (c, hr) in out.c.iter_mut().zip(h_column) {
+                *c -= hr * x0[m];
             }
         }
-        Some(Linearized { phi, c })
+        true
     }
 }
 
@@ -158,36 +179,34 @@ where
 /// Eliminating $\delta w_i = \Phi_i \delta z_i + c_i$ step by step leaves the recursion
 /// $\delta z_{i+1} = \Phi^z_i \delta z_i + c^z_i$ ($z$ rows), with $\delta x_0 = -(x_0 - a)$ known and
 /// $\delta p_0 = \xi$ free: $\delta z_i = Z_i \xi + \zeta_i$, and $\xi$ solves the $nk \times nk$
-/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. Cost $O(N\thinspace nk\thinspace S M)$, no
-/// banded matrix. Writes the direction at `v` (residual `r`) into `delta`; `false` if a step map or
-/// the end system is singular or the direction is not finite.
+/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. One pass forms each step's map (into its slot
+/// of `maps`, one per step) and advances $Z_i$ and $\zeta_i$ with it; a second recovers
+/// $\delta z_i$ and $\delta u_i$. Cost $O(N\thinspace nk\thinspace S M)$, no banded matrix. Writes
+/// the direction at `v` (residual `r`) into `delta`; `false` if a step map or the end system is
+/// singular or the direction is not finite (checked once, on `delta`).
 pub(super) fn condensed_direction<Sys, const S: usize, const M: usize>(
     problem: &BoundaryValueProblem<'_, Sys, S, M>,
     v: &[f64],
     r: &[f64],
     delta: &mut [f64],
     linearize: StepMap<'_, S, M>,
-    maps: &mut Vec<Linearized<S, M>>,
+    maps: &mut [Linearized<S, M>],
 ) -> bool
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
     let layout = problem.layout();
     let (nk, steps) = (layout.nk, problem.steps);
-    maps.clear();
-    for i in 0..steps {
-        let f = SVector::<f64, M>::from_column_slice(&r[layout.row(i)..layout.row(i) + M]);
-        match linearize(&problem.state(v, i), &problem.unknowns(v, i), &f) {
-            Some(map) => maps.push(map),
-            None => return false,
-        }
-    }
-    // forward sweep of the sensitivity Z_i (nk columns) and the offset zeta_i
+    // the sensitivity Z_i (nk columns) and the offset zeta_i, advanced as each map is formed
     let mut sensitivity: Vec<SVector<f64, S>> = (0..nk)
         .map(|j| SVector::from_fn(|row, _| if row == nk + j { 1.0 } else { 0.0 }))
         .collect();
     let mut zeta = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { 0.0 });
-    for map in maps.iter() {
+    for (i, map) in maps.iter_mut().enumerate().take(steps) {
+        let f = SVector::<f64, M>::from_column_slice(&r[layout.row(i)..layout.row(i) + M]);
+        if !linearize(&problem.state(v, i), &problem.unknowns(v, i), &f, map) {
+            return false;
+        }
         for column in &mut sensitivity {
             *column = map.linear_z(column);
         }
