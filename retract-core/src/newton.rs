@@ -208,9 +208,10 @@ pub(crate) fn sum_abs<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) ->
     lane_sum(m.as_slice(), f64::abs)
 }
 
-/// $\sum_i f(v_i)$, summed in four lanes so that it vectorises.
+/// $\sum_i f(v_i)$, summed in four lanes so that it vectorises (a single running sum is a
+/// chain of dependent additions that the compiler may not reorder).
 #[inline]
-fn lane_sum(entries: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn lane_sum(entries: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     let mut lanes = [0.0f64; 4];
     let mut chunks = entries.chunks_exact(4);
     for chunk in &mut chunks {

@@ -32,6 +32,7 @@ use nalgebra::SVector;
 
 use super::guess::Hermite;
 use crate::banded::BandMatrix;
+use crate::newton::lane_sum;
 use crate::{Error, LiftedSystem, ReducedScheme};
 use condense::{Linearized, ReducedStepMap, StepMap, condensed_direction, general_step_map};
 
@@ -311,42 +312,19 @@ where
 }
 
 /// Whether every entry is finite: $\sum_i 0 \cdot v_i = 0$, NaN exactly when some $v_i$ is
-/// not finite (four independent sums, so the loop vectorises and does not branch).
+/// not finite (summed in four lanes, so the loop vectorises and does not branch).
 fn all_finite(v: &[f64]) -> bool {
-    lanes(v, 0.0, |acc, x| acc + x * 0.0, |a, b| a + b) == 0.0
+    lane_sum(v, |x| x * 0.0) == 0.0
 }
 
 /// $\max_i |v_i|$ (NaN entries are skipped by `f64::max`; callers check finiteness).
 fn max_abs(v: &[f64]) -> f64 {
-    lanes(v, 0.0, |m, x| m.max(x.abs()), f64::max)
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// $\sum_i v_i^2$: not finite if an entry is not (or the sum overflows).
 fn squared_norm(v: &[f64]) -> f64 {
-    lanes(v, 0.0, |acc, x| acc + x * x, |a, b| a + b)
-}
-
-/// A fold of `v` by `step` in four interleaved lanes from `init`, joined by `join`: the
-/// lanes do not wait on each other, so the loop vectorises (a single running sum cannot be
-/// reordered by the compiler).
-fn lanes(
-    v: &[f64],
-    init: f64,
-    step: impl Fn(f64, f64) -> f64,
-    join: impl Fn(f64, f64) -> f64,
-) -> f64 {
-    let mut acc = [init; 4];
-    let chunks = v.chunks_exact(4);
-    let tail = chunks.remainder();
-    for chunk in chunks {
-        for (a, &x) in acc.iter_mut().zip(chunk) {
-            *a = step(*a, x);
-        }
-    }
-    for (a, &x) in acc.iter_mut().zip(tail) {
-        *a = step(*a, x);
-    }
-    join(join(acc[0], acc[1]), join(acc[2], acc[3]))
+    lane_sum(v, |x| x * x)
 }
 
 impl<'a, Sys, const S: usize, const M: usize> BoundaryValueProblem<'a, Sys, S, M>
