@@ -300,12 +300,13 @@ mod tests {
 
     #[test]
     fn expression_growth_is_bounded() {
-        // n = 6, k = 2, 5 obstacles in an unrolled loop
+        // n = 6, k = 2, 5 obstacles in an unrolled loop: 2002 lines (1946 before the plain
+        // recovery `recover_plain`, linear in M); the bound catches a blow-up, not a line
         let (attr, item) = crate::samples::obstacle_field(6, 5);
         let tokens = try_expand(attr, item).unwrap();
         let file: syn::File = syn::parse2(tokens).unwrap();
         let lines = prettyplease::unparse(&file).lines().count();
         println!("expansion: {lines} lines");
-        assert!(lines < 2000, "{lines} lines");
+        assert!(lines < 2200, "{lines} lines");
     }
 }

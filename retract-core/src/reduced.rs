@@ -139,6 +139,18 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         z0: &SVector<f64, S>,
         forcing: &SVector<f64, M>,
     ) -> SVector<f64, M>;
+
+    /// $w = T z_0 - A^{-1} n$ without the corrections of [`Self::recover`] (each entry one
+    /// rounded sum; [`crate::StepOptions::compensated`] off). By default [`Self::recover`];
+    /// the macro emits the plain sums.
+    fn recover_plain(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
+        z0: &SVector<f64, S>,
+        forcing: &SVector<f64, M>,
+    ) -> SVector<f64, M> {
+        self.recover(factors, z0, forcing)
+    }
 }
 
 /// What [`ReducedScheme::closed_form_factors`] wrote.
@@ -842,7 +854,11 @@ where
         let forcing_size = Sys::FORCED
             .iter()
             .fold(0.0, |sum, &q| sum + forcing[q].abs());
-        let w = system.recover(factors, z0, &forcing);
+        let w = if options.compensated {
+            system.recover(factors, z0, &forcing)
+        } else {
+            system.recover_plain(factors, z0, &forcing)
+        };
         if !(state_size + forcing_size < factors.finite_below || all_finite(&w)) {
             return Err(if all_finite(z0) {
                 Error::NonFinite {

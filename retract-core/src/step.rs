@@ -59,6 +59,21 @@ pub struct StepOptions {
     /// most this many halvings (reported in [`StepReport::halvings`]); 0 (the default) stops
     /// at the first failure. Domain violations are never retried.
     pub max_halvings: u32,
+    /// In [`crate::ReducedStepper`]: recover the step's unknowns with the rounding corrections
+    /// of the cached factors, $w = (T + T_{lo}) z_0 - (A^{-1} + A^{-1}_{lo}) n$
+    /// ([`crate::ReducedScheme::recover`], [`crate::reduced`]); on by default. Off, each entry
+    /// is one rounded sum of $T z_0 - A^{-1} n$ ([`crate::ReducedScheme::recover_plain`]): the
+    /// step is about a quarter cheaper, and every step applies the same rounded linear map, so
+    /// a quadratic invariant (an angular momentum) drifts linearly instead of staying at
+    /// rounding. The other steps ignore it.
+    #[cfg_attr(feature = "serde", serde(default = "compensated_by_default"))]
+    pub compensated: bool,
+}
+
+/// [`StepOptions::compensated`]'s default, for configurations written before it existed.
+#[cfg(feature = "serde")]
+fn compensated_by_default() -> bool {
+    true
 }
 
 impl Default for StepOptions {
@@ -71,6 +86,7 @@ impl Default for StepOptions {
             max_chord_pieces: 16,
             locate_crossing: false,
             max_halvings: 0,
+            compensated: true,
         }
     }
 }
@@ -105,6 +121,13 @@ impl StepOptions {
     /// Switches the location of a domain crossing on or off.
     pub fn with_crossing_location(mut self, on: bool) -> Self {
         self.locate_crossing = on;
+        self
+    }
+
+    /// Switches the rounding corrections of the reduced step on or off
+    /// ([`Self::compensated`]).
+    pub fn with_compensation(mut self, on: bool) -> Self {
+        self.compensated = on;
         self
     }
 

@@ -4,7 +4,8 @@
 //!
 //! The variants of one step, timed in interleaved rounds ([`crate::timing`]):
 //! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`), with and without
-//!   the domain check;
+//!   the domain check, and without the domain check and the rounding corrections
+//!   (`StepOptions::compensated` off);
 //! - generated, general (Newton on all 15 unknowns, `retract::step`);
 //! - the hand-written peers of [`crate::peers`]: dense 12x12 Newton (Jacobian by hand, by
 //!   dual numbers, by finite differences) and the reduced 3x3 Newton on $q_\theta$ (the
@@ -29,6 +30,8 @@ use crate::timing::{Row, Timed, best_ns, best_of, format_ns, interleaved, write_
 pub const REDUCED: &str = "generated, reduced (2 unknowns)";
 /// Generated, reduced step, domain check off.
 pub const REDUCED_UNCHECKED: &str = "generated, reduced, domain check off";
+/// Generated, reduced step, domain check and rounding corrections off.
+pub const REDUCED_PLAIN: &str = "generated, reduced, check and corrections off";
 /// Generated, general step.
 pub const GENERAL: &str = "generated, general (15 unknowns)";
 /// Hand-written dense Newton.
@@ -50,8 +53,10 @@ pub fn check_variants(system: &RigidBody, z: &Z) -> Result<(), Error> {
     let options = StepOptions::default();
     let reference = step(system, z, H, &options)?.0;
     let mut reduced = ReducedStepper::new(system);
-    let variants: [(&'static str, Z); 6] = [
+    let plain = options.with_domain_check(false).with_compensation(false);
+    let variants: [(&'static str, Z); 7] = [
         (REDUCED, reduced.step(z, H, &options)?.0),
+        (REDUCED_PLAIN, reduced.step(z, H, &plain)?.0),
         (HAND_DENSE, dense_step(z, DenseJacobian::Hand)?),
         (HAND_REDUCED, hand_reduced_step(z)?),
         (HAND_GUARDED, hand_guarded_step(z)?),
@@ -145,8 +150,12 @@ pub fn newton_systems(
 pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row> {
     let options = StepOptions::default();
     let unchecked = options.with_domain_check(false);
-    let (mut reduced, mut reduced_unchecked) =
-        (ReducedStepper::new(system), ReducedStepper::new(system));
+    let plain = unchecked.with_compensation(false);
+    let (mut reduced, mut reduced_unchecked, mut reduced_plain) = (
+        ReducedStepper::new(system),
+        ReducedStepper::new(system),
+        ReducedStepper::new(system),
+    );
     let (slow, slowest) = ((calls / 20).max(1), (calls / 100).max(1));
     interleaved(
         rounds,
@@ -156,6 +165,10 @@ pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row>
             }),
             Timed::new(REDUCED_UNCHECKED, calls, &mut || {
                 let s = reduced_unchecked.step(black_box(z), H, &unchecked);
+                black_box(s.map(|s| s.0[0]).ok());
+            }),
+            Timed::new(REDUCED_PLAIN, calls, &mut || {
+                let s = reduced_plain.step(black_box(z), H, &plain);
                 black_box(s.map(|s| s.0[0]).ok());
             }),
             Timed::new(GENERAL, slow, &mut || {
@@ -187,6 +200,8 @@ pub const RUN_REDUCED: &str = "generated reduced, domain check on";
 pub const RUN_HAND_GUARDED: &str = "hand-written reduced, domain check on";
 /// The reduced stepper's 400-step run, domain check off.
 pub const RUN_REDUCED_UNCHECKED: &str = "generated reduced, domain check off";
+/// The reduced stepper's 400-step run, domain check and rounding corrections off.
+pub const RUN_REDUCED_PLAIN: &str = "generated reduced, check and corrections off";
 /// The hand-written 400-step run.
 pub const RUN_HAND: &str = "hand-written reduced, domain check off";
 /// The factors of one step size (a cache miss of the reduced stepper).
@@ -201,6 +216,7 @@ pub const FACTORS: &str = "factors of a new step size (`ReducedFactors::new`)";
 pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec<Row>, Error> {
     let options = StepOptions::default();
     let unchecked = options.with_domain_check(false);
+    let plain = unchecked.with_compensation(false);
     let z0 = paper_start(system);
     let reduced_run = |options: &StepOptions| -> Result<Z, Error> {
         let mut stepper = ReducedStepper::new(system);
@@ -215,6 +231,7 @@ pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec
     };
     reduced_run(&options)?;
     reduced_run(&unchecked)?;
+    reduced_run(&plain)?;
     hand_run(hand_guarded_step)?;
     hand_run(hand_reduced_step)?;
     Ok(interleaved(
@@ -231,6 +248,9 @@ pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec
             }),
             Timed::new(RUN_HAND, calls, &mut || {
                 black_box(hand_run(hand_reduced_step).ok());
+            }),
+            Timed::new(RUN_REDUCED_PLAIN, calls, &mut || {
+                black_box(reduced_run(&plain).ok());
             }),
             Timed::new(FACTORS, calls * 10, &mut || {
                 black_box(ReducedFactors::new(system, black_box(H), 0.5).ok());
@@ -271,11 +291,12 @@ pub fn write_steps(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(
     writeln!(
         out,
         "\nstep ratios: generated/hand-written reduced {:.2}x (check off), {:.2}x (check on; \
-         {:.2}x the hand-written step without it); dense/generated {:.1}x, dual/generated \
-         {:.1}x",
+         {:.2}x the hand-written step without it), {:.2}x (check and corrections off); \
+         dense/generated {:.1}x, dual/generated {:.1}x",
         unchecked / hand,
         reduced / guarded,
         reduced / hand,
+        best_of(rows, REDUCED_PLAIN) / hand,
         best_of(rows, HAND_DENSE) / reduced,
         best_of(rows, DUAL) / reduced,
     )?;
@@ -295,9 +316,11 @@ pub fn write_runs(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<()
     write_rows(out, "400-step run", rows)?;
     writeln!(
         out,
-        "\nrun ratios: generated/hand-written {:.2}x (check on), {:.2}x (check off)",
+        "\nrun ratios: generated/hand-written {:.2}x (check on), {:.2}x (check off), {:.2}x \
+         (check and corrections off)",
         best_of(rows, RUN_REDUCED) / best_of(rows, RUN_HAND_GUARDED),
         best_of(rows, RUN_REDUCED_UNCHECKED) / best_of(rows, RUN_HAND),
+        best_of(rows, RUN_REDUCED_PLAIN) / best_of(rows, RUN_HAND),
     )?;
     Ok(())
 }

@@ -506,8 +506,10 @@ impl<'a> Reduction<'a> {
     /// summed as a balanced tree, the last addition exact (`two_sum`), and the corrections
     /// (T_lo z0 and A^{-1}_lo n, of the size of the rounding errors) added to its error, so
     /// that they enter the one rounding of the result instead of being lost below the last
-    /// bit. A row of exact terms (factors +-1) has no correction and is a plain sum.
-    fn recover_row(&self, row: usize) -> TokenStream {
+    /// bit. A row of exact terms (factors +-1) has no correction and is a plain sum. With
+    /// `compensated` false, the row is the plain sum of the terms of T and A^{-1} (no
+    /// corrections, no exact addition).
+    fn recover_row(&self, row: usize, compensated: bool) -> TokenStream {
         let (core, s, red) = (&self.e.core, self.e.s, self.red);
         let rl = index(row);
         let mut terms: Vec<Term> = Vec::new();
@@ -549,7 +551,7 @@ impl<'a> Reduction<'a> {
                 Term::Product(a, b) => (false, quote!(#a * #b)),
             })
             .collect();
-        if corrections.is_empty() {
+        if corrections.is_empty() || !compensated {
             return signed_sum(&signed);
         }
         let small = signed_sum(&corrections);
@@ -573,9 +575,10 @@ impl<'a> Reduction<'a> {
         })
     }
 
-    /// The method `recover`: w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the
+    /// The methods `recover`, w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the
     /// structural nonzeros, each row with its corrections inside its last rounding
-    /// ([`Self::recover_row`]).
+    /// ([`Self::recover_row`]), and `recover_plain`, w = T z0 - A^{-1} n(y), each row one plain
+    /// sum.
     fn recover(&self, forcing_lets: &[TokenStream]) -> TokenStream {
         let Emission {
             m,
@@ -585,21 +588,34 @@ impl<'a> Reduction<'a> {
             ..
         } = self.e;
         let factors_ty = &self.factors_ty;
-        let recover_sets = (0..*m).map(|row| self.recover_row(row));
-        quote! {
-            /// w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the structural nonzeros,
-            /// the corrections inside each row's last rounding.
-            #[inline]
-            fn recover(
-                &self,
-                factors: &#factors_ty,
-                z0: &#vec_s,
-                forcing: &#vec_m,
-            ) -> #vec_m {
-                #(#forcing_lets)*
-                #vec_m_path::from([#(#recover_sets),*])
+        let method = |name: Ident, doc: &str, compensated: bool| {
+            let sets = (0..*m).map(|row| self.recover_row(row, compensated));
+            quote! {
+                #[doc = #doc]
+                #[inline]
+                fn #name(
+                    &self,
+                    factors: &#factors_ty,
+                    z0: &#vec_s,
+                    forcing: &#vec_m,
+                ) -> #vec_m {
+                    #(#forcing_lets)*
+                    #vec_m_path::from([#(#sets),*])
+                }
             }
-        }
+        };
+        let compensated = method(
+            format_ident!("recover"),
+            " w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the structural nonzeros, the \
+             corrections inside each row's last rounding.",
+            true,
+        );
+        let plain = method(
+            format_ident!("recover_plain"),
+            " w = T z0 - A^{-1} n(y) over the structural nonzeros, each row one plain sum.",
+            false,
+        );
+        quote!(#compensated #plain)
     }
 }
 
