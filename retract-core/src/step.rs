@@ -928,3 +928,21 @@ fn locate_crossing_with<const S: usize>(
     }
     0.5 * (inside + outside)
 }
+
+#[cfg(all(test, feature = "serde"))]
+mod tests {
+    use super::StepOptions;
+
+    #[test]
+    fn options_written_before_the_compensation_switch_read_as_compensated() {
+        let mut json = serde_json::to_value(StepOptions::default().with_compensation(false))
+            .expect("options serialize");
+        assert_eq!(json["compensated"], false);
+        json.as_object_mut()
+            .expect("an object")
+            .remove("compensated");
+        let read: StepOptions = serde_json::from_value(json).expect("options without the field");
+        assert!(read.compensated);
+        assert_eq!(read, StepOptions::default());
+    }
+}
