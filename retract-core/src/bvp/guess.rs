@@ -58,6 +58,7 @@ impl Hermite {
 
     /// $q_i^{(j)}(t)$ (zero for $j \ge 2k$).
     pub fn derivative(&self, i: usize, j: usize, t: f64) -> f64 {
+        debug_assert!(i < self.n, "coordinate {i} of {}", self.n);
         self.derivatives
             .get(j * self.n + i)
             .map_or(0.0, |d| d.iter().rev().fold(0.0, |acc, &c| acc * t + c))

@@ -221,7 +221,7 @@ where
     // second sweep: delta z_i and delta u_i
     let mut dz = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { xi[row - nk] });
     delta[layout.z(0)..layout.z(0) + S].copy_from_slice(dz.as_slice());
-    for (i, map) in maps.iter().enumerate() {
+    for (i, map) in maps.iter().enumerate().take(steps) {
         let dw = map.affine(&dz);
         delta[layout.z(i + 1)..layout.z(i + 1) + S].copy_from_slice(&dw.as_slice()[..S]);
         delta[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&dw.as_slice()[S..]);
