@@ -13,31 +13,17 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use retract::bvp::{Curve, OptimalControlProblem, PlanGuess, PlanOptions};
-use retract::{higher_order_lagrangian, jet_function};
+use retract::jet_function;
 
+#[path = "common/cart_pole.rs"]
+mod cart_pole;
 #[path = "common/pendulum.rs"]
 mod pendulum;
+use cart_pole::{CartPole, PoleTorque};
 use pendulum::{ElbowCost, ShoulderTorque, TorqueCost};
 
-/// Cart-pole: cost 1/2 F^2 on the cart force
-/// F = (mc + mp) x'' + mp l cos(th) th'' - mp l sin(th) th'^2, q = (x, th), th from the
-/// downward vertical.
-#[higher_order_lagrangian(order = 2)]
-fn cart_pole(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], mc: f64, mp: f64, l: f64) -> f64 {
-    let force =
-        (mc + mp) * ddq[0] + mp * l * q[1].cos() * ddq[1] - mp * l * q[1].sin() * dq[1] * dq[1];
-    0.5 * force * force
-}
-
-/// The pole's generalized force, which no actuator supplies: it must vanish at every step,
-/// tau_p = mp l cos(th) x'' + mp l^2 th'' + mp g l sin(th).
-#[jet_function(order = 2)]
-fn pole_torque(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], mp: f64, l: f64, g: f64) -> f64 {
-    mp * l * q[1].cos() * ddq[0] + mp * l * l * ddq[1] + mp * g * l * q[1].sin()
-}
-
 /// A bound on the cart force: `limit - sign F >= 0` (sign = +1 and -1 bound it above and
-/// below; F as in [`cart_pole`], whose cost is 1/2 F^2).
+/// below; F as in [`cart_pole::cart_pole`], whose cost is 1/2 F^2).
 #[jet_function(order = 2)]
 fn force_margin(
     q: [f64; 2],

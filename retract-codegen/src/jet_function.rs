@@ -56,12 +56,21 @@ pub fn try_expand_jet_function(attr: TokenStream, item: TokenStream) -> syn::Res
     let (sig, roots) = charts::compose(&mut graph, sig, &[root]);
     let root = roots[0];
     let (_, gradient, hessian) = mechanics::derivatives(&mut graph, root, sig.dim, sig.order);
+    let (n, k) = (sig.dim, sig.order);
+    let involves_top = gradient[k * n..(k + 1) * n]
+        .iter()
+        .any(|&d| !graph.is_const(d, 0.0));
     let bodies = scalar_bodies(&graph, &sig, root, &gradient, &hessian);
-    Ok(generate(&function, &sig, bodies))
+    Ok(generate(&function, &sig, bodies, involves_top))
 }
 
 /// The function, its parameter struct and the `JetFunction` impl.
-fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies) -> TokenStream {
+fn generate(
+    function: &ItemFn,
+    sig: &signature::Signature,
+    bodies: ScalarBodies,
+    involves_top: bool,
+) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let (n_lit, k_lit) = (
         proc_macro2::Literal::usize_unsuffixed(n),
@@ -102,6 +111,7 @@ fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies)
         hessian,
     } = bodies;
     let allow = allow_generated();
+    let type_name = sig.type_name.to_string();
 
     out.extend(quote! {
         #[automatically_derived]
@@ -120,6 +130,16 @@ fn generate(function: &ItemFn, sig: &signature::Signature, bodies: ScalarBodies)
             /// The Hessian of g in (x, u); structural zeros are not computed.
             fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
                 #hessian
+            }
+
+            /// Whether g depends on the top derivative q^(k) (decided from the expression).
+            fn involves_top(&self) -> bool {
+                #involves_top
+            }
+
+            /// The generated type's name.
+            fn name(&self) -> &'static str {
+                #type_name
             }
         }
     });

@@ -264,14 +264,19 @@ fn kind_of(ty: &Type) -> Option<Kind> {
         matches!(ty, Type::Path(p) if p.qself.is_none() && p.path.is_ident("f64"))
     }
     fn array_len(ty: &Type) -> Option<usize> {
-        match ty {
-            Type::Array(a) if is_f64(&a.elem) => match &a.len {
+        // (a length passed through `macro_rules!` arrives in an invisible group)
+        fn literal(len: &syn::Expr) -> Option<usize> {
+            match len {
                 syn::Expr::Lit(syn::ExprLit {
                     lit: syn::Lit::Int(n),
                     ..
                 }) => n.base10_parse().ok().filter(|&n: &usize| n > 0),
+                syn::Expr::Group(g) => literal(&g.expr),
                 _ => None,
-            },
+            }
+        }
+        match ty {
+            Type::Array(a) if is_f64(&a.elem) => literal(&a.len),
             _ => None,
         }
     }

@@ -78,6 +78,19 @@ pub trait JetFunction<const N: usize, const K: usize> {
 
     /// The Hessian of $g$ in $(x, u)$, by blocks.
     fn hessian(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Hessian<N, K>;
+
+    /// Whether $g$ depends on the top derivative $u = q^{(k)}$. The optimizer imposes a
+    /// constraint that does not at the nodes $x_i$ as well as at the steps' evaluation points
+    /// ([`crate::bvp::Placement`]). `#[jet_function]` decides it from the expression; the
+    /// default, `true`, is right for any $g$.
+    fn involves_top(&self) -> bool {
+        true
+    }
+
+    /// A name for messages (`#[jet_function]`: the generated type's name).
+    fn name(&self) -> &'static str {
+        "jet function"
+    }
 }
 
 /// A $k$-th order Lagrangian $L(x, u)$ on $\mathbb{R}^N$ with $K = k$.

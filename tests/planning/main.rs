@@ -15,6 +15,7 @@ mod free_end;
 mod inequalities;
 mod mpc;
 mod optimize;
+mod placement;
 mod stage_systems;
 mod typed_data;
 

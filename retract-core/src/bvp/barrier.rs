@@ -1,32 +1,51 @@
-//! The primal-dual logarithmic barrier of the inequalities $g_j(x_{\theta,i}, u_i) \ge 0$, with
-//! slacks.
+//! The primal-dual logarithmic barrier of the inequalities $g_j \ge 0$, with slacks: those at
+//! the steps' evaluation points $(x_{\theta,i}, u_i)$ and those at the interior nodes $x_i$
+//! ($0 < i < N$; the fixed ends are checked before iterating).
 //!
 //! Each inequality becomes $g - s = 0$, $s > 0$, and for a barrier parameter $\mu$ (per unit
 //! time) the optimizer minimises $J - h \mu \sum \ln s$ (as IPOPT), so the first guess need not
 //! satisfy the inequalities. With multipliers $z \approx \mu / s$ and the residual
 //! $r = g - s$, eliminating $\delta s = \nabla g^T \delta y + r$ and $\delta z$ from the
-//! primal-dual Newton system leaves, per step, the gradient
+//! primal-dual Newton system leaves, per constraint, the gradient
 //! $-h \nabla g\thinspace(\mu/s - (z/s)\thinspace r)$ and the Hessian $h (z/s) \nabla g \nabla g^T - h z \nabla^2 g$
-//! added to the model of $h L$; then $\delta z = (\mu - z s - z\thinspace\delta s)/s$. The slacks
+//! added to the model of $h L$ of its step (in $(x_\theta, u)$) or of its node (in $x_i$);
+//! then $\delta z = (\mu - z s - z\thinspace\delta s)/s$. The slacks
 //! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$
 //! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
 //! \min(\mu / 5, \mu^{1.5}))$.
 
+use nalgebra::{SMatrix, SVector};
+
 use super::constraints::Linearized;
 use super::riccati::{Direction, StageModel};
 
-/// Barrier parameter, slacks and multipliers, `count` per step, step-major.
+/// Barrier parameter, slacks and multipliers: `count` per step (step-major), then `nodes`
+/// per interior node $x_1, \dots, x_{N-1}$ (node-major).
 pub(super) struct Barrier {
     pub mu: f64,
     pub s: Vec<f64>,
     pub z: Vec<f64>,
+    /// Inequalities per step.
     pub count: usize,
+    /// Inequalities per interior node.
+    pub nodes: usize,
+    /// Steps $N$.
+    pub steps: usize,
+}
+
+/// Where entry `k` of a [`Barrier`] lives.
+pub(super) enum Slot {
+    /// At the evaluation point of step `i`.
+    Step(usize),
+    /// At node `i`.
+    Node(usize),
 }
 
 impl Barrier {
-    /// Slacks $s = \max(g, 0.1 \max(1, |g|))$ and $z = \mu / s$ at the first iterate.
-    pub fn new(mu: f64, count: usize, values: &[f64]) -> Self {
+    /// Slacks $s = \max(g, 0.1 \max(1, |g|))$ and $z = \mu / s$ at the first iterate, for
+    /// `count` inequalities per step and `nodes` per interior node over `steps` steps.
+    pub fn new(mu: f64, (count, nodes, steps): (usize, usize, usize), values: &[f64]) -> Self {
         let s: Vec<f64> = values
             .iter()
             .map(|g| g.max(0.1 * g.abs().max(1.0)))
@@ -36,7 +55,122 @@ impl Barrier {
             z: s.iter().map(|s| mu / s).collect(),
             s,
             count,
+            nodes,
+            steps,
         }
+    }
+
+    /// The number of entries at the steps' evaluation points (those at the nodes follow).
+    pub fn at_steps(&self) -> usize {
+        self.count * self.steps
+    }
+
+    /// The index of inequality `j` of interior node `i`.
+    pub fn node_index(&self, i: usize, j: usize) -> usize {
+        self.at_steps() + (i - 1) * self.nodes + j
+    }
+
+    /// Where entry `k` lives.
+    pub fn slot(&self, k: usize) -> Slot {
+        let at_steps = self.at_steps();
+        if k < at_steps {
+            Slot::Step(k / self.count)
+        } else {
+            Slot::Node(1 + (k - at_steps) / self.nodes)
+        }
+    }
+
+    /// Adds the barrier's gradient and primal-dual Hessian (without the constraints' own
+    /// curvature) of the inequalities `lin` of interior node `i` to the node terms of its
+    /// stage ([`StageModel::node`]).
+    pub fn add_to_node<const N: usize, const X: usize>(
+        &self,
+        stage: &mut StageModel<N, X>,
+        i: usize,
+        lin: &[Linearized<N, X>],
+        h: f64,
+    ) {
+        let (hessian, gradient) = stage
+            .node
+            .get_or_insert((SMatrix::zeros(), SVector::zeros()));
+        for (j, c) in lin.iter().enumerate() {
+            let k = self.node_index(i, j);
+            let (s, z) = (self.s[k], self.z[k]);
+            *gradient -= c.gx * (h * (self.mu / s - z / s * (c.value - s)));
+            *hessian += c.gx * c.gx.transpose() * (h * z / s);
+        }
+    }
+
+    /// $-h z \nabla g$ summed over the inequalities of every node ($i = 0, \dots, N$; zero at
+    /// the ends and where there are none), with the multipliers `z`: the node terms of the
+    /// gradient of the Lagrangian.
+    pub fn node_gradients<const N: usize, const X: usize>(
+        &self,
+        lin: &[Linearized<N, X>],
+        z: &[f64],
+        h: f64,
+    ) -> Vec<SVector<f64, X>> {
+        let mut out = vec![SVector::zeros(); if self.nodes > 0 { self.steps + 1 } else { 0 }];
+        for (k, c) in lin.iter().enumerate().skip(self.at_steps()) {
+            if let Slot::Node(i) = self.slot(k) {
+                out[i] -= c.gx * (h * z[k]);
+            }
+        }
+        out
+    }
+
+    /// The barrier's share $\sum_k h (z_k / s_k) (\nabla g_k^T \delta y)^2$ of the model's
+    /// curvature along a direction with slack steps `ds` ($\nabla g^T \delta y = \delta s -
+    /// (g - s)$).
+    pub fn curvature<const N: usize, const X: usize>(
+        &self,
+        lin: &[Linearized<N, X>],
+        ds: &[f64],
+        h: f64,
+    ) -> f64 {
+        lin.iter()
+            .zip(ds)
+            .zip(self.s.iter().zip(&self.z))
+            .map(|((c, d), (s, z))| {
+                let along = d - (c.value - s);
+                h * z / s * along * along
+            })
+            .sum()
+    }
+
+    /// The multipliers after a primal-dual step with slack steps `ds`:
+    /// $z + \alpha_z \delta z$, $\delta z = (\mu - z s - z\thinspace\delta s) / s$ and
+    /// $\alpha_z$ the dual fraction-to-the-boundary step of [`Self::update`] (1 near a
+    /// solution, where this is $(\mu - z\thinspace\delta s) / s$).
+    pub fn predicted(&self, ds: &[f64]) -> Vec<f64> {
+        let dz = self.dual_steps(ds);
+        let alpha_z = self.dual_step_length(&dz);
+        self.z
+            .iter()
+            .zip(&dz)
+            .map(|(z, d)| z + alpha_z * d)
+            .collect()
+    }
+
+    /// $\delta z = (\mu - z s - z\thinspace\delta s) / s$.
+    fn dual_steps(&self, ds: &[f64]) -> Vec<f64> {
+        self.z
+            .iter()
+            .zip(&self.s)
+            .zip(ds)
+            .map(|((z, s), d)| (self.mu - z * s - z * d) / s)
+            .collect()
+    }
+
+    /// The largest step in $(0, 1]$ along `dz` that keeps every multiplier above
+    /// $(1 - \tau)$ times its value.
+    fn dual_step_length(&self, dz: &[f64]) -> f64 {
+        let tau = self.tau();
+        self.z
+            .iter()
+            .zip(dz)
+            .filter(|(_, d)| **d < 0.0)
+            .fold(1.0_f64, |a, (z, d)| a.min(-tau * z / d))
     }
 
     /// The fraction-to-the-boundary parameter $\tau$.
@@ -45,7 +179,7 @@ impl Barrier {
     }
 
     /// Adds the barrier's gradient and primal-dual Hessian (without the constraints' own
-    /// curvature) of step `i` to its model.
+    /// curvature) of the inequalities `lin` of step `i` to its model.
     pub fn add_to_stage<const N: usize, const X: usize>(
         &self,
         stage: &mut StageModel<N, X>,
@@ -66,19 +200,19 @@ impl Barrier {
         }
     }
 
-    /// Subtracts $h z \nabla g$ of every inequality from the cost gradients: the gradient of
-    /// the Lagrangian $h L - h z^T g$ per step.
+    /// Subtracts $h z \nabla g$ of every inequality at the steps, with the multipliers `z`,
+    /// from the cost gradients: the gradient of the Lagrangian $h L - h z^T g$ per step.
     pub fn lagrangian_gradients<const N: usize, const X: usize>(
         &self,
         gradients: &mut [(nalgebra::SVector<f64, X>, nalgebra::SVector<f64, N>)],
         lin: &[Linearized<N, X>],
+        z: &[f64],
         h: f64,
     ) {
-        let count = self.count.max(1);
-        for (k, c) in lin.iter().enumerate() {
-            let (gx, gu) = &mut gradients[k / count];
-            *gx -= c.gx * (h * self.z[k]);
-            *gu -= c.gu * (h * self.z[k]);
+        for (k, c) in lin.iter().enumerate().take(self.at_steps()) {
+            let (gx, gu) = &mut gradients[k / self.count];
+            *gx -= c.gx * (h * z[k]);
+            *gu -= c.gu * (h * z[k]);
         }
     }
 
@@ -89,13 +223,17 @@ impl Barrier {
         direction: &Direction<N, X>,
         theta: f64,
     ) -> Vec<f64> {
-        let count = self.count.max(1);
         lin.iter()
             .enumerate()
             .map(|(k, c)| {
-                let i = k / count;
-                let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-                c.gx.dot(&dx) + c.gu.dot(&direction.du[i]) + c.value - self.s[k]
+                let change = match self.slot(k) {
+                    Slot::Step(i) => {
+                        let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+                        c.gx.dot(&dx) + c.gu.dot(&direction.du[i])
+                    }
+                    Slot::Node(i) => c.gx.dot(&direction.dx[i]),
+                };
+                change + c.value - self.s[k]
             })
             .collect()
     }
@@ -163,20 +301,8 @@ impl Barrier {
 
     /// Takes the step: slacks by `alpha` along `ds`, multipliers by their own length.
     pub fn update(&mut self, ds: &[f64], alpha: f64) {
-        let tau = self.tau();
-        let dz: Vec<f64> = self
-            .z
-            .iter()
-            .zip(&self.s)
-            .zip(ds)
-            .map(|((z, s), d)| (self.mu - z * s - z * d) / s)
-            .collect();
-        let alpha_z = self
-            .z
-            .iter()
-            .zip(&dz)
-            .filter(|(_, d)| **d < 0.0)
-            .fold(1.0_f64, |a, (z, d)| a.min(-tau * z / d));
+        let dz = self.dual_steps(ds);
+        let alpha_z = self.dual_step_length(&dz);
         for (((z, s), d), dzk) in self.z.iter_mut().zip(self.s.iter_mut()).zip(ds).zip(&dz) {
             *s += alpha * d;
             *z = (*z + alpha_z * dzk).clamp(self.mu / (1e10 * *s), 1e10 * self.mu / *s);

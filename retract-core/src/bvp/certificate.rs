@@ -19,7 +19,9 @@ use crate::newton::max_abs;
 /// $p_N = \mu_{N-1} + \theta d_{N-1}$ (so that $\mu_i = \theta p_i + (1-\theta) p_{i+1}$ and
 /// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). At the components of $x_N$ that are
 /// free (`fixed` 0) the residual is $p_N + \nabla\Phi(x_N)$, at the free ones of $x_0$
-/// (`start_fixed` 0) it is $p_0$. Returns the momenta and the
+/// (`start_fixed` 0) it is $p_0$. The node terms of the Lagrangian (`node_gradients`, its
+/// gradient in $x_i$ from the inequalities at the nodes; empty without them) add to $r_{x,i}$.
+/// Returns the momenta and the
 /// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla
 /// L|_\infty))$ (the terminal residual without the $h$).
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
@@ -27,6 +29,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     stages: &[StageModel<N, X>],
     gradients: &[(SVector<f64, X>, SVector<f64, N>)],
     direction: &Direction<N, X>,
+    node_gradients: &[SVector<f64, X>],
     (terminal_gradient, fixed, start_fixed): (&SVector<f64, X>, &SVector<f64, X>, &SVector<f64, X>),
 ) -> (Vec<SVector<f64, X>>, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
@@ -57,7 +60,10 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
             worst = worst.max((gu[a] - h * mu[X - N + a]).abs());
         }
         if i > 0 {
-            let r = d * (1.0 - theta) + d_prev * theta - (mu - mu_prev);
+            let mut r = d * (1.0 - theta) + d_prev * theta - (mu - mu_prev);
+            if let Some(node) = node_gradients.get(i) {
+                r += node;
+            }
             worst = worst.max(max_abs(&r));
         }
         momenta.push(mu - d * (1.0 - theta));

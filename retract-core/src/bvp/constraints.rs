@@ -1,6 +1,8 @@
-//! Stage constraints of the optimizer: equalities $g(x_\theta, u) = 0$ and inequalities
-//! $g(x_\theta, u) \ge 0$ at the evaluation point of every step, either a [`JetFunction`]
-//! written as plain Rust (differentiated by `#[jet_function]`) or a bound on one variable.
+//! Stage constraints of the optimizer: equalities $g(x_\theta, u) = 0$ at the evaluation
+//! point of every step, and inequalities $\ell \le g \le u$ on a [`JetFunction`] written as
+//! plain Rust (differentiated by `#[jet_function]`) or on one variable, imposed where their
+//! [`Placement`] says: at the evaluation points $(x_{\theta,i}, u_i)$ of the steps, at the
+//! nodes $x_i$, or both.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -9,25 +11,112 @@ use crate::{Hessian, JetFunction};
 
 /// A variable of a step that a bound applies to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Variable {
     /// Entry `r` of the jet $x = (q, q', \dots, q^{(k-1)})$ (blocks of $n$: entry $j n + a$
-    /// is $q_a^{(j)}$), at the step's evaluation point $x_\theta$.
+    /// is $q_a^{(j)}$), at the nodes $x_i$ and the evaluation points $x_{\theta,i}$.
     Jet(usize),
-    /// Component `a` of the top derivative $u = q^{(k)}$.
+    /// Component `a` of the top derivative $u = q^{(k)}$, which lives at the steps'
+    /// evaluation points.
     Top(usize),
 }
 
-/// One scalar stage constraint.
+/// Where an inequality is imposed.
+///
+/// The jet $x = (q, \dots, q^{(k-1)})$ lives at the nodes $x_i$ (times $t_i = i h$) and at
+/// the evaluation points $x_{\theta,i} = (1-\theta) x_i + \theta x_{i+1}$ of the steps; the
+/// top derivative $u_i = q^{(k)}$ only at the evaluation points. A constraint of the jet
+/// alone (a clearance, a joint limit) holds where the plan is: by default at both
+/// ([`Placement::NodesAndMidpoints`]); one that involves $u$ at the evaluation points
+/// ([`Placement::Midpoints`]). The plan reports its largest violation at each and along its
+/// interpolant ([`super::Plan::violations`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Placement {
+    /// At $(x_{\theta,i}, u_i)$ for every step $i < N$.
+    Midpoints,
+    /// At every node $x_i$, $i = 0, \dots, N$ (only for constraints of the jet alone; the
+    /// fixed ends are checked before iterating).
+    Nodes,
+    /// Both.
+    NodesAndMidpoints,
+}
+
+impl Placement {
+    /// Whether the constraint holds at the steps' evaluation points.
+    pub fn at_midpoints(self) -> bool {
+        matches!(self, Placement::Midpoints | Placement::NodesAndMidpoints)
+    }
+    /// Whether the constraint holds at the nodes.
+    pub fn at_nodes(self) -> bool {
+        matches!(self, Placement::Nodes | Placement::NodesAndMidpoints)
+    }
+}
+
+/// The kind of a constraint a failure names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum ConstraintKind {
+    /// A stage equality ([`super::OptimalControlProblem::with_equality`]).
+    Equality,
+    /// An inequality on a function ([`super::OptimalControlProblem::with_inequality`],
+    /// [`super::OptimalControlProblem::with_function_bounds`]).
+    Inequality,
+    /// A bound on a variable ([`super::OptimalControlProblem::with_bounds`] and the vector
+    /// forms).
+    Bound(Variable),
+}
+
+/// A constraint as the user added it: its kind, its index among the constraints of that
+/// class (equalities, inequalities and bounds, counted separately in the order added), and the
+/// generated type's name for a function ([`JetFunction::name`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ConstraintRef {
+    /// Equality, inequality or bound.
+    pub kind: ConstraintKind,
+    /// The index among the constraints of its class, from 0 in the order they were added.
+    pub index: usize,
+    /// The function's type name (e.g. `CartForce`); `"bound"` for a bound.
+    pub name: &'static str,
+}
+
+impl core::fmt::Display for ConstraintRef {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.kind {
+            ConstraintKind::Equality => write!(f, "equality #{} ({})", self.index, self.name),
+            ConstraintKind::Inequality => {
+                write!(f, "inequality #{} ({})", self.index, self.name)
+            }
+            ConstraintKind::Bound(Variable::Jet(r)) => {
+                write!(f, "bound #{} on jet entry {r}", self.index)
+            }
+            ConstraintKind::Bound(Variable::Top(a)) => {
+                write!(f, "bound #{} on top derivative {a}", self.index)
+            }
+        }
+    }
+}
+
+/// What an inequality constrains.
 #[derive(Clone, Copy)]
-pub(super) enum StageConstraint<'a, const N: usize, const K: usize> {
-    /// $g(x_\theta, u)$.
+pub(super) enum Source<'a, const N: usize, const K: usize> {
+    /// $g(x, u)$.
     Function(&'a (dyn JetFunction<N, K> + Sync)),
-    /// $\pm(v - \text{value})$: the variable above (sign +1) or below (sign -1) a value.
-    Bound {
-        variable: Variable,
-        value: f64,
-        sign: f64,
-    },
+    /// One variable.
+    Variable(Variable),
+}
+
+/// One scalar inequality $\sigma (v - c) \ge 0$ of a source value $v$: $v \ge c$ ($\sigma = 1$,
+/// a lower bound) or $v \le c$ ($\sigma = -1$).
+#[derive(Clone, Copy)]
+pub(super) struct Inequality<'a, const N: usize, const K: usize> {
+    pub source: Source<'a, N, K>,
+    pub value: f64,
+    pub sign: f64,
+    pub placement: Placement,
+    /// The index of the user's constraint (one `with_*_bounds` call may add two).
+    pub index: usize,
 }
 
 /// Value, gradient $(\partial_x, \partial_u)$ of a stage constraint at $(x_\theta, u)$.
@@ -37,17 +126,38 @@ pub(super) struct Linearized<const N: usize, const X: usize> {
     pub gu: SVector<f64, N>,
 }
 
-impl<const N: usize, const K: usize> StageConstraint<'_, N, K> {
-    /// The constraint's value alone.
-    pub fn value<const X: usize>(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> f64 {
-        match *self {
-            StageConstraint::Function(g) => g.value(&blocks::<N, K, X>(x), u),
-            StageConstraint::Bound {
-                variable,
-                value,
-                sign,
-            } => sign * (read(variable, x, u) - value),
+impl<const N: usize, const K: usize> Inequality<'_, N, K> {
+    /// The constraint as the user added it.
+    pub fn reference(&self) -> ConstraintRef {
+        match self.source {
+            Source::Function(g) => ConstraintRef {
+                kind: ConstraintKind::Inequality,
+                index: self.index,
+                name: g.name(),
+            },
+            Source::Variable(v) => ConstraintRef {
+                kind: ConstraintKind::Bound(v),
+                index: self.index,
+                name: "bound",
+            },
         }
+    }
+
+    /// Whether the source involves the top derivative $u$ (then it lives at the midpoints).
+    pub fn involves_top(&self) -> bool {
+        match self.source {
+            Source::Function(g) => g.involves_top(),
+            Source::Variable(v) => matches!(v, Variable::Top(_)),
+        }
+    }
+
+    /// $\sigma (v(x, u) - c)$.
+    pub fn value<const X: usize>(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> f64 {
+        let v = match self.source {
+            Source::Function(g) => g.value(&blocks::<N, K, X>(x), u),
+            Source::Variable(variable) => read(variable, x, u),
+        };
+        self.sign * (v - self.value)
     }
 
     /// Value and gradient.
@@ -56,28 +166,25 @@ impl<const N: usize, const K: usize> StageConstraint<'_, N, K> {
         x: &SVector<f64, X>,
         u: &SVector<f64, N>,
     ) -> Linearized<N, X> {
-        match *self {
-            StageConstraint::Function(g) => {
+        let sign = self.sign;
+        match self.source {
+            Source::Function(g) => {
                 let xb = blocks::<N, K, X>(x);
                 let grad = g.gradient(&xb, u);
                 Linearized {
-                    value: g.value(&xb, u),
-                    gx: SVector::from_fn(|r, _| grad.x[r / N][r % N]),
-                    gu: grad.u,
+                    value: sign * (g.value(&xb, u) - self.value),
+                    gx: SVector::from_fn(|r, _| sign * grad.x[r / N][r % N]),
+                    gu: grad.u * sign,
                 }
             }
-            StageConstraint::Bound {
-                variable,
-                value,
-                sign,
-            } => {
+            Source::Variable(variable) => {
                 let (mut gx, mut gu) = (SVector::zeros(), SVector::zeros());
                 match variable {
                     Variable::Jet(r) => gx[r] = sign,
                     Variable::Top(a) => gu[a] = sign,
                 }
                 Linearized {
-                    value: sign * (read(variable, x, u) - value),
+                    value: sign * (read(variable, x, u) - self.value),
                     gx,
                     gu,
                 }
@@ -85,36 +192,32 @@ impl<const N: usize, const K: usize> StageConstraint<'_, N, K> {
         }
     }
 
-    /// `weight` times the Hessian blocks $(H_{xx}, H_{ux}, H_{uu})$ (zero for a bound).
+    /// `weight` times the Hessian blocks $(H_{xx}, H_{ux}, H_{uu})$ of $\sigma v$ (none for a
+    /// bound).
     pub fn weighted_hessian<const X: usize>(
         &self,
         x: &SVector<f64, X>,
         u: &SVector<f64, N>,
         weight: f64,
     ) -> Option<(SMatrix<f64, X, X>, SMatrix<f64, N, X>, SMatrix<f64, N, N>)> {
-        match self {
-            StageConstraint::Function(g) if weight != 0.0 => Some(flat_hessian::<N, K, X>(
+        match self.source {
+            Source::Function(g) if weight != 0.0 => Some(flat_hessian::<N, K, X>(
                 &g.hessian(&blocks::<N, K, X>(x), u),
-                weight,
+                weight * self.sign,
             )),
             _ => None,
         }
     }
 
-    /// Whether the constraint is well formed for jets of length `X`.
+    /// Whether the constraint is well formed for jets of length `X`: a finite value, a
+    /// variable in range, and no node placement for what involves $u$.
     pub fn valid<const X: usize>(&self) -> bool {
-        match *self {
-            StageConstraint::Function(_) => true,
-            StageConstraint::Bound {
-                variable, value, ..
-            } => {
-                let inside = match variable {
-                    Variable::Jet(r) => r < X,
-                    Variable::Top(a) => a < N,
-                };
-                inside && value.is_finite()
-            }
-        }
+        let inside = match self.source {
+            Source::Function(_) => true,
+            Source::Variable(Variable::Jet(r)) => r < X,
+            Source::Variable(Variable::Top(a)) => a < N,
+        };
+        inside && self.value.is_finite() && !(self.placement.at_nodes() && self.involves_top())
     }
 }
 

@@ -73,20 +73,24 @@
 
 mod barrier;
 mod certificate;
+mod constrain;
 mod constraints;
 mod curve;
 mod extrapolate;
 mod guess;
 mod optimize;
+mod refine;
 mod riccati;
 mod sqp;
+mod violations;
 
-pub use constraints::Variable;
+pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions, RealTime,
 };
+pub use violations::{INTERPOLANT_POINTS, Infeasibility, Location, Violations};
 
 mod root_finder;
 mod shift;

@@ -29,11 +29,12 @@ use std::time::{Duration, Instant};
 
 use nalgebra::SVector;
 
-use super::constraints::{StageConstraint, Variable};
+use super::constraints::{Inequality, Placement};
 use super::curve::Curve;
 use super::guess::Hermite;
 use super::riccati::Dynamics;
 use super::sqp::Sqp;
+use super::violations::{Infeasibility, Violations};
 use crate::{DomainViolation, Error, JetFunction, Lagrangian, LiftedSystem};
 
 /// Options of [`OptimalControlProblem::solve`].
@@ -209,6 +210,10 @@ pub struct Plan<const N: usize, const X: usize> {
     pub iterations: usize,
     /// Residuals and curvature at this point.
     pub certificate: Certificate,
+    /// The largest constraint violation at the nodes, at the evaluation points and along the
+    /// interpolant ([`Violations`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub violations: Violations,
 }
 
 impl<const N: usize, const X: usize> Plan<N, X> {
@@ -347,6 +352,9 @@ pub enum Failure {
     LineSearch,
     /// The inertia correction reached its cap without making the reduced Hessian definite.
     Regularization,
+    /// A constraint no point satisfies (refused before iterating): its own data contradict
+    /// themselves, or the fixed start or goal violates it at the node.
+    Infeasible(Infeasibility),
     /// The KKT conditions hold but the reduced Hessian has negative (or zero) curvature: a
     /// saddle, not a minimum.
     NotAMinimum {
@@ -399,12 +407,21 @@ impl core::fmt::Display for Failure {
                 f,
                 "the inertia correction could not make the reduced Hessian positive definite"
             ),
+            Failure::Infeasible(infeasibility) => write!(f, "infeasible: {infeasibility}"),
+            Failure::NotAMinimum {
+                negative_directions: 0,
+            } => write!(
+                f,
+                "the KKT point found is not a strict minimum: its reduced Hessian is singular \
+                 (a direction of zero curvature, or constraints dependent there); fix the \
+                 free directions (e.g. an end) or start from another guess"
+            ),
             Failure::NotAMinimum {
                 negative_directions,
             } => write!(
                 f,
                 "the KKT point found is not a minimum: its reduced Hessian has \
-                 {negative_directions} non-positive eigenvalue(s); start from another guess"
+                 {negative_directions} negative eigenvalue(s); start from another guess"
             ),
         }
     }
@@ -462,7 +479,11 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     /// of range (an error at solve).
     pub(super) bad_free_component: bool,
     pub(super) equalities: Vec<&'a (dyn JetFunction<N, K> + Sync)>,
-    pub(super) inequalities: Vec<StageConstraint<'a, N, K>>,
+    /// The scalar inequalities (a two-sided constraint gives two).
+    pub(super) inequalities: Vec<Inequality<'a, N, K>>,
+    /// Function inequalities and bounds added so far (their indices in messages).
+    pub(super) function_inequalities: usize,
+    pub(super) bounds: usize,
     pub(super) start: SVector<f64, X>,
     pub(super) goal: SVector<f64, X>,
     pub(super) t_end: f64,
@@ -483,6 +504,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
             bad_free_component: self.bad_free_component,
             equalities: self.equalities.clone(),
             inequalities: self.inequalities.clone(),
+            function_inequalities: self.function_inequalities,
+            bounds: self.bounds,
             start: self.start,
             goal: self.goal,
             t_end: self.t_end,
@@ -510,6 +533,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             bad_free_component: false,
             equalities: Vec::new(),
             inequalities: Vec::new(),
+            function_inequalities: 0,
+            bounds: 0,
             start: SVector::from_column_slice(start),
             goal: SVector::from_column_slice(goal),
             t_end,
@@ -568,39 +593,6 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         self
     }
 
-    /// Adds the equality constraint $g(x_{\theta,i}, u_i) = 0$ at every step (e.g. a passive
-    /// joint's torque, written under `#[jet_function]`). At most $n$ constraints, jointly of
-    /// full rank in the top derivative $u$ (so that each step can satisfy them).
-    pub fn with_equality(mut self, constraint: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
-        self.equalities.push(constraint);
-        self
-    }
-
-    /// Adds the inequality $g(x_{\theta,i}, u_i) \ge 0$ at the evaluation point of every step
-    /// (obstacle clearance, a keep-out cone, a torque limit $\tau_{\max} - \tau \ge 0$),
-    /// handled by the interior-point iteration with slacks (see the module docs): the first
-    /// guess need not satisfy it.
-    pub fn with_inequality(mut self, constraint: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
-        self.inequalities
-            .push(StageConstraint::Function(constraint));
-        self
-    }
-
-    /// Bounds `lower` $\le v \le$ `upper` on one variable of every step (either may be
-    /// infinite: no bound on that side), as two inequalities ([`Self::with_inequality`]).
-    pub fn with_bounds(mut self, variable: Variable, lower: f64, upper: f64) -> Self {
-        for (value, sign) in [(lower, 1.0), (upper, -1.0)] {
-            if value.is_nan() || value.is_finite() {
-                self.inequalities.push(StageConstraint::Bound {
-                    variable,
-                    value,
-                    sign,
-                });
-            }
-        }
-        self
-    }
-
     fn h(&self) -> f64 {
         self.t_end / self.steps as f64
     }
@@ -614,7 +606,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         if !self.inequalities.iter().all(|c| c.valid::<X>()) {
             return invalid(
                 "bounds",
-                "a bound needs a finite value and a jet index < n k or a top index < n",
+                "bounds need values that are not NaN, a jet index < n k (a block j < k) or a \
+                 top index < n, and no node placement for what involves the top derivative",
             );
         }
         if self.equalities.len() > n {
@@ -741,6 +734,12 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 system.check_parameters().map_err(invalid)?;
             }
         }
+        if let Some(infeasibility) = self.contradiction().or_else(|| self.ends_violation()) {
+            return Err(PlanError {
+                failure: Failure::Infeasible(infeasibility),
+                last: None,
+            });
+        }
         let iterate = self.initial(guess).map_err(invalid)?;
         self.check_terminal_cost(&iterate).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
@@ -750,10 +749,16 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
+        let placed = |at: fn(Placement) -> bool| {
+            let list = self.inequalities.iter().filter(|c| at(c.placement));
+            list.copied().collect()
+        };
         Sqp::<Sys, N, K, X, S, M> {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started: Instant::now(),
+            at_steps: placed(Placement::at_midpoints),
+            at_nodes: placed(Placement::at_nodes),
         }
         .run(iterate)
     }

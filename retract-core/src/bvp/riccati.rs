@@ -112,6 +112,9 @@ pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub cx: SMatrix<f64, N, X>,
     pub cu: SMatrix<f64, N, N>,
     pub value: SVector<f64, N>,
+    /// Terms of the node $x_i$ itself (the barrier of the inequalities placed at the node):
+    /// their Hessian and gradient in $\delta x_i$, added to $Q_{xx}$ and $q_x$.
+    pub node: Option<(SMatrix<f64, X, X>, SVector<f64, X>)>,
 }
 
 /// The stage constraints in the Riccati variables: with $\delta y = (E \delta x + \theta \bar B
@@ -365,7 +368,10 @@ fn stage_factor<const N: usize, const X: usize>(
     // shared by Q_ux and Q_uu
     let bth = b.left_t(&hxx) * theta;
     let btp = b.left_t(p);
-    let qxx = e.left_t(&e.right(&hxx)) + a.left_t(&a.right(p));
+    let mut qxx = e.left_t(&e.right(&hxx)) + a.left_t(&a.right(p));
+    if let Some((node, _)) = &stage.node {
+        qxx += node;
+    }
     let qux = e.right(&(bth + stage.hux)) + a.right(&btp);
     let cross = b.right(&stage.hux) * theta;
     let quu = b.right(&bth) * theta + cross + cross.transpose() + huu + b.right(&btp);
@@ -608,8 +614,12 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let offset = stage.defect * theta;
             let gx = stage.gx + stage.hxx * offset + offset * rho;
             let gu = stage.gu + stage.hux * offset;
+            let mut lx = dynamics.poly_e.left_t(&gx);
+            if let Some((_, node)) = &stage.node {
+                lx += node;
+            }
             StageLinear {
-                lx: dynamics.poly_e.left_t(&gx),
+                lx,
                 lu: dynamics.poly_b.left_t(&gx) * theta + gu,
                 defect: stage.defect,
                 constraint: stage.value + stage.cx * offset,
@@ -846,6 +856,15 @@ mod tests {
             view += block;
             let mut top = rhs.rows_mut(0, nv);
             top -= t.transpose() * g;
+            // the node terms of x_i
+            if let Some((hn, gn)) = &s.node {
+                for r in 0..X {
+                    for c in 0..X {
+                        kkt[(xc(i) + r, xc(i) + c)] += hn[(r, c)];
+                    }
+                    rhs[xc(i) + r] -= gn[r];
+                }
+            }
             // x_{i+1} - A x_i - B u_i = c_i
             let row = nv + (i + 1) * X;
             for r in 0..X {
@@ -889,6 +908,99 @@ mod tests {
         (kkt, rhs)
     }
 
+    /// Iterative refinement leaves the Riccati solution of a subproblem with stage equality
+    /// constraints, node terms, an inertia correction and a free end where it is (its
+    /// residual is rounding), and takes a perturbed solution back to it.
+    #[test]
+    fn refinement_keeps_a_constrained_solution() {
+        const N: usize = 2;
+        const X: usize = 4;
+        let dynamics = Dynamics::<N, X>::new(0.3, 0.5);
+        let mut seed = 11;
+        let steps = 6;
+        let stages: Vec<StageModel<N, X>> = (0..steps)
+            .map(|i| {
+                let m = SMatrix::<f64, 6, 6>::from_fn(|_, _| noise(&mut seed));
+                let h = m * m.transpose() + SMatrix::<f64, 6, 6>::identity() * 0.5;
+                let mut cx = SMatrix::<f64, N, X>::zeros();
+                let mut cu = SMatrix::<f64, N, N>::zeros();
+                let mut value = SVector::<f64, N>::zeros();
+                let constraints = i % 2;
+                if constraints == 1 {
+                    cx.set_row(
+                        0,
+                        &SVector::<f64, X>::from_fn(|_, _| noise(&mut seed)).transpose(),
+                    );
+                    cu.set_row(
+                        0,
+                        &SVector::<f64, N>::from_fn(|_, _| noise(&mut seed)).transpose(),
+                    );
+                    value[0] = noise(&mut seed);
+                }
+                let node = (i > 0).then(|| {
+                    let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
+                    (m * m.transpose(), SVector::from_fn(|_, _| noise(&mut seed)))
+                });
+                StageModel {
+                    hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
+                    hux: h.fixed_view::<2, 4>(4, 0).into_owned(),
+                    huu: h.fixed_view::<2, 2>(4, 4).into_owned(),
+                    gx: SVector::from_fn(|_, _| noise(&mut seed)),
+                    gu: SVector::from_fn(|_, _| noise(&mut seed)),
+                    defect: SVector::from_fn(|_, _| 0.1 * noise(&mut seed)),
+                    constraints,
+                    cx,
+                    cu,
+                    value,
+                    node,
+                }
+            })
+            .collect();
+        let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
+        let terminal = Terminal {
+            hessian: m * m.transpose(),
+            fixed: SVector::from([1.0, 1.0, 0.0, 0.0]),
+            start_fixed: SVector::repeat(1.0),
+        };
+        let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+        let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+        let s_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+        let rho = 0.25;
+        let riccati = Riccati::factor_with(&dynamics, &stages, rho, &terminal);
+        assert!(riccati.positive_definite());
+        let exact = riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end));
+        let model = (&stages[..], &terminal);
+        for perturbation in [0.0, 0.1] {
+            let mut d = riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end));
+            for v in d.dx.iter_mut().skip(1).chain(d.costate.iter_mut()) {
+                *v += SVector::<f64, X>::from_fn(|_, _| perturbation * noise(&mut seed));
+            }
+            for v in d.du.iter_mut().chain(d.multipliers.iter_mut()) {
+                *v += SVector::<f64, N>::from_fn(|_, _| perturbation * noise(&mut seed));
+            }
+            crate::bvp::refine::refine(
+                &riccati,
+                &dynamics,
+                model,
+                rho,
+                &r0,
+                (&r_end, &s_end),
+                &mut d,
+            );
+            for (i, stage) in stages.iter().enumerate() {
+                let off = (d.dx[i + 1] - exact.dx[i + 1])
+                    .amax()
+                    .max((d.du[i] - exact.du[i]).amax())
+                    .max((d.costate[i] - exact.costate[i]).amax());
+                assert!(off < 1e-9, "step {i}, perturbation {perturbation}: {off:e}");
+                if stage.constraints > 0 {
+                    let y = (d.multipliers[i] - exact.multipliers[i])[0];
+                    assert!(y.abs() < 1e-9, "multiplier {i}: {y:e}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn riccati_equals_the_dense_kkt_solve() {
         const N: usize = 2;
@@ -907,9 +1019,15 @@ mod tests {
             let dynamics = Dynamics::<N, X>::new(0.3, 0.5);
             let mut seed = 7;
             let stages: Vec<StageModel<N, X>> = (0..steps)
-                .map(|_| {
+                .map(|i| {
                     let m = SMatrix::<f64, 6, 6>::from_fn(|_, _| noise(&mut seed));
                     let h = m * m.transpose() + SMatrix::<f64, 6, 6>::identity() * shift;
+                    // node terms on the odd interior nodes (a node inequality's barrier)
+                    let node = (i % 2 == 1).then(|| {
+                        let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
+                        let g = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
+                        (m * m.transpose() * 0.5, g)
+                    });
                     StageModel {
                         hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
                         hux: h.fixed_view::<2, 4>(4, 0).into_owned(),
@@ -921,6 +1039,7 @@ mod tests {
                         cx: SMatrix::zeros(),
                         cu: SMatrix::zeros(),
                         value: SVector::zeros(),
+                        node,
                     }
                 })
                 .collect();
@@ -974,6 +1093,27 @@ mod tests {
                     for a in 0..N {
                         assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
                     }
+                }
+                // one step of iterative refinement from a wrong solution gives the right one
+                // (the system is linear), costates included
+                let mut wrong = riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end));
+                for v in wrong.dx.iter_mut().chain(wrong.costate.iter_mut()) {
+                    *v += SVector::<f64, X>::from_fn(|_, _| 0.1 * noise(&mut seed));
+                }
+                for v in &mut wrong.du {
+                    *v += SVector::<f64, N>::from_fn(|_, _| 0.1 * noise(&mut seed));
+                }
+                let model = (&stages[..], &terminal);
+                let end = (&r_end, &s_end);
+                crate::bvp::refine::refine(&riccati, &dynamics, model, 0.0, &r0, end, &mut wrong);
+                for i in 0..=steps {
+                    assert!((wrong.dx[i] - d.dx[i]).amax() < 1e-9, "refined dx[{i}]");
+                }
+                for i in 0..steps {
+                    assert!((wrong.du[i] - d.du[i]).amax() < 1e-9, "refined du[{i}]");
+                    let scale = 1.0 + d.costate[i].amax();
+                    let off = (wrong.costate[i] - d.costate[i]).amax();
+                    assert!(off < 1e-9 * scale, "refined costate[{i}]: {off:e}");
                 }
             }
         }

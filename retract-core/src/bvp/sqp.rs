@@ -5,12 +5,13 @@ use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::barrier::Barrier;
+use super::barrier::{Barrier, Slot};
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
-use super::constraints::{Linearized, flat_hessian};
+use super::constraints::{Inequality, Linearized, flat_hessian};
 use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
+use super::refine::refine;
 use super::riccati::{Direction, Dynamics, Riccati, StageModel, Terminal};
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
@@ -18,6 +19,25 @@ use crate::{Lagrangian, LiftedSystem};
 /// The error below which a full step's factorisation is kept for a simplified Newton step
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
+
+/// The smallest barrier parameter, for a KKT tolerance $\varepsilon$: $\varepsilon / 4$ (so
+/// that $z s \approx \mu$ is below the tolerance). Lower, an active inequality's slack
+/// $s = \mu / z$ falls toward the rounding of its constraint's value and the barrier Hessian
+/// $h z / s$ toward $10^{12}$ of the rest: the subproblem's multipliers lose their digits and
+/// the residuals stall.
+fn barrier_floor(tolerance: f64) -> f64 {
+    tolerance / 2.0
+}
+
+/// The ratio $z / s$ of an inequality above which the subproblem's solution is refined
+/// ([`refine`]), and the number of refinement steps.
+const REFINE_RATIO: f64 = 1e6;
+const REFINEMENTS: usize = 2;
+
+/// The penalty weights of the active inequalities in the second-order check
+/// ([`Sqp::certify`]), relative to the largest entry of the stage Hessians (and to
+/// $|\nabla g|^2$), tried in turn.
+const FINSLER_WEIGHTS: [f64; 3] = [1e2, 1e4, 1e6];
 
 /// One run of the SQP iteration.
 pub(super) struct Sqp<
@@ -33,6 +53,10 @@ pub(super) struct Sqp<
     pub problem: &'p OptimalControlProblem<'a, Sys, N, K, X>,
     pub dynamics: Dynamics<N, X>,
     pub started: Instant,
+    /// The inequalities placed at the steps' evaluation points.
+    pub at_steps: Vec<Inequality<'a, N, K>>,
+    /// The inequalities placed at the nodes (imposed at the interior ones).
+    pub at_nodes: Vec<Inequality<'a, N, K>>,
 }
 
 /// The models of all stages at one iterate.
@@ -122,8 +146,9 @@ where
             for g in &self.problem.equalities {
                 violation += g.value(&xb, u).abs();
             }
-            values.extend(self.problem.inequalities.iter().map(|c| c.value(&xt, u)));
+            values.extend(self.at_steps.iter().map(|c| c.value(&xt, u)));
         }
+        self.node_values(iterate, &mut values);
         let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
         let last = &iterate.x[iterate.x.len() - 1];
         violation += slack
@@ -165,6 +190,7 @@ where
             cx: SMatrix::zeros(),
             cu: SMatrix::zeros(),
             value: SVector::zeros(),
+            node: None,
         };
         for (j, c) in self.problem.equalities.iter().enumerate() {
             let grad = c.gradient(&xb, u);
@@ -182,7 +208,7 @@ where
                 huu += cuu;
             }
         }
-        for (j, c) in self.problem.inequalities.iter().enumerate() {
+        for (j, c) in self.at_steps.iter().enumerate() {
             let z = barrier.z[i * barrier.count + j];
             if let Some((cxx, cux, cuu)) = c.weighted_hessian(&xt, u, -h * z) {
                 hxx += cxx;
@@ -191,7 +217,39 @@ where
             }
         }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
+        stage.node = self.node_curvature(iterate, i, barrier);
         stage
+    }
+
+    /// The curvature $-h z \nabla^2 g$ of the inequalities at node `i` (interior nodes
+    /// only), as node terms with a zero gradient; `None` where there are none.
+    fn node_curvature(
+        &self,
+        iterate: &Iterate<N, X>,
+        i: usize,
+        barrier: &Barrier,
+    ) -> Option<(SMatrix<f64, X, X>, SVector<f64, X>)> {
+        if self.at_nodes.is_empty() || i == 0 || i >= iterate.u.len() {
+            return None;
+        }
+        let (h, zero) = (self.dynamics.h, SVector::<f64, N>::zeros());
+        let mut hessian = SMatrix::<f64, X, X>::zeros();
+        for (j, c) in self.at_nodes.iter().enumerate() {
+            let z = barrier.z[barrier.node_index(i, j)];
+            if let Some((cxx, _, _)) = c.weighted_hessian(&iterate.x[i], &zero, -h * z) {
+                hessian += cxx;
+            }
+        }
+        Some((hessian, SVector::zeros()))
+    }
+
+    /// Appends the values of the node inequalities at the interior nodes (node-major).
+    fn node_values(&self, iterate: &Iterate<N, X>, values: &mut Vec<f64>) {
+        let zero = SVector::<f64, N>::zeros();
+        let steps = iterate.u.len();
+        for x in iterate.x.iter().take(steps).skip(1) {
+            values.extend(self.at_nodes.iter().map(|c| c.value(x, &zero)));
+        }
     }
 
     /// The models of every stage with the constraint multipliers `y`; `None` if anything is
@@ -217,6 +275,14 @@ where
             let stage = stages.last_mut()?;
             cost_gradient.push((stage.gx, stage.gu));
             barrier.add_to_stage(stage, i, own, h);
+            if stage.node.is_some() {
+                let from = barrier.node_index(i, 0);
+                barrier.add_to_node(stage, i, &inequalities[from..from + barrier.nodes], h);
+            }
+            let node_finite = stage
+                .node
+                .as_ref()
+                .is_none_or(|(m, g)| all_finite(m) & all_finite(g));
             // each a vectorised sum of 0 * entry (nalgebra's `sum` is one chain of dependent
             // additions: a fifth of an SQP iteration on the SE(2) scene)
             let finite = all_finite(&stage.hxx)
@@ -226,7 +292,8 @@ where
                 & all_finite(&stage.gu)
                 & all_finite(&stage.cx)
                 & all_finite(&stage.cu)
-                & all_finite(&stage.value);
+                & all_finite(&stage.value)
+                & node_finite;
             if !finite {
                 return None;
             }
@@ -278,20 +345,21 @@ where
         (phi.value(&x, &u), gradient, hxx)
     }
 
-    /// Every inequality linearised at every step (step-major).
+    /// Every inequality linearised where it is imposed, in the order of [`Barrier`]: those
+    /// of the steps (step-major), then those of the interior nodes (node-major).
     pub fn inequalities(&self, iterate: &Iterate<N, X>) -> Vec<Linearized<N, X>> {
-        if self.problem.inequalities.is_empty() {
-            return Vec::new();
+        let steps = iterate.u.len();
+        let count = steps * self.at_steps.len() + steps.saturating_sub(1) * self.at_nodes.len();
+        let mut out = Vec::with_capacity(count);
+        if !self.at_steps.is_empty() {
+            for (i, u) in iterate.u.iter().enumerate() {
+                let xt = self.x_theta(iterate, i);
+                out.extend(self.at_steps.iter().map(|c| c.linearize(&xt, u)));
+            }
         }
-        let mut out = Vec::with_capacity(iterate.u.len() * self.problem.inequalities.len());
-        for (i, u) in iterate.u.iter().enumerate() {
-            let xt = self.x_theta(iterate, i);
-            out.extend(
-                self.problem
-                    .inequalities
-                    .iter()
-                    .map(|c| c.linearize(&xt, u)),
-            );
+        let zero = SVector::<f64, N>::zeros();
+        for x in iterate.x.iter().take(steps).skip(1) {
+            out.extend(self.at_nodes.iter().map(|c| c.linearize(x, &zero)));
         }
         out
     }
@@ -332,12 +400,14 @@ where
         barrier: &Barrier,
         negative_directions: usize,
         direction: &Direction<N, X>,
+        z: &[f64],
     ) -> (Vec<SVector<f64, X>>, Certificate) {
+        let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
         let with_inequalities;
-        let gradients = if barrier.count > 0 {
+        let gradients = if barrier.at_steps() > 0 {
             let mut g = models.cost_gradient.clone();
-            barrier.lagrangian_gradients(&mut g, &models.inequalities, self.dynamics.h);
+            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, h);
             with_inequalities = g;
             &with_inequalities
         } else {
@@ -348,12 +418,23 @@ where
             &models.terminal.fixed,
             &models.terminal.start_fixed,
         );
-        let (momenta, stationarity) =
-            kkt_residuals(&self.dynamics, &models.stages, gradients, direction, end);
+        let nodes = barrier.node_gradients(&models.inequalities, z, h);
+        let (momenta, stationarity) = kkt_residuals(
+            &self.dynamics,
+            &models.stages,
+            gradients,
+            direction,
+            &nodes,
+            end,
+        );
+        let complementarity = z
+            .iter()
+            .zip(&barrier.s)
+            .fold(0.0_f64, |m, (z, s)| m.max(z * s));
         let certificate = Certificate {
             stationarity,
             feasibility: models.violation_max(),
-            complementarity: barrier.complementarity().0,
+            complementarity,
             negative_directions,
             min_reduced_hessian_eig: f64::NAN,
         };
@@ -368,15 +449,17 @@ where
         momenta: Vec<SVector<f64, X>>,
         certificate: Certificate,
     ) -> Plan<N, X> {
+        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
         Plan {
-            h: self.dynamics.h,
-            theta: self.dynamics.theta,
+            h,
+            theta,
             x: iterate.x.clone(),
             u: iterate.u.clone(),
             momenta,
             cost,
             iterations,
             certificate,
+            violations: self.problem.violations(iterate, h, theta).0,
         }
     }
 
@@ -392,7 +475,7 @@ where
     pub fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
-        let count = self.problem.inequalities.len();
+        let count = self.at_steps.len() + self.at_nodes.len();
         let values: Vec<f64> = self
             .inequalities(&iterate)
             .iter()
@@ -409,8 +492,9 @@ where
         } else {
             0.0
         };
-        let mut barrier = Barrier::new(mu, count, &values);
-        let floor = options.tolerance / 10.0;
+        let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
+        let mut barrier = Barrier::new(mu, layout, &values);
+        let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
         let mut full_step: Option<Direction<N, X>> = None;
@@ -453,7 +537,7 @@ where
                 rho,
                 stale,
                 direction,
-                momenta,
+                mut momenta,
                 certificate,
                 error,
             } = sub;
@@ -466,25 +550,27 @@ where
             // converged, or at the acceptable level with no progress left but rounding
             let acceptable = stalled >= 3 && error.max(complementarity) <= options.acceptable;
             if (error <= options.tolerance || acceptable) && barrier.mu <= floor {
-                return self
-                    .certify(
-                        (&iterate, &y, &barrier),
-                        &models,
-                        (rho == 0.0 && !stale).then_some(&riccati),
-                        certificate,
-                    )
-                    .map(|certificate| {
-                        self.plan(
-                            &iterate,
-                            models.cost,
-                            iterations,
-                            momenta.clone(),
-                            certificate,
-                        )
-                    })
-                    .map_err(|(failure, certificate)| {
-                        fail(failure, &iterate, models.cost, certificate, momenta)
-                    });
+                let certified = self.certify(
+                    (&iterate, &y, &barrier),
+                    &models,
+                    (rho == 0.0 && !stale).then_some(&riccati),
+                    certificate,
+                );
+                match certified {
+                    Ok(certificate) => {
+                        let plan =
+                            self.plan(&iterate, models.cost, iterations, momenta, certificate);
+                        // (no plan with a constraint violated beyond the tolerance where it is
+                        // imposed: iterate on)
+                        if plan.violations.imposed() <= options.tolerance {
+                            return Ok(plan);
+                        }
+                        momenta = plan.momenta;
+                    }
+                    Err((failure, certificate)) => {
+                        return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                    }
+                }
             }
             let out_of_time = options
                 .max_time
@@ -541,16 +627,39 @@ where
         kept: Option<(Riccati<N, X>, f64)>,
         rho_last: f64,
     ) -> Option<Subproblem<N, X>> {
+        // an active inequality's barrier Hessian h z/s grad g grad g^T this far above the rest
+        // costs the solve digits: refine it
+        let ill_conditioned = barrier
+            .z
+            .iter()
+            .zip(&barrier.s)
+            .any(|(z, s)| *z > REFINE_RATIO * s);
         let solve = |riccati: Riccati<N, X>, rho: f64, stale: bool| {
-            let direction = riccati.solve(
-                &self.dynamics,
-                &models.stages,
-                self.dynamics.h * rho,
-                &models.r0,
-                (&models.r_end, &models.terminal_gradient),
-            );
+            let end = (&models.r_end, &models.terminal_gradient);
+            let rho_h = self.dynamics.h * rho;
+            let mut direction =
+                riccati.solve(&self.dynamics, &models.stages, rho_h, &models.r0, end);
+            if ill_conditioned {
+                let model = (&models.stages[..], &models.terminal);
+                for _ in 0..REFINEMENTS {
+                    refine(
+                        &riccati,
+                        &self.dynamics,
+                        model,
+                        rho_h,
+                        &models.r0,
+                        end,
+                        &mut direction,
+                    );
+                }
+            }
+            // the multipliers of the inequalities that go with the subproblem's solution: the
+            // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
+            // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
+            let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
+            let z = barrier.predicted(&ds);
             let (momenta, certificate) =
-                self.residuals(models, barrier, riccati.negative, &direction);
+                self.residuals(models, barrier, riccati.negative, &direction, &z);
             let error = certificate.stationarity.max(certificate.feasibility);
             Subproblem {
                 riccati,
@@ -585,26 +694,33 @@ where
     ) -> Option<Plan<N, X>> {
         let (iterate, y, barrier) = state;
         let options = &self.problem.options;
-        if barrier.mu > options.tolerance / 10.0 {
+        if barrier.mu > barrier_floor(options.tolerance) {
             return None;
         }
         let models = self.models(iterate, y, barrier)?;
-        let (momenta, certificate) = self.residuals(&models, barrier, 0, last);
+        let (momenta, certificate) = self.residuals(&models, barrier, 0, last, &barrier.z);
         if certificate.stationarity.max(certificate.feasibility) > options.tolerance {
             return None;
         }
         let certificate = self.certify(state, &models, None, certificate).ok()?;
-        Some(self.plan(iterate, models.cost, iterations, momenta, certificate))
+        let plan = self.plan(iterate, models.cost, iterations, momenta, certificate);
+        (plan.violations.imposed() <= options.tolerance).then_some(plan)
     }
 
     /// The second-order check at a KKT point: the Hessian of the Lagrangian must be positive
-    /// definite on the null space of the constraints, with the active inequalities
-    /// ($s_k < z_k$: strict complementarity separates them by orders of magnitude) as
-    /// equalities and the barrier terms left out (the second-order sufficient condition; the
-    /// barrier Hessian itself is too ill-conditioned near the end to count its inertia). Then
-    /// its smallest eigenvalue completes the certificate. `factored`: the factorisation of
-    /// `models` without correction, if there is one (without inequalities it is the one
-    /// checked; else it is computed here).
+    /// definite on the null space of the constraints, the active inequalities ($s_k < z_k$:
+    /// strict complementarity separates them by orders of magnitude) included and the barrier
+    /// terms left out (the second-order sufficient condition; the barrier Hessian itself is
+    /// too ill-conditioned near the end to count its inertia). The active inequalities enter
+    /// as penalties $\sigma \nabla g \nabla g^T$ (Finsler's lemma: if $H + \sigma A^T A$ is
+    /// positive definite on the null space of the other constraints, so is $H$ on that of $A$
+    /// too, for any $\sigma$; and the converse holds for $\sigma$ large enough), with
+    /// $\sigma$ from [`FINSLER_WEIGHTS`] times the scale of the stage Hessians until the count
+    /// is right. That needs no rank of the active set: state constraints at $\theta = 0$ or
+    /// more than $n$ active inequalities at a step are fine. Then the smallest eigenvalue of
+    /// the penalised reduced Hessian (a lower bound on that of the constrained one) completes
+    /// the certificate. `factored`: the factorisation of `models` without correction, if there
+    /// is one (without inequalities it is the one checked; else it is computed here).
     fn certify(
         &self,
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
@@ -614,14 +730,8 @@ where
     ) -> Result<Certificate, (Failure, Certificate)> {
         let (iterate, y, barrier) = state;
         let refactored;
-        let exact = if barrier.count > 0 {
-            let stages = self.active_set_models(iterate, y, barrier, &models.inequalities);
-            refactored = Riccati::factor_with(
-                &self.dynamics,
-                stages.as_deref().unwrap_or(&models.stages),
-                0.0,
-                &models.terminal,
-            );
+        let exact = if !barrier.s.is_empty() {
+            refactored = self.penalized_factor(iterate, y, barrier, models);
             &refactored
         } else if let Some(riccati) = factored {
             riccati
@@ -645,34 +755,78 @@ where
         Ok(certificate)
     }
 
-    /// The stage models of the Lagrangian (no barrier terms) with the active inequalities
-    /// appended to the equalities; `None` if a step has more than $n$ of them.
-    fn active_set_models(
+    /// The factorisation of the Lagrangian's stage models (no barrier terms) with the active
+    /// inequalities as penalties, for the first weight of [`FINSLER_WEIGHTS`] that makes it
+    /// positive definite (else the last one's).
+    fn penalized_factor(
         &self,
         iterate: &Iterate<N, X>,
         y: &[SVector<f64, N>],
         barrier: &Barrier,
-        lin: &[Linearized<N, X>],
-    ) -> Option<Vec<StageModel<N, X>>> {
-        let count = barrier.count;
-        let mut stages = Vec::with_capacity(iterate.u.len());
-        for (i, yi) in y.iter().enumerate() {
-            let mut stage = self.stage(iterate, i, yi, barrier);
-            for (k, c) in lin.iter().enumerate().skip(i * count).take(count) {
-                if barrier.s[k] < barrier.z[k] {
-                    let m = stage.constraints;
-                    if m >= N {
-                        return None;
+        models: &Models<N, X>,
+    ) -> Riccati<N, X> {
+        let h = self.dynamics.h;
+        let base: Vec<StageModel<N, X>> = (0..iterate.u.len())
+            .map(|i| self.stage(iterate, i, &y[i], barrier))
+            .collect();
+        let largest = base.iter().fold(0.0_f64, |m, s| {
+            m.max(crate::newton::max_abs(&s.hxx))
+                .max(crate::newton::max_abs(&s.huu))
+        });
+        let scale = largest.max(h);
+        let lin = &models.inequalities;
+        let mut stages = base.clone();
+        let mut riccati = None;
+        for weight in FINSLER_WEIGHTS {
+            stages.copy_from_slice(&base);
+            for (k, c) in lin.iter().enumerate() {
+                if barrier.s[k] >= barrier.z[k] {
+                    continue;
+                }
+                let sigma =
+                    weight * scale / c.gx.norm_squared().max(c.gu.norm_squared()).max(1e-300);
+                match barrier.slot(k) {
+                    Slot::Step(i) => {
+                        let stage = &mut stages[i];
+                        stage.hxx += c.gx * c.gx.transpose() * sigma;
+                        stage.hux += c.gu * c.gx.transpose() * sigma;
+                        stage.huu += c.gu * c.gu.transpose() * sigma;
                     }
-                    stage.cx.set_row(m, &c.gx.transpose());
-                    stage.cu.set_row(m, &c.gu.transpose());
-                    stage.value[m] = 0.0;
-                    stage.constraints += 1;
+                    Slot::Node(i) => {
+                        let (hessian, _) = stages[i]
+                            .node
+                            .get_or_insert((SMatrix::zeros(), SVector::zeros()));
+                        *hessian += c.gx * c.gx.transpose() * sigma;
+                    }
                 }
             }
-            stages.push(stage);
+            let factor = Riccati::factor_with(&self.dynamics, &stages, 0.0, &models.terminal);
+            let done = factor.positive_definite();
+            riccati = Some(factor);
+            if done {
+                break;
+            }
         }
-        Some(stages)
+        riccati
+            .unwrap_or_else(|| Riccati::factor_with(&self.dynamics, &base, 0.0, &models.terminal))
+    }
+
+    /// $\sum_i \delta y_i^T H_i \delta y_i$ over the stages' models (with their node terms)
+    /// along the direction, $\delta y_i = (\delta x_{\theta,i}, \delta u_i)$.
+    fn curvature(&self, models: &Models<N, X>, direction: &Direction<N, X>) -> f64 {
+        let theta = self.dynamics.theta;
+        let mut sum = 0.0;
+        for (i, stage) in models.stages.iter().enumerate() {
+            let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+            let du = &direction.du[i];
+            sum += dx.dot(&(stage.hxx * dx))
+                + 2.0 * du.dot(&(stage.hux * dx))
+                + du.dot(&(stage.huu * du));
+            if let Some((node, _)) = &stage.node {
+                sum += direction.dx[i].dot(&(node * direction.dx[i]));
+            }
+        }
+        sum
     }
 
     /// Backtracking on $J - h \mu \sum \ln g + \pi \|c\|_1$ along the direction: the
@@ -702,7 +856,14 @@ where
         }
         let violation = models.violation_l1();
         if violation > 0.0 {
-            let needed = slope / (0.9 * violation);
+            // the model's decrease must pay for its curvature too (Nocedal and Wright, 18.36):
+            // pi >= (slope + max(0, d^T H d) / 2) / ((1 - 0.1) |c|_1), so that long steps
+            // toward feasibility are not cut by the cost they add; H without the barrier's
+            // h z/s grad g grad g^T, which near an active bound would make pi huge
+            let curvature = (self.curvature(models, direction)
+                - barrier.curvature(&models.inequalities, ds, self.dynamics.h))
+            .max(0.0);
+            let needed = (slope + 0.5 * curvature) / (0.9 * violation);
             if needed > *penalty {
                 *penalty = needed * 1.1;
             }

@@ -1,0 +1,294 @@
+//! The constrained suite C1-C4 of `../shared/BENCHMARKS.md`, solved by the optimizer at its
+//! default options from the suite's first guesses: the cart-pole with a force bound, the planar
+//! quadrotor past a disc with thrust limits, parallel parking in a slot and chains of 3 and 7
+//! links with joint limits. One line per problem:
+//! `<name> J=<J> iterations=<n> time_ms=<t> max_violation=<v> min_reduced_hessian_eig=<e>`.
+//!
+//! Run: `cargo run --release --example constrained` (add `-- quick` for a smaller version of
+//! each problem: a tenth of the steps; the test target runs that).
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use retract::bvp::{Curve, OptimalControlProblem, Plan, PlanError, PlanGuess};
+use retract::{higher_order_lagrangian, jet_function};
+
+#[path = "common/cart_pole.rs"]
+mod cart_pole;
+use cart_pole::{CartForce, CartPole, PoleTorque};
+
+const G: f64 = 9.81;
+
+/// What a suite returns: an error for its first failure.
+type Outcome = Result<(), Box<dyn std::error::Error>>;
+
+/// A suite of problems, run at full or reduced size.
+type Suite = fn(bool) -> Outcome;
+
+/// Planar quadrotor, q = (x, z, theta): cost 1/2 (f1^2 + f2^2) of the rotor thrusts
+/// f1,2 = Th/2 -+ tq/(2a), Th = -fx sin(theta) + fz cos(theta), fx = m x'', fz = m z'' + m g,
+/// tq = I theta''.
+#[higher_order_lagrangian(order = 2)]
+fn quadrotor(_q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> f64 {
+    let (s, c) = (_q[2].sin(), _q[2].cos());
+    let thrust = -m * ddq[0] * s + (m * ddq[1] + m * 9.81) * c;
+    let torque = inertia * ddq[2];
+    let f1 = 0.5 * thrust - torque / (2.0 * arm);
+    let f2 = 0.5 * thrust + torque / (2.0 * arm);
+    0.5 * (f1 * f1 + f2 * f2)
+}
+
+/// The quadrotor's lateral body force fx cos(theta) + fz sin(theta) (two rotors cannot push
+/// sideways: an equality).
+#[jet_function(order = 2)]
+fn lateral(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64) -> f64 {
+    m * ddq[0] * q[2].cos() + (m * ddq[1] + m * 9.81) * q[2].sin()
+}
+
+/// A rotor's thrust, `side` -1 for f1 and +1 for f2.
+#[jet_function(order = 2)]
+fn rotor(
+    q: [f64; 3],
+    _dq: [f64; 3],
+    ddq: [f64; 3],
+    m: f64,
+    inertia: f64,
+    arm: f64,
+    side: f64,
+) -> f64 {
+    let thrust = -m * ddq[0] * q[2].sin() + (m * ddq[1] + m * 9.81) * q[2].cos();
+    0.5 * thrust + side * inertia * ddq[2] / (2.0 * arm)
+}
+
+/// Clearance of the disc of radius 0.3 about (1, 0.5): (x - 1)^2 + (z - 0.5)^2 - 0.3^2.
+#[jet_function(order = 2)]
+fn clearance(q: [f64; 3], _dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
+    (q[0] - 1.0).powi(2) + (q[1] - 0.5).powi(2) - 0.09
+}
+
+/// The car's cost 1/2 |q''|^2, q = (x, y, psi).
+#[higher_order_lagrangian(order = 2)]
+fn car_effort(_q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3]) -> f64 {
+    0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1] + ddq[2] * ddq[2])
+}
+
+/// No side slip: v_x sin(psi) - v_y cos(psi).
+#[jet_function(order = 2)]
+fn side_slip(q: [f64; 3], dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
+    dq[0] * q[2].sin() - dq[1] * q[2].cos()
+}
+
+/// Turning radius at least 1: s^2 - psi'^2 with the forward speed
+/// s = v_x cos(psi) + v_y sin(psi).
+#[jet_function(order = 2)]
+fn turning(q: [f64; 3], dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
+    let speed = dq[0] * q[2].cos() + dq[1] * q[2].sin();
+    speed * speed - dq[2] * dq[2]
+}
+
+/// The planar n-link chain's cost 1/2 |tau|^2, tau the Euler-Lagrange torques of T - V (unit
+/// lengths and masses at the link ends, joint angles relative, q_1 from the downward vertical):
+/// with absolute angles phi_a = q_1 + ... + q_a, the torque on phi_a is the sum over the
+/// masses j >= a and the links b <= j of cos(phi_a - phi_b) phi_b'' + sin(phi_a - phi_b)
+/// phi_b'^2, plus g (n - a + 1) sin(phi_a), and tau_i = sum_{a >= i} of those.
+macro_rules! chain {
+    ($name:ident, $n:literal) => {
+        #[doc = concat!("The ", stringify!($n), "-link chain (see the macro's docs).")]
+        #[higher_order_lagrangian(order = 2)]
+        fn $name(q: [f64; $n], dq: [f64; $n], ddq: [f64; $n]) -> f64 {
+            let mut cost = 0.0;
+            let mut tau = 0.0;
+            // link a = n - 1 - r, from the tip: the joint torques accumulate
+            for r in 0..$n {
+                let mut phi_a = 0.0;
+                for i in 0..$n - r {
+                    phi_a += q[i];
+                }
+                // masses j >= a, each pulling on the links b <= j
+                let mut torque = 9.81 * ((r + 1) as f64) * phi_a.sin();
+                for j in $n - 1 - r..$n {
+                    for b in 0..j + 1 {
+                        let (mut phi_b, mut dphi_b, mut ddphi_b) = (0.0, 0.0, 0.0);
+                        for i in 0..b + 1 {
+                            phi_b += q[i];
+                            dphi_b += dq[i];
+                            ddphi_b += ddq[i];
+                        }
+                        let d = phi_a - phi_b;
+                        torque += d.cos() * ddphi_b + d.sin() * dphi_b * dphi_b;
+                    }
+                }
+                tau += torque;
+                cost += 0.5 * tau * tau;
+            }
+            cost
+        }
+    };
+}
+chain!(chain3, 3);
+chain!(chain7, 7);
+
+/// A solved problem's report line, or the failure.
+fn report<const N: usize, const X: usize>(
+    name: &str,
+    start: Instant,
+    result: Result<Plan<N, X>, PlanError<N, X>>,
+) -> Outcome {
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    match result {
+        Ok(plan) => {
+            println!(
+                "{name} J={:.8} iterations={} time_ms={ms:.1} max_violation={:.1e} \
+                 min_reduced_hessian_eig={:.3e}",
+                plan.cost,
+                plan.iterations,
+                plan.violations.imposed(),
+                plan.certificate.min_reduced_hessian_eig
+            );
+            Ok(())
+        }
+        Err(e) => {
+            println!("{name} failed after {ms:.1} ms: {e}");
+            Err(format!("{name}: {e}").into())
+        }
+    }
+}
+
+/// The number of steps for a horizon: 100 T, a tenth of it in the quick run.
+fn steps(t_end: f64, quick: bool) -> usize {
+    let full = (100.0 * t_end).round() as usize;
+    if quick { full / 10 } else { full }
+}
+
+fn cart_pole_suite(quick: bool) -> Outcome {
+    let (mc, mp, l) = (1.0, 0.3, 0.5);
+    let system = CartPole::new(mc, mp, l);
+    let unactuated = PoleTorque::new(mp, l, G);
+    let force = CartForce::new(mc, mp, l);
+    for (t_end, limit) in [(2.0, 12.0), (2.0, 10.0), (3.0, 6.0)] {
+        let name = format!("cartpole-T{t_end}-F{limit}");
+        let start = Instant::now();
+        let result = OptimalControlProblem::new(
+            &system,
+            &[0.0; 4],
+            &[0.0, PI, 0.0, 0.0],
+            t_end,
+            steps(t_end, quick),
+        )
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -limit, limit)
+        .solve(PlanGuess::Spline);
+        report(&name, start, result)?;
+    }
+    Ok(())
+}
+
+fn quadrotor_suite(quick: bool) -> Outcome {
+    let (m, inertia, arm) = (1.0, 0.01, 0.1);
+    let system = Quadrotor::new(m, inertia, arm);
+    let no_lateral = Lateral::new(m);
+    let (f1, f2) = (
+        Rotor::new(m, inertia, arm, -1.0),
+        Rotor::new(m, inertia, arm, 1.0),
+    );
+    let disc = Clearance::new();
+    for fmax in [15.0, 6.0] {
+        let name = format!("quadrotor-f{fmax}");
+        let start = Instant::now();
+        let result = OptimalControlProblem::new(
+            &system,
+            &[0.0; 6],
+            &[2.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            2.0,
+            steps(2.0, quick),
+        )
+        .with_equality(&no_lateral)
+        .with_function_bounds(&f1, 0.0, fmax)
+        .with_function_bounds(&f2, 0.0, fmax)
+        .with_inequality(&disc)
+        .solve(PlanGuess::Spline);
+        report(&name, start, result)?;
+    }
+    Ok(())
+}
+
+fn parking_suite(quick: bool) -> Outcome {
+    use retract::bvp::Variable;
+    let system = CarEffort::new();
+    let (slip, turn) = (SideSlip::new(), Turning::new());
+    let t_end = 6.0;
+    let times = [0.0, 1.5, 3.0, 4.5, 6.0];
+    let knots = [
+        [0.0, 0.0, 0.0],
+        [0.3, 0.1, 0.4],
+        [0.4, 0.25, 0.0],
+        [0.2, 0.4, -0.4],
+        [0.0, 0.5, 0.0],
+    ];
+    let guess = Curve::through_waypoints(&times, &knots)?;
+    for xbox in [0.8, 0.4] {
+        let name = format!("parking-x{xbox}");
+        let start = Instant::now();
+        let result = OptimalControlProblem::new(
+            &system,
+            &[0.0; 6],
+            &[0.0, 0.5, 0.0, 0.0, 0.0, 0.0],
+            t_end,
+            steps(t_end, quick),
+        )
+        .with_equality(&slip)
+        .with_inequality(&turn)
+        .with_bounds(Variable::Jet(0), -xbox, xbox)
+        .solve(PlanGuess::Curve(&guess));
+        report(&name, start, result)?;
+    }
+    Ok(())
+}
+
+fn chain_suite(quick: bool) -> Outcome {
+    use retract::bvp::Variable;
+    let t_end = 2.0;
+    let system = Chain3::new();
+    let mut problem = OptimalControlProblem::new(
+        &system,
+        &[0.0; 6],
+        &[1.5, 1.5, 1.5, 0.0, 0.0, 0.0],
+        t_end,
+        steps(t_end, quick),
+    );
+    for joint in 0..3 {
+        problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
+    }
+    let start = Instant::now();
+    report("chain3", start, problem.solve(PlanGuess::Spline))?;
+    let system = Chain7::new();
+    let mut goal = [0.0; 14];
+    goal[..7].fill(0.5);
+    let mut problem =
+        OptimalControlProblem::new(&system, &[0.0; 14], &goal, t_end, steps(t_end, quick));
+    for joint in 0..7 {
+        problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
+    }
+    let start = Instant::now();
+    report("chain7", start, problem.solve(PlanGuess::Spline))
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let only = std::env::args().nth(1).filter(|a| a != "quick");
+    let mut failed = false;
+    let suites: [(&str, Suite); 4] = [
+        ("cartpole", cart_pole_suite),
+        ("quadrotor", quadrotor_suite),
+        ("parking", parking_suite),
+        ("chain", chain_suite),
+    ];
+    for (name, suite) in suites {
+        if only.as_ref().is_none_or(|o| o == name) {
+            failed |= suite(quick).is_err();
+        }
+    }
+    if failed {
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,207 @@
+//! How far a plan is from its constraints: the largest violation at the nodes, at the steps'
+//! evaluation points and along the plan's interpolant between the nodes, and the constraint
+//! a failure names ([`Infeasibility`]).
+
+use nalgebra::SVector;
+
+use super::constraints::{ConstraintKind, ConstraintRef};
+use super::guess::Hermite;
+use super::optimize::{Iterate, OptimalControlProblem, blocks};
+
+/// Points per step at which the interpolant is checked ([`Violations::interpolant`]):
+/// $t_i + j h / 16$, $j = 1, \dots, 15$.
+pub const INTERPOLANT_POINTS: usize = 16;
+
+/// The largest constraint violation of a plan: $\max(0, -g)$ of the inequalities $g \ge 0$
+/// (bounds on either side alike) and $|g|$ of the equalities, where each is imposed and along
+/// the plan's interpolant.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Violations {
+    /// At the nodes $x_i$, over the constraints placed there ([`super::Placement`]).
+    pub nodes: f64,
+    /// At the steps' evaluation points $(x_{\theta,i}, u_i)$, over the constraints placed
+    /// there.
+    pub midpoints: f64,
+    /// Along the interpolant of [`super::Plan::evaluate`] at
+    /// [`INTERPOLANT_POINTS`] $- 1$ points inside every step, over the inequalities placed at
+    /// the nodes (constraints of the jet alone; between the nodes nothing holds them, so a
+    /// plan may cut a corner here by $O(h^2)$).
+    pub interpolant: f64,
+}
+
+impl Violations {
+    /// The larger of the node and midpoint violations: what certification bounds.
+    pub fn imposed(&self) -> f64 {
+        self.nodes.max(self.midpoints)
+    }
+}
+
+/// Where a constraint is violated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub enum Location {
+    /// In its own data: a lower side above an upper side, equal sides, or sides of two bounds
+    /// of one variable that exclude each other.
+    Definition,
+    /// At the fixed start $x_0$.
+    Start,
+    /// At the fixed goal $x_N$.
+    Goal,
+    /// At node $x_i$.
+    Node(usize),
+    /// At the evaluation point of step $i$.
+    Step(usize),
+    /// On the interpolant inside step $i$.
+    Between(usize),
+}
+
+/// A constraint that cannot be, or was not, satisfied: which one, where, and by how much.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Infeasibility {
+    /// The constraint.
+    pub constraint: ConstraintRef,
+    /// Where.
+    pub location: Location,
+    /// By how much: $\max(0, -g)$ of an inequality, $|g|$ of an equality; for
+    /// [`Location::Definition`] the lower side less the upper side.
+    pub violation: f64,
+}
+
+impl core::fmt::Display for Infeasibility {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let (c, v) = (&self.constraint, self.violation);
+        match self.location {
+            Location::Definition if v.is_infinite() => {
+                write!(f, "{c} has an infinite side facing the wrong way")
+            }
+            Location::Definition if v == 0.0 => write!(
+                f,
+                "{c} has equal lower and upper sides: an inequality needs an interior (write \
+                 an equality)"
+            ),
+            Location::Definition => write!(
+                f,
+                "{c} has a lower side {v:e} above an upper side (of itself or of another bound \
+                 of the same variable): no point satisfies it"
+            ),
+            Location::Start => write!(f, "the start violates {c} by {v:e}"),
+            Location::Goal => write!(f, "the goal violates {c} by {v:e}"),
+            Location::Node(i) => write!(f, "{c} is violated by {v:e} at node {i}"),
+            Location::Step(i) => write!(f, "{c} is violated by {v:e} at step {i}"),
+            Location::Between(i) => {
+                write!(
+                    f,
+                    "{c} is violated by {v:e} on the interpolant inside step {i}"
+                )
+            }
+        }
+    }
+}
+
+/// The running maximum of violations with the constraint that attains it.
+#[derive(Default)]
+struct Worst {
+    value: f64,
+    at: Option<Infeasibility>,
+}
+
+impl Worst {
+    fn see(&mut self, violation: f64, constraint: ConstraintRef, location: Location) {
+        // (a NaN violation is the worst of all)
+        if violation > self.value || (violation.is_nan() && !self.value.is_nan()) {
+            self.value = violation;
+            self.at = Some(Infeasibility {
+                constraint,
+                location,
+                violation,
+            });
+        }
+    }
+}
+
+impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
+    OptimalControlProblem<'_, Sys, N, K, X>
+{
+    /// The violations of `iterate` (jets and top derivatives) with step `h` and `theta`, and
+    /// the worst constraint at a node or evaluation point.
+    pub(super) fn violations(
+        &self,
+        iterate: &Iterate<N, X>,
+        h: f64,
+        theta: f64,
+    ) -> (Violations, Option<Infeasibility>) {
+        let zero = SVector::<f64, N>::zeros();
+        let (mut nodes, mut midpoints, mut between) =
+            (Worst::default(), Worst::default(), Worst::default());
+        for (i, x) in iterate.x.iter().enumerate() {
+            for c in self.inequalities.iter().filter(|c| c.placement.at_nodes()) {
+                nodes.see(-c.value(x, &zero), c.reference(), Location::Node(i));
+            }
+        }
+        for (i, u) in iterate.u.iter().enumerate() {
+            let xt = iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta;
+            for c in self
+                .inequalities
+                .iter()
+                .filter(|c| c.placement.at_midpoints())
+            {
+                midpoints.see(-c.value(&xt, u), c.reference(), Location::Step(i));
+            }
+            let xb = blocks::<N, K, X>(&xt);
+            for (index, g) in self.equalities.iter().enumerate() {
+                let constraint = ConstraintRef {
+                    kind: ConstraintKind::Equality,
+                    index,
+                    name: g.name(),
+                };
+                midpoints.see(g.value(&xb, u).abs(), constraint, Location::Step(i));
+            }
+            self.between(iterate, i, h, &mut between);
+        }
+        let worst = [nodes.at, midpoints.at]
+            .into_iter()
+            .flatten()
+            .max_by(|a, b| a.violation.total_cmp(&b.violation));
+        let report = Violations {
+            nodes: nodes.value,
+            midpoints: midpoints.value,
+            interpolant: between.value,
+        };
+        (report, worst)
+    }
+
+    /// The node inequalities on the interpolant inside step `i`.
+    fn between(&self, iterate: &Iterate<N, X>, i: usize, h: f64, worst: &mut Worst) {
+        let mut at_nodes = self
+            .inequalities
+            .iter()
+            .filter(|c| c.placement.at_nodes())
+            .peekable();
+        if at_nodes.peek().is_none() {
+            return;
+        }
+        let Ok(piece) = Hermite::new(
+            iterate.x[i].as_slice(),
+            iterate.x[i + 1].as_slice(),
+            h,
+            N,
+            K,
+        ) else {
+            return;
+        };
+        let zero = SVector::<f64, N>::zeros();
+        let points: Vec<SVector<f64, X>> = (1..INTERPOLANT_POINTS)
+            .map(|j| {
+                let t = h * j as f64 / INTERPOLANT_POINTS as f64;
+                SVector::from_fn(|r, _| piece.jet_entry(r, t))
+            })
+            .collect();
+        for c in at_nodes {
+            for x in &points {
+                worst.see(-c.value(x, &zero), c.reference(), Location::Between(i));
+            }
+        }
+    }
+}
