@@ -88,7 +88,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     // the cart-pole at T = 2 with its cart force bounded, |F| <= 14 (the free plan needs more;
-    // at 12 the interior point stalls near stationarity 5e-5)
+    // examples/constrained.rs has the tighter bounds of the constrained suite)
     let limit = 14.0;
     let (upper, lower) = (
         ForceMargin::new(1.0, 0.3, 0.5, limit, 1.0),

@@ -19,6 +19,10 @@ mod placement;
 mod stage_systems;
 mod typed_data;
 
+// the cart-pole of the swing-up suite, shared with the examples
+#[path = "../../examples/common/cart_pole.rs"]
+mod cart_pole;
+
 // the car's models and U-turn, shared with the example
 #[path = "../../examples/common/car.rs"]
 mod car_models;

@@ -156,6 +156,20 @@ fn contradictions_are_refused_naming_the_constraint() {
     assert_eq!(equal.constraint.kind, ConstraintKind::Inequality);
     assert_eq!(equal.constraint.name, "Clearance");
     assert_eq!(equal.violation, 0.0);
+    // a side infinite the wrong way (q0 >= +inf)
+    let infinite = infeasibility(
+        problem()
+            .with_bounds(Variable::Jet(0), f64::INFINITY, f64::INFINITY)
+            .solve(PlanGuess::Spline),
+    );
+    assert!(infinite.violation.is_infinite());
+    // node constraints with a free end are refused (not silently left out at the end)
+    let free = problem()
+        .with_inequality(&disc)
+        .with_free_end(&[2])
+        .solve(PlanGuess::Spline)
+        .unwrap_err();
+    assert!(matches!(free.failure, Failure::Invalid(_)), "{free}");
     // the start inside the disc: a node constraint at the fixed start
     let inside = [0.0, -0.2, 0.0, 0.0];
     let start = infeasibility(
@@ -237,4 +251,41 @@ fn an_active_state_bound_is_certified_at_theta_0_and_1() {
     assert!((j0 - j1).abs() < 1e-8 * j0, "{j0} vs {j1}");
     // above the unconstrained 12 |q(T)|^2 / T^3 / 2 = 6
     assert!(half > 6.0 && j0 > 6.0, "{half} {j0}");
+}
+
+/// The constrained suite's cart-pole (C1 of `../shared/BENCHMARKS.md`: T = 2, |F| <= 12 and
+/// 10 at the midpoints, N = 200, the smoothstep guess) at the default options: certified, at
+/// the cost IPOPT reaches on the same transcription (CasADi 3.8.2, IPOPT 3.14.19, tol 1e-10:
+/// 34.13577956 and 37.6490895, whose bounds it relaxes by 1e-8 relative, so its costs are
+/// lower by about that), within 1.5 times its iterations (13 and 22). Before the curvature
+/// term of the merit penalty and the refinement near active bounds this stalled at
+/// stationarity 5e-4.
+#[test]
+fn the_bounded_cart_pole_converges_at_the_default_options() {
+    use super::cart_pole::{CartForce, CartPole, PoleTorque};
+    let (system, unactuated) = (
+        CartPole::new(1.0, 0.3, 0.5),
+        PoleTorque::new(0.3, 0.5, 9.81),
+    );
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    let goal = [0.0, std::f64::consts::PI, 0.0, 0.0];
+    for (limit, ipopt_cost, ipopt_iterations) in [(12.0, 34.13577956, 13), (10.0, 37.6490895, 22)] {
+        let plan = OptimalControlProblem::new(&system, &[0.0; 4], &goal, 2.0, 200)
+            .with_equality(&unactuated)
+            .with_function_bounds(&force, -limit, limit)
+            .solve(PlanGuess::Spline)
+            .unwrap_or_else(|e| panic!("|F| <= {limit}: {e}"));
+        assert!(
+            (plan.cost - ipopt_cost).abs() < 1e-6 * ipopt_cost,
+            "|F| <= {limit}: {} against {ipopt_cost}",
+            plan.cost
+        );
+        assert!(
+            2 * plan.iterations <= 3 * ipopt_iterations,
+            "|F| <= {limit}: {} iterations",
+            plan.iterations
+        );
+        assert!(plan.violations.imposed() <= 1e-9);
+        assert_eq!(plan.certificate.negative_directions, 0);
+    }
 }

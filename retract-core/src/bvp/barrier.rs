@@ -90,9 +90,10 @@ impl Barrier {
         lin: &[Linearized<N, X>],
         h: f64,
     ) {
-        let (hessian, gradient) = stage
+        let node = stage
             .node
-            .get_or_insert((SMatrix::zeros(), SVector::zeros()));
+            .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
+        let (hessian, gradient) = &mut **node;
         for (j, c) in lin.iter().enumerate() {
             let k = self.node_index(i, j);
             let (s, z) = (self.s[k], self.z[k]);

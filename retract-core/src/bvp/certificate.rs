@@ -20,7 +20,9 @@ use crate::newton::max_abs;
 /// $p_{i+1} - p_i = d_i$, the scheme's $p$-equations). At the components of $x_N$ that are
 /// free (`fixed` 0) the residual is $p_N + \nabla\Phi(x_N)$, at the free ones of $x_0$
 /// (`start_fixed` 0) it is $p_0$. The node terms of the Lagrangian (`node_gradients`, its
-/// gradient in $x_i$ from the inequalities at the nodes; empty without them) add to $r_{x,i}$.
+/// gradient $n_i$ in $x_i$ from the inequalities at the nodes; empty without them) add to
+/// $r_{x,i}$: where such a constraint is active the momentum jumps at the node, $p_{i+1} - p_i
+/// = d_i + n_{i+1}$, and $p_{i+1}$ above is the value after the jump.
 /// Returns the momenta and the
 /// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla
 /// L|_\infty))$ (the terminal residual without the $h$).

@@ -103,8 +103,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     }
 
     /// The two sides of `lower` $\le v \le$ `upper` as scalar inequalities (a side that is
-    /// infinite in its own direction is left out; NaN is kept, to be refused by
-    /// [`Self::validate`]).
+    /// infinite in its own direction is left out; NaN is kept, to be refused by `validate`,
+    /// and an infinity facing the wrong way, to be refused as a contradiction).
     fn push_interval(
         &mut self,
         source: Source<'a, N, K>,
@@ -172,8 +172,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }
             for c in self.inequalities.iter().filter(|c| c.placement.at_nodes()) {
                 let value = c.value(x, &zero);
-                // (NaN counts as violated)
-                if value.is_nan() || value < 0.0 {
+                // (NaN counts as violated; rounding of a value on the bound does not)
+                if value.is_nan() || -value > self.options.tolerance {
                     return Some(Infeasibility {
                         constraint: c.reference(),
                         location,

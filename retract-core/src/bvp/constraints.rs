@@ -35,8 +35,8 @@ pub enum Variable {
 pub enum Placement {
     /// At $(x_{\theta,i}, u_i)$ for every step $i < N$.
     Midpoints,
-    /// At every node $x_i$, $i = 0, \dots, N$ (only for constraints of the jet alone; the
-    /// fixed ends are checked before iterating).
+    /// At every node $x_i$, $i = 0, \dots, N$ (only for constraints of the jet alone, and
+    /// with start and goal fixed: they are checked before iterating).
     Nodes,
     /// Both.
     NodesAndMidpoints,
@@ -209,15 +209,16 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         }
     }
 
-    /// Whether the constraint is well formed for jets of length `X`: a finite value, a
-    /// variable in range, and no node placement for what involves $u$.
+    /// Whether the constraint is well formed for jets of length `X`: a value that is not NaN
+    /// (an infinite one is refused as a contradiction), a variable in range, and no node
+    /// placement for what involves $u$.
     pub fn valid<const X: usize>(&self) -> bool {
         let inside = match self.source {
             Source::Function(_) => true,
             Source::Variable(Variable::Jet(r)) => r < X,
             Source::Variable(Variable::Top(a)) => a < N,
         };
-        inside && self.value.is_finite() && !(self.placement.at_nodes() && self.involves_top())
+        inside && !self.value.is_nan() && !(self.placement.at_nodes() && self.involves_top())
     }
 }
 

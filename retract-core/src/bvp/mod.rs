@@ -90,7 +90,7 @@ pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions, RealTime,
 };
-pub use violations::{INTERPOLANT_POINTS, Infeasibility, Location, Violations};
+pub use violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 
 mod root_finder;
 mod shift;

@@ -352,8 +352,9 @@ pub enum Failure {
     LineSearch,
     /// The inertia correction reached its cap without making the reduced Hessian definite.
     Regularization,
-    /// A constraint no point satisfies (refused before iterating): its own data contradict
-    /// themselves, or the fixed start or goal violates it at the node.
+    /// A constraint the interior-point iteration cannot satisfy (refused before iterating):
+    /// its own data contradict themselves or leave no interior (equal sides: write an
+    /// equality), or the fixed start or goal violates it at the node.
     Infeasible(Infeasibility),
     /// The KKT conditions hold but the reduced Hessian has negative (or zero) curvature: a
     /// saddle, not a minimum.
@@ -390,8 +391,7 @@ impl core::fmt::Display for Failure {
             ),
             Failure::IterationLimit => write!(
                 f,
-                "no certified minimum within the iteration budget; the last iterate is \
-                 attached (raise max_iterations, or start from a better guess)"
+                "no certified minimum within the iteration budget; the last iterate is attached"
             ),
             Failure::TimeLimit => write!(
                 f,
@@ -437,8 +437,24 @@ impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
                 " (after {} iterations: cost {:e}, stationarity {:e}, feasibility {:e})",
                 last.iterations, last.cost, c.stationarity, c.feasibility
             )?;
+            if matches!(self.failure, Failure::IterationLimit | Failure::TimeLimit) {
+                write!(f, "; {}", advice(c))?;
+            }
         }
         Ok(())
+    }
+}
+
+/// What to do about a budget that ran out, from the residuals the last iterate reached.
+fn advice(c: &Certificate) -> &'static str {
+    if c.feasibility <= 1e-6 && c.stationarity <= 1e-4 {
+        "the iterate is feasible and nearly stationary: more iterations will not improve it \
+         beyond rounding; a looser tolerance accepts it (or raise the acceptable level)"
+    } else if c.feasibility.is_nan() || c.feasibility > 1e-3 {
+        "the iterate is still far from feasible: start from a guess that satisfies the \
+         constraints, or check that they can hold together"
+    } else {
+        "raise max_iterations, or start from a better guess"
     }
 }
 
@@ -610,6 +626,18 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                  top index < n, and no node placement for what involves the top derivative",
             );
         }
+        let free_end = self
+            .fixed_start
+            .iter()
+            .chain(self.fixed_end.iter())
+            .any(|f| *f == 0.0);
+        if free_end && self.inequalities.iter().any(|c| c.placement.at_nodes()) {
+            return invalid(
+                "placement",
+                "constraints at the nodes need a start and a goal that fix every component (with \
+                 a free end, place them at the midpoints: Placement::Midpoints)",
+            );
+        }
         if self.equalities.len() > n {
             return invalid(
                 "equalities",
@@ -758,7 +786,12 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started: Instant::now(),
             at_steps: placed(Placement::at_midpoints),
-            at_nodes: placed(Placement::at_nodes),
+            // (at theta = 0 or 1 the evaluation points are nodes: no second copy there)
+            at_nodes: if self.options.theta == 0.0 || self.options.theta == 1.0 {
+                placed(|p| p == Placement::Nodes)
+            } else {
+                placed(Placement::at_nodes)
+            },
         }
         .run(iterate)
     }

@@ -38,8 +38,8 @@ fn stage_gradient<const N: usize, const X: usize>(
     }
     let mut lx = dynamics.poly_e.left_t(&gx);
     let lu = dynamics.poly_b.left_t(&gx) * theta + gu;
-    if let Some((hessian, gradient)) = &stage.node {
-        lx += hessian * dx + gradient;
+    if let Some(node) = &stage.node {
+        lx += node.0 * dx + node.1;
     }
     (lx, lu, constraint)
 }

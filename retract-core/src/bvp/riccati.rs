@@ -99,7 +99,7 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
 /// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
 /// defect $c_i$, and the stage's equality constraints $g(y) = 0$: `constraints` rows of
 /// `cx` $= \partial g/\partial x_\theta$, `cu` $= \partial g/\partial u$ and `value` $= g$.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub hxx: SMatrix<f64, X, X>,
     /// $\partial^2 / \partial u \partial x_\theta$ ($N \times X$).
@@ -114,8 +114,12 @@ pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub value: SVector<f64, N>,
     /// Terms of the node $x_i$ itself (the barrier of the inequalities placed at the node):
     /// their Hessian and gradient in $\delta x_i$, added to $Q_{xx}$ and $q_x$.
-    pub node: Option<(SMatrix<f64, X, X>, SVector<f64, X>)>,
+    /// (Boxed: most stages of most problems have none, and the model stays small.)
+    pub node: Option<Box<NodeTerms<X>>>,
 }
+
+/// The Hessian and gradient in $\delta x_i$ of terms of a node $x_i$ itself.
+pub(crate) type NodeTerms<const X: usize> = (SMatrix<f64, X, X>, SVector<f64, X>);
 
 /// The stage constraints in the Riccati variables: with $\delta y = (E \delta x + \theta \bar B
 /// \delta u + \theta c, \delta u)$ the linearisation is $C_x \delta x + C_u \delta u + c_0 = 0$,
@@ -369,8 +373,8 @@ fn stage_factor<const N: usize, const X: usize>(
     let bth = b.left_t(&hxx) * theta;
     let btp = b.left_t(p);
     let mut qxx = e.left_t(&e.right(&hxx)) + a.left_t(&a.right(p));
-    if let Some((node, _)) = &stage.node {
-        qxx += node;
+    if let Some(node) = &stage.node {
+        qxx += node.0;
     }
     let qux = e.right(&(bth + stage.hux)) + a.right(&btp);
     let cross = b.right(&stage.hux) * theta;
@@ -615,8 +619,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let gx = stage.gx + stage.hxx * offset + offset * rho;
             let gu = stage.gu + stage.hux * offset;
             let mut lx = dynamics.poly_e.left_t(&gx);
-            if let Some((_, node)) = &stage.node {
-                lx += node;
+            if let Some(node) = &stage.node {
+                lx += node.1;
             }
             StageLinear {
                 lx,
@@ -857,7 +861,8 @@ mod tests {
             let mut top = rhs.rows_mut(0, nv);
             top -= t.transpose() * g;
             // the node terms of x_i
-            if let Some((hn, gn)) = &s.node {
+            if let Some(node) = &s.node {
+                let (hn, gn) = &**node;
                 for r in 0..X {
                     for c in 0..X {
                         kkt[(xc(i) + r, xc(i) + c)] += hn[(r, c)];
@@ -939,7 +944,7 @@ mod tests {
                 }
                 let node = (i > 0).then(|| {
                     let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
-                    (m * m.transpose(), SVector::from_fn(|_, _| noise(&mut seed)))
+                    Box::new((m * m.transpose(), SVector::from_fn(|_, _| noise(&mut seed))))
                 });
                 StageModel {
                     hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
@@ -1026,7 +1031,7 @@ mod tests {
                     let node = (i % 2 == 1).then(|| {
                         let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
                         let g = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-                        (m * m.transpose() * 0.5, g)
+                        Box::new((m * m.transpose() * 0.5, g))
                     });
                     StageModel {
                         hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),

@@ -20,7 +20,7 @@ use crate::{Lagrangian, LiftedSystem};
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
 
-/// The smallest barrier parameter, for a KKT tolerance $\varepsilon$: $\varepsilon / 4$ (so
+/// The smallest barrier parameter, for a KKT tolerance $\varepsilon$: $\varepsilon / 2$ (so
 /// that $z s \approx \mu$ is below the tolerance). Lower, an active inequality's slack
 /// $s = \mu / z$ falls toward the rounding of its constraint's value and the barrier Hessian
 /// $h z / s$ toward $10^{12}$ of the rest: the subproblem's multipliers lose their digits and
@@ -217,7 +217,7 @@ where
             }
         }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
-        stage.node = self.node_curvature(iterate, i, barrier);
+        stage.node = self.node_curvature(iterate, i, barrier).map(Box::new);
         stage
     }
 
@@ -282,7 +282,7 @@ where
             let node_finite = stage
                 .node
                 .as_ref()
-                .is_none_or(|(m, g)| all_finite(m) & all_finite(g));
+                .is_none_or(|node| all_finite(&node.0) & all_finite(&node.1));
             // each a vectorised sum of 0 * entry (nalgebra's `sum` is one chain of dependent
             // additions: a fifth of an SQP iteration on the SE(2) scene)
             let finite = all_finite(&stage.hxx)
@@ -465,7 +465,7 @@ where
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
     /// definite reduced Hessian (and, with inequalities, the barrier parameter at its floor
-    /// $\varepsilon / 10$), or a budget or the line search fails. After a full step from an
+    /// [`barrier_floor`]), or a budget or the line search fails. After a full step from an
     /// error below $\sqrt{\varepsilon}$ the residuals at the new point are first evaluated
     /// with the last subproblem's multipliers (the Newton estimates there): if they and the
     /// inertia of the factorisation at the point certify it, it is returned without solving
@@ -778,7 +778,7 @@ where
         let mut stages = base.clone();
         let mut riccati = None;
         for weight in FINSLER_WEIGHTS {
-            stages.copy_from_slice(&base);
+            stages.clone_from_slice(&base);
             for (k, c) in lin.iter().enumerate() {
                 if barrier.s[k] >= barrier.z[k] {
                     continue;
@@ -793,10 +793,10 @@ where
                         stage.huu += c.gu * c.gu.transpose() * sigma;
                     }
                     Slot::Node(i) => {
-                        let (hessian, _) = stages[i]
+                        let node = stages[i]
                             .node
-                            .get_or_insert((SMatrix::zeros(), SVector::zeros()));
-                        *hessian += c.gx * c.gx.transpose() * sigma;
+                            .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
+                        node.0 += c.gx * c.gx.transpose() * sigma;
                     }
                 }
             }
@@ -822,9 +822,12 @@ where
             sum += dx.dot(&(stage.hxx * dx))
                 + 2.0 * du.dot(&(stage.hux * dx))
                 + du.dot(&(stage.huu * du));
-            if let Some((node, _)) = &stage.node {
-                sum += direction.dx[i].dot(&(node * direction.dx[i]));
+            if let Some(node) = &stage.node {
+                sum += direction.dx[i].dot(&(node.0 * direction.dx[i]));
             }
+        }
+        if let Some(last) = direction.dx.last() {
+            sum += last.dot(&(models.terminal.hessian * last));
         }
         sum
     }
@@ -860,9 +863,15 @@ where
             // pi >= (slope + max(0, d^T H d) / 2) / ((1 - 0.1) |c|_1), so that long steps
             // toward feasibility are not cut by the cost they add; H without the barrier's
             // h z/s grad g grad g^T, which near an active bound would make pi huge
-            let curvature = (self.curvature(models, direction)
-                - barrier.curvature(&models.inequalities, ds, self.dynamics.h))
-            .max(0.0);
+            // (with the dynamics alone, linear, a full step is feasible: no curvature needed)
+            let nonlinear = !self.problem.equalities.is_empty() || !barrier.s.is_empty();
+            let curvature = if nonlinear {
+                (self.curvature(models, direction)
+                    - barrier.curvature(&models.inequalities, ds, self.dynamics.h))
+                .max(0.0)
+            } else {
+                0.0
+            };
             let needed = (slope + 0.5 * curvature) / (0.9 * violation);
             if needed > *penalty {
                 *penalty = needed * 1.1;

@@ -8,9 +8,9 @@ use super::constraints::{ConstraintKind, ConstraintRef};
 use super::guess::Hermite;
 use super::optimize::{Iterate, OptimalControlProblem, blocks};
 
-/// Points per step at which the interpolant is checked ([`Violations::interpolant`]):
-/// $t_i + j h / 16$, $j = 1, \dots, 15$.
-pub const INTERPOLANT_POINTS: usize = 16;
+/// The parts each step is cut into to check the interpolant ([`Violations::interpolant`]):
+/// at the 15 points $t_i + j h / 16$, $j = 1, \dots, 15$, inside it.
+pub const INTERPOLANT_DIVISIONS: usize = 16;
 
 /// The largest constraint violation of a plan: $\max(0, -g)$ of the inequalities $g \ge 0$
 /// (bounds on either side alike) and $|g|$ of the equalities, where each is imposed and along
@@ -23,16 +23,20 @@ pub struct Violations {
     /// At the steps' evaluation points $(x_{\theta,i}, u_i)$, over the constraints placed
     /// there.
     pub midpoints: f64,
-    /// Along the interpolant of [`super::Plan::evaluate`] at
-    /// [`INTERPOLANT_POINTS`] $- 1$ points inside every step, over the inequalities placed at
+    /// Along the interpolant of [`super::Plan::evaluate`] at the
+    /// [`INTERPOLANT_DIVISIONS`] $- 1$ points inside every step, over the inequalities placed at
     /// the nodes (constraints of the jet alone; between the nodes nothing holds them, so a
     /// plan may cut a corner here by $O(h^2)$).
     pub interpolant: f64,
 }
 
 impl Violations {
-    /// The larger of the node and midpoint violations: what certification bounds.
+    /// The larger of the node and midpoint violations: what certification bounds (NaN if
+    /// either is).
     pub fn imposed(&self) -> f64 {
+        if self.nodes.is_nan() || self.midpoints.is_nan() {
+            return f64::NAN;
+        }
         self.nodes.max(self.midpoints)
     }
 }
@@ -192,9 +196,9 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             return;
         };
         let zero = SVector::<f64, N>::zeros();
-        let points: Vec<SVector<f64, X>> = (1..INTERPOLANT_POINTS)
+        let points: Vec<SVector<f64, X>> = (1..INTERPOLANT_DIVISIONS)
             .map(|j| {
-                let t = h * j as f64 / INTERPOLANT_POINTS as f64;
+                let t = h * j as f64 / INTERPOLANT_DIVISIONS as f64;
                 SVector::from_fn(|r, _| piece.jet_entry(r, t))
             })
             .collect();
