@@ -161,6 +161,8 @@ fn steps(t_end: f64, quick: bool) -> usize {
 }
 
 fn cart_pole_suite(quick: bool) -> Outcome {
+    // (every problem runs; the first failure is returned)
+    let mut outcome: Outcome = Ok(());
     let (mc, mp, l) = (1.0, 0.3, 0.5);
     let system = CartPole::new(mc, mp, l);
     let unactuated = PoleTorque::new(mp, l, G);
@@ -178,12 +180,14 @@ fn cart_pole_suite(quick: bool) -> Outcome {
         .with_equality(&unactuated)
         .with_function_bounds(&force, -limit, limit)
         .solve(PlanGuess::Spline);
-        report(&name, start, result)?;
+        outcome = outcome.and(report(&name, start, result));
     }
-    Ok(())
+    outcome
 }
 
 fn quadrotor_suite(quick: bool) -> Outcome {
+    // (every problem runs; the first failure is returned)
+    let mut outcome: Outcome = Ok(());
     let (m, inertia, arm) = (1.0, 0.01, 0.1);
     let system = Quadrotor::new(m, inertia, arm);
     let no_lateral = Lateral::new(m);
@@ -207,12 +211,14 @@ fn quadrotor_suite(quick: bool) -> Outcome {
         .with_function_bounds(&f2, 0.0, fmax)
         .with_inequality(&disc)
         .solve(PlanGuess::Spline);
-        report(&name, start, result)?;
+        outcome = outcome.and(report(&name, start, result));
     }
-    Ok(())
+    outcome
 }
 
 fn parking_suite(quick: bool) -> Outcome {
+    // (every problem runs; the first failure is returned)
+    let mut outcome: Outcome = Ok(());
     use retract::bvp::Variable;
     let system = CarEffort::new();
     let (slip, turn) = (SideSlip::new(), Turning::new());
@@ -240,9 +246,9 @@ fn parking_suite(quick: bool) -> Outcome {
         .with_inequality(&turn)
         .with_bounds(Variable::Jet(0), -xbox, xbox)
         .solve(PlanGuess::Curve(&guess));
-        report(&name, start, result)?;
+        outcome = outcome.and(report(&name, start, result));
     }
-    Ok(())
+    outcome
 }
 
 fn chain_suite(quick: bool) -> Outcome {
@@ -260,7 +266,7 @@ fn chain_suite(quick: bool) -> Outcome {
         problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
     }
     let start = Instant::now();
-    report("chain3", start, problem.solve(PlanGuess::Spline))?;
+    let first = report("chain3", start, problem.solve(PlanGuess::Spline));
     let system = Chain7::new();
     let mut goal = [0.0; 14];
     goal[..7].fill(0.5);
@@ -270,7 +276,7 @@ fn chain_suite(quick: bool) -> Outcome {
         problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
     }
     let start = Instant::now();
-    report("chain7", start, problem.solve(PlanGuess::Spline))
+    first.and(report("chain7", start, problem.solve(PlanGuess::Spline)))
 }
 
 fn main() {
