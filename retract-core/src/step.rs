@@ -934,15 +934,16 @@ mod tests {
     use super::StepOptions;
 
     #[test]
-    fn options_written_before_the_compensation_switch_read_as_compensated() {
-        let mut json = serde_json::to_value(StepOptions::default().with_compensation(false))
-            .expect("options serialize");
+    fn options_written_before_the_compensation_switch_read_as_compensated()
+    -> Result<(), serde_json::Error> {
+        let mut json = serde_json::to_value(StepOptions::default().with_compensation(false))?;
         assert_eq!(json["compensated"], false);
-        json.as_object_mut()
-            .expect("an object")
-            .remove("compensated");
-        let read: StepOptions = serde_json::from_value(json).expect("options without the field");
+        let object = json.as_object_mut();
+        assert!(object.is_some(), "options serialize to an object");
+        object.map(|o| o.remove("compensated"));
+        let read: StepOptions = serde_json::from_value(json)?;
         assert!(read.compensated);
         assert_eq!(read, StepOptions::default());
+        Ok(())
     }
 }
