@@ -8,6 +8,7 @@
 mod common;
 
 mod attitude_slew;
+mod budgets;
 mod bvp;
 mod car;
 mod extrapolate;

@@ -53,7 +53,12 @@ pub struct PlanOptions {
     pub acceptable: f64,
     /// Iteration budget.
     pub max_iterations: usize,
-    /// Wall-time budget; `None` for none.
+    /// Wall-time budget, counted from the call to `solve`; `None` for none. The clock is read
+    /// between the phases of an iteration (models, each factorisation of the inertia
+    /// correction, each line-search trial) and every 1024 steps inside the model build and
+    /// the factorisation, so a solve returns [`Failure::TimeLimit`] with the iterate reached
+    /// about one such piece after the budget; the checks of the first guess before the first
+    /// iteration (about 20 ms at 65 536 steps) are not interrupted.
     pub max_time: Option<Duration>,
     /// The chord of a step longer than this (max-norm of $x_{i+1} - x_i$) is checked by the
     /// singularity guard in pieces of at most this length, as
@@ -733,11 +738,13 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
+        let started = Instant::now();
         let invalid = |e| PlanError {
             failure: Failure::Invalid(e),
             last: None,
         };
         self.validate(N, K).map_err(invalid)?;
+        self.check_workspace_fits().map_err(invalid)?;
         if S != 2 * X || M != S + N {
             return Err(invalid(Error::InvalidArgument {
                 name: "system",
@@ -784,7 +791,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Sqp::<Sys, N, K, X, S, M> {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
-            started: Instant::now(),
+            started,
             at_steps: placed(Placement::at_midpoints),
             // (at theta = 0 or 1 the evaluation points are nodes: no second copy there)
             at_nodes: if self.options.theta == 0.0 || self.options.theta == 1.0 {
@@ -827,6 +834,35 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }),
             Err(e) => Err(e),
         }
+    }
+
+    /// The bytes the solve will hold at once, about: per step, three stage models (the
+    /// iterate's, a copy in the second-order check and its penalised copy), the
+    /// factorisation, the iterate and a trial point, the direction and the momenta, and each
+    /// inequality's linearisation, slack and multiplier.
+    fn workspace_bytes(&self) -> usize {
+        use core::mem::size_of;
+        let per_step = 3 * size_of::<super::riccati::StageModel<N, X>>()
+            + super::riccati::Riccati::<N, X>::bytes_per_step()
+            + 8 * size_of::<SVector<f64, X>>()
+            + 6 * size_of::<SVector<f64, N>>()
+            + 2 * self.inequalities.len()
+                * (size_of::<super::constraints::Linearized<N, X>>() + 4 * size_of::<f64>());
+        per_step.saturating_mul(self.steps + 1)
+    }
+
+    /// Refuses a problem whose workspace ([`Self::workspace_bytes`]) the allocator will not
+    /// give, before anything is allocated for it: the reservation is tried once and released
+    /// (a solve that fails to allocate would abort the process instead of returning).
+    fn check_workspace_fits(&self) -> Result<(), Error> {
+        let mut probe: Vec<u8> = Vec::new();
+        probe
+            .try_reserve_exact(self.workspace_bytes())
+            .map_err(|_| Error::InvalidArgument {
+                name: "steps",
+                requirement: "the optimizer's workspace (about 3 stage models and a \
+                              factorisation per step) must fit in memory: fewer steps",
+            })
     }
 
     fn initial(&self, guess: PlanGuess<'_, N, X>) -> Result<Iterate<N, X>, Error> {

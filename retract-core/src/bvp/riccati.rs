@@ -29,6 +29,8 @@
 //! $\sum_i \mathrm{neg}(Q_{uu,i}) + \mathrm{neg}(D) - nk$ negative eigenvalues, and it is
 //! positive definite exactly when that count is 0 and nothing is singular.
 
+use std::time::Instant;
+
 use nalgebra::{DMatrix, SMatrix, SVector, SymmetricEigen};
 
 use super::shift::{BlockColumn, BlockPoly};
@@ -238,7 +240,13 @@ pub(crate) struct Riccati<const N: usize, const X: usize> {
     pub negative: usize,
     /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
     pub singular: bool,
+    /// The deadline of [`Self::factor_until`] passed before the factorisation was complete
+    /// (then it is also `singular`, and not to be used).
+    pub interrupted: bool,
 }
+
+/// The steps between two looks at the clock in [`Riccati::factor_until`].
+pub(super) const STEPS_PER_CLOCK_CHECK: usize = 1024;
 
 /// The solution of the quadratic subproblem.
 pub(crate) struct Direction<const N: usize, const X: usize> {
@@ -475,6 +483,18 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         rho: f64,
         terminal: &Terminal<X>,
     ) -> Self {
+        Self::factor_until(dynamics, stages, rho, terminal, None)
+    }
+
+    /// [`Self::factor_with`], stopped (`interrupted`) once `deadline` has passed: the clock is
+    /// read every [`STEPS_PER_CLOCK_CHECK`] steps.
+    pub fn factor_until(
+        dynamics: &Dynamics<N, X>,
+        stages: &[StageModel<N, X>],
+        rho: f64,
+        terminal: &Terminal<X>,
+        deadline: Option<Instant>,
+    ) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = stages.len();
         let mut p = (terminal.hessian + terminal.hessian.transpose()) * 0.5;
@@ -489,7 +509,14 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let mut singular = false;
         let mut d = SMatrix::<f64, X, X>::zeros();
         let mut eliminated: Option<SMatrix<f64, X, X>> = None;
+        let mut interrupted = false;
         for (j, stage) in stages.iter().rev().enumerate() {
+            if j % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1
+                && deadline.is_some_and(|d| Instant::now() >= d)
+            {
+                interrupted = true;
+                break;
+            }
             let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p);
             singular |= neg.is_none();
             negative += neg.unwrap_or(0);
@@ -577,7 +604,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             p_start: p,
             eliminated_at_start,
             negative: negative.saturating_sub(terminal.rows()),
-            singular,
+            singular: singular || interrupted,
+            interrupted,
         }
     }
 
@@ -597,6 +625,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// True when the reduced Hessian is positive definite.
+    /// The bytes a factorisation holds per step (its stage factors).
+    pub fn bytes_per_step() -> usize {
+        core::mem::size_of::<StageFactor<N, X>>()
+    }
+
     pub fn positive_definite(&self) -> bool {
         !self.singular && self.negative == 0
     }

@@ -12,7 +12,7 @@ use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
 use super::refine::refine;
-use super::riccati::{Direction, Dynamics, Riccati, StageModel, Terminal};
+use super::riccati::{Direction, Dynamics, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
 
@@ -252,27 +252,31 @@ where
         }
     }
 
-    /// The models of every stage with the constraint multipliers `y`; `None` if anything is
-    /// not finite.
+    /// The models of every stage with the constraint multipliers `y`; [`Failure::NonFinite`]
+    /// if anything is not finite, [`Failure::TimeLimit`] if the budget runs out (the clock is
+    /// read every [`STEPS_PER_CLOCK_CHECK`] steps).
     fn models(
         &self,
         iterate: &Iterate<N, X>,
         y: &[SVector<f64, N>],
         barrier: &Barrier,
-    ) -> Option<Models<N, X>> {
+    ) -> Result<Models<N, X>, Failure> {
         let h = self.dynamics.h;
         let mut stages = Vec::with_capacity(iterate.u.len());
         let inequalities = self.inequalities(iterate);
         let mut cost_gradient = Vec::with_capacity(iterate.u.len());
         let mut cost = 0.0;
         for (i, u) in iterate.u.iter().enumerate() {
+            if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
+                return Err(Failure::TimeLimit);
+            }
             let system = self.problem.system_at(i);
             cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
             // (built in place: a stage model is a few hundred bytes)
             stages.push(self.stage(iterate, i, &y[i], barrier));
-            let stage = stages.last_mut()?;
+            let stage = stages.last_mut().ok_or(Failure::NonFinite)?;
             cost_gradient.push((stage.gx, stage.gu));
             barrier.add_to_stage(stage, i, own, h);
             if stage.node.is_some() {
@@ -295,7 +299,7 @@ where
                 & all_finite(&stage.value)
                 & node_finite;
             if !finite {
-                return None;
+                return Err(Failure::NonFinite);
             }
         }
         let r0 = (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start);
@@ -307,23 +311,27 @@ where
         let (phi, terminal_gradient, hessian) = self.terminal_model(last);
         let cost = cost + phi;
         let barrier_cost = cost + log;
-        (barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian))
-            .then_some(Models {
-                stages,
-                cost,
-                barrier_cost,
-                r0,
-                r_end,
-                inequalities,
-                cost_gradient,
-                slack_violation,
-                terminal: Terminal {
-                    hessian,
-                    fixed,
-                    start_fixed: self.problem.fixed_start,
-                },
-                terminal_gradient,
-            })
+        let finite =
+            barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian);
+        if !finite {
+            return Err(Failure::NonFinite);
+        }
+        Ok(Models {
+            stages,
+            cost,
+            barrier_cost,
+            r0,
+            r_end,
+            inequalities,
+            cost_gradient,
+            slack_violation,
+            terminal: Terminal {
+                hessian,
+                fixed,
+                start_fixed: self.problem.fixed_start,
+            },
+            terminal_gradient,
+        })
     }
 
     /// $\Phi(x_N)$ (0 without a terminal cost).
@@ -368,26 +376,48 @@ where
     /// the reduced Hessian positive definite: none if the last iteration needed none (or
     /// little), else from a third of the `last` one (the correction decays geometrically
     /// instead of dropping to 0 at a point where the Hessian is barely definite), growing by 8
-    /// (100 from scratch) until the inertia is right.
-    fn factor_corrected(&self, models: &Models<N, X>, last: f64) -> Option<(Riccati<N, X>, f64)> {
+    /// (100 from scratch) until the inertia is right. Fails with [`Failure::Regularization`]
+    /// past $\rho = 10^{40}$, or [`Failure::TimeLimit`] when the budget runs out between
+    /// factorisations.
+    fn factor_corrected(
+        &self,
+        models: &Models<N, X>,
+        last: f64,
+    ) -> Result<(Riccati<N, X>, f64), Failure> {
         let h = self.dynamics.h;
-        if last < 1e-8 {
-            let riccati =
-                Riccati::factor_with(&self.dynamics, &models.stages, 0.0, &models.terminal);
-            if riccati.positive_definite() {
-                return Some((riccati, 0.0));
+        let factor = |rho: f64| {
+            let (stages, end) = (&models.stages, &models.terminal);
+            let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, self.deadline());
+            if riccati.interrupted {
+                return Err(Failure::TimeLimit);
             }
+            Ok(riccati.positive_definite().then_some(riccati))
+        };
+        if last < 1e-8
+            && let Some(riccati) = factor(0.0)?
+        {
+            return Ok((riccati, 0.0));
         }
         let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
         while rho < 1e40 {
-            let riccati =
-                Riccati::factor_with(&self.dynamics, &models.stages, h * rho, &models.terminal);
-            if riccati.positive_definite() {
-                return Some((riccati, rho));
+            if let Some(riccati) = factor(h * rho)? {
+                return Ok((riccati, rho));
             }
             rho *= if last > 0.0 { 8.0 } else { 100.0 };
         }
-        None
+        Err(Failure::Regularization)
+    }
+
+    /// When the wall-time budget runs out: the start of the solve plus
+    /// [`super::PlanOptions::max_time`].
+    fn deadline(&self) -> Option<Instant> {
+        let budget = self.problem.options.max_time?;
+        self.started.checked_add(budget)
+    }
+
+    /// Whether the wall-time budget ([`Self::deadline`]) has run out.
+    fn out_of_time(&self) -> bool {
+        self.deadline().is_some_and(|d| Instant::now() >= d)
     }
 
     /// The certificate's residuals at the iterate of `models` with the multipliers of the
@@ -521,16 +551,31 @@ where
                     return Ok(plan);
                 }
             }
-            let Some(models) = self.models(&iterate, &y, &barrier) else {
-                return Err(PlanError {
-                    failure: Failure::NonFinite,
-                    last: None,
-                });
+            let models = match self.models(&iterate, &y, &barrier) {
+                Ok(models) => models,
+                Err(Failure::TimeLimit) => {
+                    let unknown = super::optimize::unknown_certificate();
+                    return Err(fail(
+                        Failure::TimeLimit,
+                        &iterate,
+                        f64::NAN,
+                        unknown,
+                        vec![],
+                    ));
+                }
+                Err(failure) => {
+                    return Err(PlanError {
+                        failure,
+                        last: None,
+                    });
+                }
             };
-            let Some(sub) = self.subproblem(&models, &barrier, kept.take(), rho_last) else {
-                let unknown = super::optimize::unknown_certificate();
-                let failure = Failure::Regularization;
-                return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
+            let sub = match self.subproblem(&models, &barrier, kept.take(), rho_last) {
+                Ok(sub) => sub,
+                Err(failure) => {
+                    let unknown = super::optimize::unknown_certificate();
+                    return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
+                }
             };
             let Subproblem {
                 riccati,
@@ -572,9 +617,7 @@ where
                     }
                 }
             }
-            let out_of_time = options
-                .max_time
-                .is_some_and(|budget| self.started.elapsed() >= budget);
+            let out_of_time = self.out_of_time();
             if iterations == options.max_iterations || out_of_time {
                 let failure = if out_of_time {
                     Failure::TimeLimit
@@ -585,16 +628,18 @@ where
             }
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
-            let Some((next, alpha, at_rounding)) =
-                self.line_search(&iterate, &models, &direction, &barrier, &ds, &mut penalty)
-            else {
-                if stale {
+            let searched =
+                self.line_search(&iterate, &models, &direction, &barrier, &ds, &mut penalty);
+            let (next, alpha, at_rounding) = match searched {
+                Ok(accepted) => accepted,
+                Err(Failure::LineSearch) if stale => {
                     // the simplified direction failed: solve this iterate's own subproblem
                     iterations -= 1;
                     continue;
                 }
-                let failure = Failure::LineSearch;
-                return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                Err(failure) => {
+                    return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                }
             };
             iterate = next;
             barrier.update(&ds, alpha);
@@ -617,8 +662,8 @@ where
     /// (whose error was $e_{\rm prev}$), a simplified Newton step: taken if its predicted error
     /// from here, about $e^2 / e_{\rm prev}$ (the kept factorisation is off by about the last
     /// step, $e_{\rm prev}$), is below the tolerance. Otherwise, or without `kept`, a new
-    /// inertia-corrected factorisation ([`Self::factor_corrected`]); `None` if none is positive
-    /// definite. (A kept factorisation was positive definite without correction, so the
+    /// inertia-corrected factorisation ([`Self::factor_corrected`], whose failure is
+    /// returned). (A kept factorisation was positive definite without correction, so the
     /// negative directions reported with it, 0, are those of the previous iterate.)
     fn subproblem(
         &self,
@@ -626,7 +671,7 @@ where
         barrier: &Barrier,
         kept: Option<(Riccati<N, X>, f64)>,
         rho_last: f64,
-    ) -> Option<Subproblem<N, X>> {
+    ) -> Result<Subproblem<N, X>, Failure> {
         // an active inequality's barrier Hessian h z/s grad g grad g^T this far above the rest
         // costs the solve digits: refine it
         let ill_conditioned = barrier
@@ -675,11 +720,11 @@ where
             let sub = solve(riccati, 0.0, true);
             let tolerance = self.problem.options.tolerance;
             if sub.error <= tolerance || sub.error * sub.error <= tolerance * e_prev {
-                return Some(sub);
+                return Ok(sub);
             }
         }
         let (riccati, rho) = self.factor_corrected(models, rho_last)?;
-        Some(solve(riccati, rho, false))
+        Ok(solve(riccati, rho, false))
     }
 
     /// The plan at the point reached by a full step, certified with the last subproblem's
@@ -697,7 +742,7 @@ where
         if barrier.mu > barrier_floor(options.tolerance) {
             return None;
         }
-        let models = self.models(iterate, y, barrier)?;
+        let models = self.models(iterate, y, barrier).ok()?;
         let (momenta, certificate) = self.residuals(&models, barrier, 0, last, &barrier.z);
         if certificate.stationarity.max(certificate.feasibility) > options.tolerance {
             return None;
@@ -833,8 +878,9 @@ where
     }
 
     /// Backtracking on $J - h \mu \sum \ln g + \pi \|c\|_1$ along the direction: the
-    /// accepted point, the step length and the inequalities' values there; `None` if no step
-    /// is accepted.
+    /// accepted point, the step length and whether the decrease was at rounding level;
+    /// [`Failure::LineSearch`] if no step is accepted, [`Failure::TimeLimit`] if the budget
+    /// runs out between trials.
     fn line_search(
         &self,
         iterate: &Iterate<N, X>,
@@ -843,7 +889,7 @@ where
         barrier: &Barrier,
         ds: &[f64],
         penalty: &mut f64,
-    ) -> Option<(Iterate<N, X>, f64, bool)> {
+    ) -> Result<(Iterate<N, X>, f64, bool), Failure> {
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
         // directional derivative of J (stages and terminal cost) along the direction
@@ -880,7 +926,7 @@ where
         let descent = slope - *penalty * violation;
         let merit0 = models.barrier_cost + *penalty * violation;
         if !descent.is_finite() {
-            return None;
+            return Err(Failure::LineSearch);
         }
         // rounding of the merit function: of J and of the defects (about eps |x| each)
         let size: f64 = iterate.x.iter().map(|x| x.lp_norm(1)).sum();
@@ -889,6 +935,9 @@ where
         let descent = descent.min(0.0);
         let mut alpha = barrier.max_step(ds);
         for _ in 0..=options.max_backtracks {
+            if self.out_of_time() {
+                return Err(Failure::TimeLimit);
+            }
             let trial = Iterate {
                 x: iterate
                     .x
@@ -911,10 +960,10 @@ where
             if parts.is_some_and(|(cost, violation)| {
                 cost + *penalty * violation <= merit0 + options.armijo * alpha * descent + noise
             }) {
-                return Some((trial, alpha, -descent <= noise));
+                return Ok((trial, alpha, -descent <= noise));
             }
             alpha *= 0.5;
         }
-        None
+        Err(Failure::LineSearch)
     }
 }
