@@ -289,3 +289,32 @@ fn the_bounded_cart_pole_converges_at_the_default_options() {
         assert_eq!(plan.certificate.negative_directions, 0);
     }
 }
+
+/// A warm start from the plan of a nearby start around the keep-out disc (active at the
+/// nodes and midpoints where the plan passes it): no more iterations than a cold start.
+#[test]
+fn a_plan_around_the_disc_warm_starts_a_nearby_start() {
+    let (system, disc) = (PlanarEffort::new(), disc());
+    let solve = |start: &[f64; 4], guess| {
+        OptimalControlProblem::new(&system, start, &GOAL, 4.0, 40)
+            .with_inequality(&disc)
+            .solve(guess)
+    };
+    let first = solve(&START, PlanGuess::Spline).unwrap();
+    for dy in [0.05, -0.05, 0.2] {
+        let start = [START[0], START[1] + dy, 0.0, 0.0];
+        let cold = solve(&start, PlanGuess::Spline).unwrap();
+        let warm = solve(&start, PlanGuess::Plan(&first)).unwrap();
+        assert!(
+            (warm.cost - cold.cost).abs() <= 1e-9 * cold.cost,
+            "dy = {dy}"
+        );
+        assert!(
+            warm.iterations <= cold.iterations,
+            "dy = {dy}: warm {} iterations, cold {}",
+            warm.iterations,
+            cold.iterations
+        );
+        assert!(clearances(&warm, &disc).0.min(clearances(&warm, &disc).1) >= -1e-9);
+    }
+}

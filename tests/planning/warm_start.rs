@@ -1,0 +1,79 @@
+//! Warm starts from the plan of a nearby problem: the bounded cart-pole of the constrained
+//! suite (C1, `../shared/BENCHMARKS.md`, at a fifth of its steps) re-solved from a plan whose
+//! start differs, converges to a certified plan of the new problem in no more iterations than
+//! a cold start from the spline.
+
+use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
+
+use crate::cart_pole::{CartForce, CartPole, PoleTorque};
+use crate::common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
+
+const UPRIGHT: [f64; 4] = [0.0, std::f64::consts::PI, 0.0, 0.0];
+
+/// The cart-pole swing-up (T = 2, N = 40) with |F| <= 12, from the cart at `x0`.
+fn solve_from(x0: f64, guess: PlanGuess<'_, 2, 4>) -> Plan<2, 4> {
+    let system = CartPole::new(1.0, 0.3, 0.5);
+    let unactuated = PoleTorque::new(0.3, 0.5, 9.81);
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    OptimalControlProblem::new(&system, &[x0, 0.0, 0.0, 0.0], &UPRIGHT, 2.0, 40)
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -12.0, 12.0)
+        .solve(guess)
+        .unwrap_or_else(|e| panic!("from x0 = {x0}: {e}"))
+}
+
+#[test]
+fn a_plan_of_a_nearby_start_warm_starts_in_no_more_iterations_than_cold() {
+    let first = solve_from(0.0, PlanGuess::Spline);
+    for x0 in [0.02, 0.1, -0.1] {
+        let cold = solve_from(x0, PlanGuess::Spline);
+        let warm = solve_from(x0, PlanGuess::Plan(&first));
+        assert!(
+            (warm.cost - cold.cost).abs() <= 1e-8 * cold.cost,
+            "x0 = {x0}: warm {} cold {}",
+            warm.cost,
+            cold.cost
+        );
+        assert!(
+            warm.iterations <= cold.iterations,
+            "x0 = {x0}: warm {} iterations, cold {}",
+            warm.iterations,
+            cold.iterations
+        );
+    }
+}
+
+/// The one-disc scene (the obstacle a singular term of the Lagrangian): the plan from one start
+/// warm-starts the solve from starts 0.05 and 0.2 higher, in no more iterations than a cold
+/// start from the feasible bump guess.
+#[test]
+fn a_plan_past_the_soft_disc_warm_starts_a_nearby_start() {
+    let system = OneDisc { tau: 1e-2 };
+    let (x, u) = disc_bump_guess(40);
+    let solve = |start: &[f64; 4], guess| {
+        OptimalControlProblem::new(&system, start, &DISC_GOAL, 4.0, 40)
+            .solve(guess)
+            .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let first = solve(&DISC_START, PlanGuess::Path { x: &x, u: &u });
+    for dy in [0.05, 0.2] {
+        let start = [
+            DISC_START[0],
+            DISC_START[1] + dy,
+            DISC_START[2],
+            DISC_START[3],
+        ];
+        let cold = solve(&start, PlanGuess::Path { x: &x, u: &u });
+        let warm = solve(&start, PlanGuess::Plan(&first));
+        assert!(
+            (warm.cost - cold.cost).abs() <= 1e-9 * cold.cost,
+            "dy = {dy}"
+        );
+        assert!(
+            warm.iterations <= cold.iterations,
+            "dy = {dy}: warm {} iterations, cold {}",
+            warm.iterations,
+            cold.iterations
+        );
+    }
+}
