@@ -51,7 +51,8 @@ pub struct PlanOptions {
     /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
     /// acceptable level; the certificate reports the residuals reached.
     pub acceptable: f64,
-    /// Iteration budget.
+    /// Iteration budget; 3000 by default (IPOPT's): the hard problems of the constrained
+    /// suite need a few hundred to a few thousand iterations (`examples/constrained.rs`).
     pub max_iterations: usize,
     /// Wall-time budget, counted from the call to `solve`; `None` for none. The clock is read
     /// between the phases of an iteration (models, each factorisation of the inertia
@@ -85,7 +86,7 @@ impl Default for PlanOptions {
             theta: 0.5,
             tolerance: 1e-9,
             acceptable: 1e-6,
-            max_iterations: 200,
+            max_iterations: 3000,
             max_time: None,
             chord_spacing: 0.02,
             max_chord_pieces: 16,
