@@ -25,6 +25,10 @@ fn solve_from(x0: f64, guess: PlanGuess<'_, 2, 4>) -> Plan<2, 4> {
 #[test]
 fn a_plan_of_a_nearby_start_warm_starts_in_no_more_iterations_than_cold() {
     let first = solve_from(0.0, PlanGuess::Spline);
+    // the default certificate's smallest reduced-Hessian eigenvalue, with the force bound
+    // active at some steps (in the null space through the second-order check's penalties)
+    let eig = first.certificate.min_reduced_hessian_eig;
+    assert!(eig > 0.0 && eig.is_finite(), "{eig}");
     for x0 in [0.02, 0.1, -0.1] {
         let cold = solve_from(x0, PlanGuess::Spline);
         let warm = solve_from(x0, PlanGuess::Plan(&first));

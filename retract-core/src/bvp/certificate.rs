@@ -98,7 +98,10 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
 /// a positive definite factorisation, by Lanczos on its inverse: the subproblem's solution
 /// operator $v \mapsto \delta$ (min $\tfrac12 \delta^T \nabla^2 J \delta - v^T \delta$ subject
 /// to the homogeneous constraints) is $Z (Z^T \nabla^2 J Z)^{-1} Z^T$, whose largest
-/// eigenvalue is the reciprocal of the one sought. NaN if Lanczos does not settle.
+/// eigenvalue is the reciprocal of the one sought. Lanczos stops when the Ritz residual of
+/// the top Ritz value $\vartheta$ is below $10^{-3}\vartheta$ (the eigenvalue then has about
+/// six digits; 2 to 12 solves on the constrained suite and the swing-ups, less than one SQP
+/// iteration). NaN if the start vector vanishes.
 pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
@@ -181,7 +184,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
             };
             let bound = beta * eig.eigenvectors[(size - 1, index)].abs();
             largest = top;
-            if bound <= 1e-6 * top.abs() || beta <= 1e-14 * alpha.abs() {
+            if bound <= 1e-3 * top.abs() || beta <= 1e-14 * alpha.abs() {
                 return 1.0 / largest;
             }
         }

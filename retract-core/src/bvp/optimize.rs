@@ -74,9 +74,10 @@ pub struct PlanOptions {
     pub max_backtracks: usize,
     /// Initial barrier parameter $\mu$ of the inequalities (per unit time).
     pub initial_barrier: f64,
-    /// Also compute [`Certificate::min_reduced_hessian_eig`] (Lanczos, about as much time as
-    /// a few iterations). The inertia count that proves the reduced Hessian positive definite
-    /// is always done.
+    /// Also compute [`Certificate::min_reduced_hessian_eig`] (Lanczos on the final
+    /// factorisation, less than one iteration's time); on by default, off in
+    /// [`OptimalControlProblem::solve_real_time`]. The inertia count that proves the reduced
+    /// Hessian positive definite is always done.
     pub min_eigenvalue: bool,
 }
 
@@ -93,7 +94,7 @@ impl Default for PlanOptions {
             armijo: 1e-4,
             max_backtracks: 40,
             initial_barrier: 0.1,
-            min_eigenvalue: false,
+            min_eigenvalue: true,
         }
     }
 }
@@ -173,8 +174,10 @@ pub struct Certificate {
     pub negative_directions: usize,
     /// The smallest eigenvalue of $Z^T \nabla^2 J\thinspace Z$, $Z$ an orthonormal basis of the
     /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
-    /// u_{N-1})$; positive for a strict local minimum. NaN unless
-    /// [`PlanOptions::min_eigenvalue`] is set (the inertia count proves positivity either way).
+    /// u_{N-1})$; positive for a strict local minimum. With inequalities, the active ones
+    /// enter as the penalties of the second-order check (a lower bound on the value on their
+    /// null space too). NaN if [`PlanOptions::min_eigenvalue`] is off or the end $x_N$ has free
+    /// components (the inertia count proves positivity either way).
     /// With `serde`, NaN is written as "none" (JSON `null`) and read back as NaN.
     #[cfg_attr(feature = "serde", serde(with = "nan_as_none"))]
     pub min_reduced_hessian_eig: f64,
@@ -807,7 +810,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// Real-time iteration for receding horizons (as acados' RTI): at most `iterations` SQP
     /// iterations from `guess` (typically [`Plan::shifted`] of the last plan), whatever the
     /// residuals then. The result says whether the plan is a certified minimum
-    /// ([`RealTime::converged`]); if not, its certificate holds the residuals reached.
+    /// ([`RealTime::converged`]); if not, its certificate holds the residuals reached. The
+    /// smallest reduced-Hessian eigenvalue is not computed ([`PlanOptions::min_eigenvalue`]).
     ///
     /// # Errors
     /// As [`Self::solve`], except that running out of iterations is not an error.
@@ -821,6 +825,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     {
         let mut capped = self.clone();
         capped.options.max_iterations = iterations.max(1);
+        // (a receding horizon needs the plan now, not its curvature)
+        capped.options.min_eigenvalue = false;
         match capped.solve(guess) {
             Ok(plan) => Ok(RealTime {
                 plan,
