@@ -447,21 +447,29 @@ impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
                 last.iterations, last.cost, c.stationarity, c.feasibility
             )?;
             if matches!(self.failure, Failure::IterationLimit | Failure::TimeLimit) {
-                write!(f, "; {}", advice(c))?;
+                write!(f, "; {}", advice(c, last.iterations))?;
             }
         }
         Ok(())
     }
 }
 
-/// What to do about a budget that ran out, from the residuals the last iterate reached.
-fn advice(c: &Certificate) -> &'static str {
+/// The iterations after which a budget that ran out is not advised to be raised (the
+/// constrained suite's hardest solve needs 1784).
+const LONG_RUN: usize = 2000;
+
+/// What to do about a budget that ran out, from the residuals the last iterate reached after
+/// `iterations`.
+fn advice(c: &Certificate, iterations: usize) -> &'static str {
     if c.feasibility <= 1e-6 && c.stationarity <= 1e-4 {
         "the iterate is feasible and nearly stationary: more iterations will not improve it \
          beyond rounding; a looser tolerance accepts it (or raise the acceptable level)"
     } else if c.feasibility.is_nan() || c.feasibility > 1e-3 {
         "the iterate is still far from feasible: start from a guess that satisfies the \
          constraints, or check that they can hold together"
+    } else if iterations >= LONG_RUN {
+        "the iteration is not settling: more iterations are unlikely to help; start from \
+         another guess (one closer to a solution, or inside the constraints)"
     } else {
         "raise max_iterations, or start from a better guess"
     }
@@ -1007,5 +1015,35 @@ pub(super) fn unknown_certificate() -> Certificate {
         complementarity: f64::NAN,
         negative_directions: 0,
         min_reduced_hessian_eig: f64::NAN,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Certificate, LONG_RUN, advice};
+
+    fn residuals(stationarity: f64, feasibility: f64) -> Certificate {
+        Certificate {
+            stationarity,
+            feasibility,
+            complementarity: 0.0,
+            negative_directions: 0,
+            min_reduced_hessian_eig: f64::NAN,
+        }
+    }
+
+    /// The advice after a budget ran out follows the residuals and the iterations spent: a
+    /// converged iterate is not told to iterate more, an infeasible one to check its
+    /// constraints, and one that has not settled in a long run not to raise the budget.
+    #[test]
+    fn the_advice_of_a_spent_budget_matches_the_iterate() {
+        assert!(advice(&residuals(1e-6, 1e-9), 50).contains("will not improve"));
+        assert!(advice(&residuals(1.0, 1e-2), 50).contains("far from feasible"));
+        assert!(advice(&residuals(1.0, 1e-9), 50).contains("raise max_iterations"));
+        let long = advice(&residuals(5.3, 2.7e-9), LONG_RUN);
+        assert!(
+            long.contains("unlikely to help") && !long.contains("raise"),
+            "{long}"
+        );
     }
 }
