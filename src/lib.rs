@@ -14,6 +14,13 @@ pub mod plot;
 pub mod se3;
 pub mod so3;
 pub mod sphere;
+
+// The long form of the README (`docs/`): its Rust code blocks are doctests like the README's.
+// (`docs/benchmarks.md`, `docs/paper-notes.md` and `docs/architecture.md` have none.)
+#[cfg(doctest)]
+#[doc = include_str!("../docs/guide.md")]
+pub struct GuideDoctests;
+
 /// A runnable example: an obstacle course's Lagrangian, stepped once.
 ///
 /// ```

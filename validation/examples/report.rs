@@ -1,5 +1,5 @@
-//! The speed report: every figure of the README's "Speed against error" section and of its
-//! planner speed passages (solve time against N, the optimizer against the root finder,
+//! The speed report: every figure of the "Speed against error" section of `docs/benchmarks.md`
+//! and of its planner speed passages (solve time against N, the optimizer against the root finder,
 //! Richardson extrapolation) in one run, the peers (hand-written steps, dense and dual-number
 //! Newton, finite differences, RK4 and DOP853 on plain right-hand sides) timed interleaved with
 //! `retract`, printed as markdown tables with the date and the machine

@@ -1,9 +1,9 @@
 //! Energy over a long horizon: the bounded Pais-Uhlenbeck oscillator (MATH.md; w1 = 1,
-//! w2 = sqrt 2, eps = -0.05) over steps of h = 0.1 to `t_end` (10^5 in the README's figure):
-//! max |H - H(0)| so far against time for the midpoint rule, the order-4 composition at 3h
-//! (the same number of implicit solves), RK4 (on `retract`'s vector field) and DOP853 with
-//! their step size or tolerance chosen to cost about as much as the midpoint run. One run
-//! each (the runs are long; matched cost is what matters).
+//! w2 = sqrt 2, eps = -0.05) over steps of h = 0.1 to `t_end` (10^5 in the figure of
+//! `docs/benchmarks.md`): max |H - H(0)| so far against time for the midpoint rule, the
+//! order-4 composition at 3h (the same number of implicit solves), RK4 (on `retract`'s vector
+//! field) and DOP853 with their step size or tolerance chosen to cost about as much as the
+//! midpoint run. One run each (the runs are long; matched cost is what matters).
 
 use std::io::Write;
 use std::time::Instant;

@@ -1,5 +1,5 @@
-//! The speed report: every figure of the README's "Speed against error" section and the
-//! planner's speed figures from one run, the peers timed interleaved with `retract`
+//! The speed report: every figure of the "Speed against error" section of `docs/benchmarks.md`
+//! and the planner's speed figures from one run, the peers timed interleaved with `retract`
 //! (`examples/report.rs`).
 //!
 //! It writes, as markdown ready to paste: a header with the date (UTC) and the machine; the

@@ -1,5 +1,5 @@
 //! Issue 14, item 10: a grammar-based fuzzer. It generates Lagrangians from the documented
-//! syntax (README, "What a Lagrangian may contain": jets of order 1 to 3, scalar and array
+//! syntax (docs/guide.md, "What a Lagrangian may contain": jets of order 1 to 3, scalar and array
 //! jets, `f64`, array and slice parameters, nesting, long sums, `const`s, `let` and `let mut`
 //! with every compound assignment, unrolled and run-time loops, every supported method in
 //! both call forms, extreme literals, odd names) plus a share of unsupported constructs, and
