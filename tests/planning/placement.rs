@@ -305,16 +305,7 @@ fn a_plan_around_the_disc_warm_starts_a_nearby_start() {
         let start = [START[0], START[1] + dy, 0.0, 0.0];
         let cold = solve(&start, PlanGuess::Spline).unwrap();
         let warm = solve(&start, PlanGuess::Plan(&first)).unwrap();
-        assert!(
-            (warm.cost - cold.cost).abs() <= 1e-9 * cold.cost,
-            "dy = {dy}"
-        );
-        assert!(
-            warm.iterations <= cold.iterations,
-            "dy = {dy}: warm {} iterations, cold {}",
-            warm.iterations,
-            cold.iterations
-        );
+        crate::warm_start::assert_warm_matches_cold(&warm, &cold, 1e-9, &format!("dy = {dy}"));
         assert!(clearances(&warm, &disc).0.min(clearances(&warm, &disc).1) >= -1e-9);
     }
 }

@@ -8,6 +8,23 @@ use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
 use crate::cart_pole::{CartForce, CartPole, PoleTorque};
 use crate::common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 
+/// A warm-started plan `warm` ends at the cold start's cost (to `relative` of it) in no more
+/// iterations.
+pub fn assert_warm_matches_cold(warm: &Plan<2, 4>, cold: &Plan<2, 4>, relative: f64, case: &str) {
+    assert!(
+        (warm.cost - cold.cost).abs() <= relative * cold.cost,
+        "{case}: warm {} cold {}",
+        warm.cost,
+        cold.cost
+    );
+    assert!(
+        warm.iterations <= cold.iterations,
+        "{case}: warm {} iterations, cold {}",
+        warm.iterations,
+        cold.iterations
+    );
+}
+
 const UPRIGHT: [f64; 4] = [0.0, std::f64::consts::PI, 0.0, 0.0];
 
 /// The cart-pole swing-up (T = 2, N = 40) with |F| <= 12, from the cart at `x0`.
@@ -32,18 +49,7 @@ fn a_plan_of_a_nearby_start_warm_starts_in_no_more_iterations_than_cold() {
     for x0 in [0.02, 0.1, -0.1] {
         let cold = solve_from(x0, PlanGuess::Spline);
         let warm = solve_from(x0, PlanGuess::Plan(&first));
-        assert!(
-            (warm.cost - cold.cost).abs() <= 1e-8 * cold.cost,
-            "x0 = {x0}: warm {} cold {}",
-            warm.cost,
-            cold.cost
-        );
-        assert!(
-            warm.iterations <= cold.iterations,
-            "x0 = {x0}: warm {} iterations, cold {}",
-            warm.iterations,
-            cold.iterations
-        );
+        assert_warm_matches_cold(&warm, &cold, 1e-8, &format!("x0 = {x0}"));
     }
 }
 
@@ -69,15 +75,6 @@ fn a_plan_past_the_soft_disc_warm_starts_a_nearby_start() {
         ];
         let cold = solve(&start, PlanGuess::Path { x: &x, u: &u });
         let warm = solve(&start, PlanGuess::Plan(&first));
-        assert!(
-            (warm.cost - cold.cost).abs() <= 1e-9 * cold.cost,
-            "dy = {dy}"
-        );
-        assert!(
-            warm.iterations <= cold.iterations,
-            "dy = {dy}: warm {} iterations, cold {}",
-            warm.iterations,
-            cold.iterations
-        );
+        assert_warm_matches_cold(&warm, &cold, 1e-9, &format!("dy = {dy}"));
     }
 }

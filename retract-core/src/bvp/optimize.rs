@@ -869,10 +869,16 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// Refuses a problem whose workspace ([`Self::workspace_bytes`]) the allocator will not
     /// give, before anything is allocated for it: the reservation is tried once and released
     /// (a solve that fails to allocate would abort the process instead of returning).
+    /// (Below 64 MiB no probe is made: it would cost a re-plan in a receding horizon an
+    /// allocation of the whole size for nothing.)
     fn check_workspace_fits(&self) -> Result<(), Error> {
+        let bytes = self.workspace_bytes();
+        if bytes < 1 << 26 {
+            return Ok(());
+        }
         let mut probe: Vec<u8> = Vec::new();
         probe
-            .try_reserve_exact(self.workspace_bytes())
+            .try_reserve_exact(bytes)
             .map_err(|_| Error::InvalidArgument {
                 name: "steps",
                 requirement: "the optimizer's workspace (about 3 stage models and a \

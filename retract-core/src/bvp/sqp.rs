@@ -493,6 +493,23 @@ where
         }
     }
 
+    /// The barrier at the first iterate ([`Barrier::new`] with
+    /// [`super::PlanOptions::initial_barrier`], $\mu = 0$ without inequalities); `None` if an
+    /// inequality is not finite there.
+    fn initial_barrier(&self, iterate: &Iterate<N, X>) -> Option<Barrier> {
+        let values: Vec<f64> = self.inequalities(iterate).iter().map(|c| c.value).collect();
+        if !values.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
+        let mu = if layout.0 + layout.1 > 0 {
+            self.problem.options.initial_barrier
+        } else {
+            0.0
+        };
+        Some(Barrier::new(mu, layout, &values))
+    }
+
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
     /// definite reduced Hessian (and, with inequalities, the barrier parameter at its floor
     /// [`barrier_floor`]), or a budget or the line search fails. After a full step from an
@@ -506,24 +523,10 @@ where
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
         let count = self.at_steps.len() + self.at_nodes.len();
-        let values: Vec<f64> = self
-            .inequalities(&iterate)
-            .iter()
-            .map(|c| c.value)
-            .collect();
-        if !values.iter().all(|v| v.is_finite()) {
-            return Err(PlanError {
-                failure: Failure::NonFinite,
-                last: None,
-            });
-        }
-        let mu = if count > 0 {
-            options.initial_barrier
-        } else {
-            0.0
-        };
-        let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
-        let mut barrier = Barrier::new(mu, layout, &values);
+        let mut barrier = self.initial_barrier(&iterate).ok_or(PlanError {
+            failure: Failure::NonFinite,
+            last: None,
+        })?;
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
