@@ -13,7 +13,8 @@
 //! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$
 //! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
-//! \min(\mu / 5, \mu^{1.5}))$.
+//! \min(\mu / 5, \mu^{1.5}))$ in the transcribed problem's units (IPOPT's: its barrier term
+//! is $h \mu \sum \ln s$, so its parameter is $h \mu$).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -310,8 +311,9 @@ impl Barrier {
         }
     }
 
-    /// Lowers $\mu$ towards `floor` (IPOPT's monotone rule).
-    pub fn decrease(&mut self, floor: f64) {
-        self.mu = (self.mu / 5.0).min(self.mu.powf(1.5)).max(floor);
+    /// Lowers $\mu$ towards `floor` by IPOPT's monotone rule on the transcribed problem's
+    /// parameter $h \mu$: $\mu \leftarrow \max(\mu_{\min}, \min(\mu / 5, (h \mu)^{1.5} / h))$.
+    pub fn decrease(&mut self, floor: f64, h: f64) {
+        self.mu = (self.mu / 5.0).min((h * self.mu).powf(1.5) / h).max(floor);
     }
 }

@@ -23,9 +23,9 @@ use crate::newton::max_abs;
 /// gradient $n_i$ in $x_i$ from the inequalities at the nodes; empty without them) add to
 /// $r_{x,i}$: where such a constraint is active the momentum jumps at the node, $p_{i+1} - p_i
 /// = d_i + n_{i+1}$, and $p_{i+1}$ above is the value after the jump.
-/// Returns the momenta and the
-/// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \max(1, |\nabla
-/// L|_\infty))$ (the terminal residual without the $h$).
+/// Returns the momenta, the
+/// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \sigma)$ (the terminal
+/// residual without the $h$) and its scale $\sigma = \max(1, |\nabla L|_\infty)$.
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stages: &[StageModel<N, X>],
@@ -33,7 +33,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     direction: &Direction<N, X>,
     node_gradients: &[SVector<f64, X>],
     (terminal_gradient, fixed, start_fixed): (&SVector<f64, X>, &SVector<f64, X>, &SVector<f64, X>),
-) -> (Vec<SVector<f64, X>>, f64) {
+) -> (Vec<SVector<f64, X>>, f64, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
     let wt = &dynamics.poly_w;
     // (A^T mu)_j = mu_{j-1}; B^T mu = the last block
@@ -91,7 +91,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         }
     }
     let scale = (largest / h).max(1.0);
-    (momenta, (worst / (h * scale)).max(terminal / scale))
+    (momenta, (worst / (h * scale)).max(terminal / scale), scale)
 }
 
 /// The smallest eigenvalue of the reduced Hessian $Z^T \nabla^2 J\thinspace Z$ ($Z$ orthonormal) of

@@ -72,7 +72,9 @@ pub struct PlanOptions {
     pub armijo: f64,
     /// Step halvings per line search.
     pub max_backtracks: usize,
-    /// Initial barrier parameter $\mu$ of the inequalities (per unit time).
+    /// Initial barrier parameter $\mu_0$ of the inequalities, in the units of the transcribed
+    /// problem (IPOPT's `mu_init`, whose default 0.1 it shares): its barrier term is $\mu_0
+    /// \sum \ln s$ over the slacks of every inequality at every node and step.
     pub initial_barrier: f64,
     /// Also compute [`Certificate::min_reduced_hessian_eig`] (Lanczos on the final
     /// factorisation, less than one iteration's time); on by default, off in

@@ -173,7 +173,7 @@ fn constraint_projection<const N: usize, const X: usize>(
 /// What the backward pass keeps of a stage.
 #[derive(Clone, Copy, Debug)]
 struct StageFactor<const N: usize, const X: usize> {
-    /// $(\Pi Q_{uu} \Pi + I - \Pi)^{-1}$ ($Q_{uu}^{-1}$ without constraints).
+    /// $\tilde Q^{-1} = (\Pi Q_{uu} \Pi + w (I - \Pi))^{-1}$ ($Q_{uu}^{-1}$ without constraints).
     quu_inv: SMatrix<f64, N, N>,
     quu: SMatrix<f64, N, N>,
     qux: SMatrix<f64, N, X>,
@@ -357,7 +357,8 @@ fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, 
 /// $K = -Q_{uu}^{-1} Q_{ux}$ and $K_\nu = -Q_{uu}^{-1} \bar B^T S$; with them
 /// $\delta u = M \delta x + m_0 + \Pi v$ ($M = -C_u^+ C_x$) and $v$ minimises over the null
 /// space: $K = M - \Pi \tilde Q^{-1} \Pi (Q_{ux} + Q_{uu} M)$, $K_\nu = -\Pi \tilde Q^{-1}
-/// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + I - \Pi$ ($K_\nu$ by the caller, for the
+/// \Pi \bar B^T S$ with $\tilde Q = \Pi Q_{uu} \Pi + w (I - \Pi)$, $w = \max(1, \max_a
+/// |(Q_{uu})_{aa}|)$ ($K_\nu$ by the caller, for the
 /// tail). Returns the factor, $Q_{xx}$ and the negative eigenvalues of $\tilde Q$ on the null
 /// space (`None`: singular).
 #[inline(always)]
@@ -409,7 +410,10 @@ fn stage_factor<const N: usize, const X: usize>(
     let Some((projector, pinv, cx)) = constraint_projection(dynamics, stage) else {
         return (factor, qxx, None);
     };
-    let complement = SMatrix::<f64, N, N>::identity() - projector;
+    // (the complement's weight drops out of Pi Qtilde^-1 Pi: the size of Q_uu's diagonal keeps
+    // Qtilde as well conditioned as Q_uu on the null space, with a large inertia correction)
+    let weight = (0..N).fold(1.0_f64, |w, a| w.max(quu[(a, a)].abs()));
+    let complement = (SMatrix::<f64, N, N>::identity() - projector) * weight;
     let reduced = projector * quu * projector + complement;
     let Some((quu_inv, neg)) = invert_counting((reduced + reduced.transpose()) * 0.5) else {
         return (factor, qxx, None);

@@ -16,6 +16,9 @@ use super::riccati::{Direction, Dynamics, Riccati, STEPS_PER_CLOCK_CHECK, StageM
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
 
+mod line_search;
+use line_search::Filter;
+
 /// The error below which a full step's factorisation is kept for a simplified Newton step
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
@@ -91,6 +94,9 @@ struct Subproblem<const N: usize, const X: usize> {
     momenta: Vec<SVector<f64, X>>,
     certificate: Certificate,
     error: f64,
+    /// The error of the barrier problem, IPOPT's $E_\mu$ per unit time: the absolute
+    /// stationarity $\sigma \times$ the relative one, the feasibility and $\max |z s - \mu|$.
+    barrier_error: f64,
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
@@ -123,43 +129,6 @@ where
     fn x_theta(&self, iterate: &Iterate<N, X>, i: usize) -> SVector<f64, X> {
         let theta = self.dynamics.theta;
         iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
-    }
-
-    /// The barrier cost $J - h \mu \sum \ln s$ and $\|c\|_1$ (with $\sum |g - s|$) at a
-    /// trial point whose slacks are $s + \alpha\,\delta s$; `None` if not finite.
-    fn merit_parts(
-        &self,
-        iterate: &Iterate<N, X>,
-        barrier: &Barrier,
-        ds: &[f64],
-        alpha: f64,
-    ) -> Option<(f64, f64)> {
-        let h = self.dynamics.h;
-        let (mut cost, mut violation) = (0.0, 0.0);
-        let mut values = Vec::with_capacity(ds.len());
-        for (i, u) in iterate.u.iter().enumerate() {
-            let system = self.problem.system_at(i);
-            let xt = self.x_theta(iterate, i);
-            let xb = blocks::<N, K, X>(&xt);
-            cost += h * system.lagrangian(&xb, u);
-            violation += (self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1]).lp_norm(1);
-            for g in &self.problem.equalities {
-                violation += g.value(&xb, u).abs();
-            }
-            values.extend(self.at_steps.iter().map(|c| c.value(&xt, u)));
-        }
-        self.node_values(iterate, &mut values);
-        let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
-        let last = &iterate.x[iterate.x.len() - 1];
-        violation += slack
-            + (self.problem.start - iterate.x[0])
-                .component_mul(&self.problem.fixed_start)
-                .lp_norm(1)
-            + (self.problem.goal - last)
-                .component_mul(&self.problem.fixed_end)
-                .lp_norm(1);
-        let cost = cost + log + self.terminal_value(last);
-        (cost.is_finite() && violation.is_finite()).then_some((cost, violation))
     }
 
     /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h z^T g^{\ge}$,
@@ -423,7 +392,8 @@ where
     /// The certificate's residuals at the iterate of `models` with the multipliers of the
     /// subproblem solution `direction` ([`kkt_residuals`] with the gradients of $h L - h z^T
     /// g^{\ge}$, the constraint violation, $\max z g$), its negative directions those of
-    /// `riccati`; and the momenta.
+    /// `riccati`; the momenta; and the scale $\sigma$ of the relative stationarity (its
+    /// absolute value, per unit time, is $\sigma$ times the relative one).
     fn residuals(
         &self,
         models: &Models<N, X>,
@@ -431,7 +401,7 @@ where
         negative_directions: usize,
         direction: &Direction<N, X>,
         z: &[f64],
-    ) -> (Vec<SVector<f64, X>>, Certificate) {
+    ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
         let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
         let with_inequalities;
@@ -449,7 +419,7 @@ where
             &models.terminal.start_fixed,
         );
         let nodes = barrier.node_gradients(&models.inequalities, z, h);
-        let (momenta, stationarity) = kkt_residuals(
+        let (momenta, stationarity, scale) = kkt_residuals(
             &self.dynamics,
             &models.stages,
             gradients,
@@ -468,7 +438,7 @@ where
             negative_directions,
             min_reduced_hessian_eig: f64::NAN,
         };
-        (momenta, certificate)
+        (momenta, certificate, scale)
     }
 
     fn plan(
@@ -493,9 +463,9 @@ where
         }
     }
 
-    /// The barrier at the first iterate ([`Barrier::new`] with
-    /// [`super::PlanOptions::initial_barrier`], $\mu = 0$ without inequalities); `None` if an
-    /// inequality is not finite there.
+    /// The barrier at the first iterate ([`Barrier::new`] with $\mu = \mu_0 / h$ per unit time,
+    /// $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without inequalities);
+    /// `None` if an inequality is not finite there.
     fn initial_barrier(&self, iterate: &Iterate<N, X>) -> Option<Barrier> {
         let values: Vec<f64> = self.inequalities(iterate).iter().map(|c| c.value).collect();
         if !values.iter().all(|v| v.is_finite()) {
@@ -503,7 +473,7 @@ where
         }
         let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
         let mu = if layout.0 + layout.1 > 0 {
-            self.problem.options.initial_barrier
+            self.problem.options.initial_barrier / self.dynamics.h
         } else {
             0.0
         };
@@ -532,6 +502,7 @@ where
         let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
         let mut full_step: Option<Direction<N, X>> = None;
         let mut kept: Option<(Riccati<N, X>, f64)> = None;
+        let mut filter: Option<Filter> = None;
         // (the stage constraints' projections change with the iterate: no simplified steps)
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
@@ -588,13 +559,18 @@ where
                 mut momenta,
                 certificate,
                 error,
+                barrier_error,
             } = sub;
             rho_last = rho;
-            let (complementarity, complementarity_error) = barrier.complementarity();
-            if barrier.mu > floor && error.max(complementarity_error) <= 10.0 * barrier.mu {
-                barrier.decrease(floor);
+            // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
+            if barrier.mu > floor && barrier_error <= 10.0 * barrier.mu {
+                barrier.decrease(floor, self.dynamics.h);
+                if let Some(filter) = &mut filter {
+                    filter.reset();
+                }
                 continue;
             }
+            let complementarity = barrier.complementarity().0;
             // converged, or at the acceptable level with no progress left but rounding
             let acceptable = stalled >= 3 && error.max(complementarity) <= options.acceptable;
             if (error <= options.tolerance || acceptable) && barrier.mu <= floor {
@@ -631,8 +607,15 @@ where
             }
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
-            let searched =
-                self.line_search(&iterate, &models, &direction, &barrier, &ds, &mut penalty);
+            let filter = filter.get_or_insert_with(|| Filter::new(models.violation_l1()));
+            let slacks = (&barrier, &ds[..]);
+            let searched = match self.filter_search(&iterate, &models, &direction, slacks, filter) {
+                Ok(Some(accepted)) => Ok(accepted),
+                Ok(None) => {
+                    self.penalty_search(&iterate, &models, &direction, slacks, &mut penalty)
+                }
+                Err(failure) => Err(failure),
+            };
             let (next, alpha, at_rounding) = match searched {
                 Ok(accepted) => accepted,
                 Err(Failure::LineSearch) if stale => {
@@ -706,9 +689,12 @@ where
             // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
             let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
             let z = barrier.predicted(&ds);
-            let (momenta, certificate) =
+            let (momenta, certificate, scale) =
                 self.residuals(models, barrier, riccati.negative, &direction, &z);
             let error = certificate.stationarity.max(certificate.feasibility);
+            let barrier_error = (scale * certificate.stationarity)
+                .max(certificate.feasibility)
+                .max(barrier.complementarity().1);
             Subproblem {
                 riccati,
                 rho,
@@ -717,6 +703,7 @@ where
                 momenta,
                 certificate,
                 error,
+                barrier_error,
             }
         };
         if let Some((riccati, e_prev)) = kept {
@@ -746,7 +733,7 @@ where
             return None;
         }
         let models = self.models(iterate, y, barrier).ok()?;
-        let (momenta, certificate) = self.residuals(&models, barrier, 0, last, &barrier.z);
+        let (momenta, certificate, _) = self.residuals(&models, barrier, 0, last, &barrier.z);
         if certificate.stationarity.max(certificate.feasibility) > options.tolerance {
             return None;
         }
@@ -857,116 +844,5 @@ where
         }
         riccati
             .unwrap_or_else(|| Riccati::factor_with(&self.dynamics, &base, 0.0, &models.terminal))
-    }
-
-    /// $\sum_i \delta y_i^T H_i \delta y_i$ over the stages' models (with their node terms)
-    /// along the direction, $\delta y_i = (\delta x_{\theta,i}, \delta u_i)$.
-    fn curvature(&self, models: &Models<N, X>, direction: &Direction<N, X>) -> f64 {
-        let theta = self.dynamics.theta;
-        let mut sum = 0.0;
-        for (i, stage) in models.stages.iter().enumerate() {
-            let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-            let du = &direction.du[i];
-            sum += dx.dot(&(stage.hxx * dx))
-                + 2.0 * du.dot(&(stage.hux * dx))
-                + du.dot(&(stage.huu * du));
-            if let Some(node) = &stage.node {
-                sum += direction.dx[i].dot(&(node.0 * direction.dx[i]));
-            }
-        }
-        if let Some(last) = direction.dx.last() {
-            sum += last.dot(&(models.terminal.hessian * last));
-        }
-        sum
-    }
-
-    /// Backtracking on $J - h \mu \sum \ln g + \pi \|c\|_1$ along the direction: the
-    /// accepted point, the step length and whether the decrease was at rounding level;
-    /// [`Failure::LineSearch`] if no step is accepted, [`Failure::TimeLimit`] if the budget
-    /// runs out between trials.
-    fn line_search(
-        &self,
-        iterate: &Iterate<N, X>,
-        models: &Models<N, X>,
-        direction: &Direction<N, X>,
-        barrier: &Barrier,
-        ds: &[f64],
-        penalty: &mut f64,
-    ) -> Result<(Iterate<N, X>, f64, bool), Failure> {
-        let options = &self.problem.options;
-        let theta = self.dynamics.theta;
-        // directional derivative of J (stages and terminal cost) along the direction
-        let mut slope = 0.0;
-        for (i, (gx, gu)) in models.cost_gradient.iter().enumerate() {
-            let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-            slope += gx.dot(&dxt) + gu.dot(&direction.du[i]);
-        }
-        slope += barrier.slope(ds, self.dynamics.h);
-        // and of the terminal cost
-        if let Some(dx_end) = direction.dx.last() {
-            slope += models.terminal_gradient.dot(dx_end);
-        }
-        let violation = models.violation_l1();
-        if violation > 0.0 {
-            // the model's decrease must pay for its curvature too (Nocedal and Wright, 18.36):
-            // pi >= (slope + max(0, d^T H d) / 2) / ((1 - 0.1) |c|_1), so that long steps
-            // toward feasibility are not cut by the cost they add; H without the barrier's
-            // h z/s grad g grad g^T, which near an active bound would make pi huge
-            // (with the dynamics alone, linear, a full step is feasible: no curvature needed)
-            let nonlinear = !self.problem.equalities.is_empty() || !barrier.s.is_empty();
-            let curvature = if nonlinear {
-                (self.curvature(models, direction)
-                    - barrier.curvature(&models.inequalities, ds, self.dynamics.h))
-                .max(0.0)
-            } else {
-                0.0
-            };
-            let needed = (slope + 0.5 * curvature) / (0.9 * violation);
-            if needed > *penalty {
-                *penalty = needed * 1.1;
-            }
-        }
-        let descent = slope - *penalty * violation;
-        let merit0 = models.barrier_cost + *penalty * violation;
-        if !descent.is_finite() {
-            return Err(Failure::LineSearch);
-        }
-        // rounding of the merit function: of J and of the defects (about eps |x| each)
-        let size: f64 = iterate.x.iter().map(|x| x.lp_norm(1)).sum();
-        let noise = 1e-14 * (models.barrier_cost.abs() + 2.0 * *penalty * size);
-        // a non-negative slope: the direction is at rounding level; take it as it is
-        let descent = descent.min(0.0);
-        let mut alpha = barrier.max_step(ds);
-        for _ in 0..=options.max_backtracks {
-            if self.out_of_time() {
-                return Err(Failure::TimeLimit);
-            }
-            let trial = Iterate {
-                x: iterate
-                    .x
-                    .iter()
-                    .zip(&direction.dx)
-                    .map(|(x, d)| x + d * alpha)
-                    .collect(),
-                u: iterate
-                    .u
-                    .iter()
-                    .zip(&direction.du)
-                    .map(|(u, d)| u + d * alpha)
-                    .collect(),
-            };
-            let parts = self
-                .problem
-                .guard::<S, M>(&trial)
-                .ok()
-                .and_then(|()| self.merit_parts(&trial, barrier, ds, alpha));
-            if parts.is_some_and(|(cost, violation)| {
-                cost + *penalty * violation <= merit0 + options.armijo * alpha * descent + noise
-            }) {
-                return Ok((trial, alpha, -descent <= noise));
-            }
-            alpha *= 0.5;
-        }
-        Err(Failure::LineSearch)
     }
 }

@@ -1,0 +1,310 @@
+//! The line search of the SQP iteration: IPOPT's filter (Wächter and Biegler, Math. Program.
+//! 106, 2006) on the pair (constraint violation $\theta = \|c\|_1$, barrier cost $\varphi = J -
+//! h \mu \sum \ln s$), and where the filter finds no step, backtracking on the exact penalty
+//! $\varphi + \pi \theta$.
+//!
+//! A trial point $\alpha$ along the direction is acceptable to the filter if no stored pair
+//! dominates it and, either (if $\theta \le \theta_{\min}$ and the switching condition
+//! $\alpha (-\nabla\varphi^T d)^{s_\varphi} > \delta \theta^{s_\theta}$ holds) it satisfies
+//! Armijo's condition on $\varphi$, or it reduces $\theta$ by a factor $1 - \gamma_\theta$ or
+//! $\varphi$ by $\gamma_\varphi \theta$; in the second case the filter is augmented by
+//! $((1 - \gamma_\theta) \theta, \varphi - \gamma_\varphi \theta)$. The filter is emptied when
+//! $\mu$ decreases.
+
+use super::{Models, Sqp};
+use crate::bvp::barrier::Barrier;
+use crate::bvp::optimize::{Failure, Iterate, blocks};
+use crate::bvp::riccati::Direction;
+use crate::{Lagrangian, LiftedSystem};
+
+/// IPOPT's constants: $\gamma_\theta$, $\gamma_\varphi$, the switching exponents $s_\theta$,
+/// $s_\varphi$ and factor $\delta$, and $\gamma_\alpha$ of the smallest step length.
+const GAMMA_THETA: f64 = 1e-5;
+const GAMMA_PHI: f64 = 1e-8;
+const S_THETA: f64 = 1.1;
+const S_PHI: f64 = 2.3;
+const DELTA: f64 = 1.0;
+const GAMMA_ALPHA: f64 = 0.05;
+
+/// The filter: pairs $(\theta, \varphi)$ a trial point must not be dominated by, and the
+/// bounds $\theta_{\max} = 10^4 \max(1, \theta_0)$ (no trial point above it) and
+/// $\theta_{\min} = 10^{-4} \max(1, \theta_0)$ (below it, steps that only decrease
+/// $\varphi$ are taken by Armijo's condition) from the violation $\theta_0$ of the first
+/// iterate.
+pub(in crate::bvp) struct Filter {
+    entries: Vec<(f64, f64)>,
+    theta_max: f64,
+    theta_min: f64,
+}
+
+impl Filter {
+    /// An empty filter for a first violation `theta0`.
+    pub fn new(theta0: f64) -> Self {
+        let scale = theta0.max(1.0);
+        Self {
+            entries: Vec::new(),
+            theta_max: 1e4 * scale,
+            theta_min: 1e-4 * scale,
+        }
+    }
+
+    /// Empties the filter (when $\mu$ changes, the barrier cost changes with it).
+    pub fn reset(&mut self) {
+        self.entries.clear();
+    }
+
+    /// Whether $(\theta, \varphi)$ is dominated by a stored pair or has $\theta \ge
+    /// \theta_{\max}$.
+    fn rejects(&self, theta: f64, phi: f64) -> bool {
+        theta >= self.theta_max || self.entries.iter().any(|(t, p)| theta >= *t && phi >= *p)
+    }
+
+    /// Adds $(\theta, \varphi)$, dropping the pairs it dominates.
+    fn augment(&mut self, theta: f64, phi: f64) {
+        self.entries.retain(|(t, p)| *t < theta || *p < phi);
+        self.entries.push((theta, phi));
+    }
+}
+
+/// An accepted trial point: the iterate, the step length and whether the decrease it was
+/// accepted on is at rounding level.
+pub(super) type Accepted<const N: usize, const X: usize> = (Iterate<N, X>, f64, bool);
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// The barrier cost $J - h \mu \sum \ln s$ and $\|c\|_1$ (with $\sum |g - s|$) at a
+    /// trial point whose slacks are $s + \alpha\,\delta s$; `None` if not finite.
+    fn merit_parts(
+        &self,
+        iterate: &Iterate<N, X>,
+        barrier: &Barrier,
+        ds: &[f64],
+        alpha: f64,
+    ) -> Option<(f64, f64)> {
+        let h = self.dynamics.h;
+        let (mut cost, mut violation) = (0.0, 0.0);
+        let mut values = Vec::with_capacity(ds.len());
+        for (i, u) in iterate.u.iter().enumerate() {
+            let system = self.problem.system_at(i);
+            let xt = self.x_theta(iterate, i);
+            let xb = blocks::<N, K, X>(&xt);
+            cost += h * system.lagrangian(&xb, u);
+            violation += (self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1]).lp_norm(1);
+            for g in &self.problem.equalities {
+                violation += g.value(&xb, u).abs();
+            }
+            values.extend(self.at_steps.iter().map(|c| c.value(&xt, u)));
+        }
+        self.node_values(iterate, &mut values);
+        let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
+        let last = &iterate.x[iterate.x.len() - 1];
+        violation += slack
+            + (self.problem.start - iterate.x[0])
+                .component_mul(&self.problem.fixed_start)
+                .lp_norm(1)
+            + (self.problem.goal - last)
+                .component_mul(&self.problem.fixed_end)
+                .lp_norm(1);
+        let cost = cost + log + self.terminal_value(last);
+        (cost.is_finite() && violation.is_finite()).then_some((cost, violation))
+    }
+
+    /// $\sum_i \delta y_i^T H_i \delta y_i$ over the stages' models (with their node terms)
+    /// along the direction, $\delta y_i = (\delta x_{\theta,i}, \delta u_i)$.
+    fn curvature(&self, models: &Models<N, X>, direction: &Direction<N, X>) -> f64 {
+        let theta = self.dynamics.theta;
+        let mut sum = 0.0;
+        for (i, stage) in models.stages.iter().enumerate() {
+            let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+            let du = &direction.du[i];
+            sum += dx.dot(&(stage.hxx * dx))
+                + 2.0 * du.dot(&(stage.hux * dx))
+                + du.dot(&(stage.huu * du));
+            if let Some(node) = &stage.node {
+                sum += direction.dx[i].dot(&(node.0 * direction.dx[i]));
+            }
+        }
+        if let Some(last) = direction.dx.last() {
+            sum += last.dot(&(models.terminal.hessian * last));
+        }
+        sum
+    }
+
+    /// $\nabla\varphi^T d$: the derivative of the barrier cost $J - h \mu \sum \ln s$
+    /// (stages, terminal cost, slacks) along the direction.
+    fn slope(
+        &self,
+        models: &Models<N, X>,
+        direction: &Direction<N, X>,
+        barrier: &Barrier,
+        ds: &[f64],
+    ) -> f64 {
+        let theta = self.dynamics.theta;
+        let mut slope = barrier.slope(ds, self.dynamics.h);
+        for (i, (gx, gu)) in models.cost_gradient.iter().enumerate() {
+            let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+            slope += gx.dot(&dxt) + gu.dot(&direction.du[i]);
+        }
+        if let Some(dx_end) = direction.dx.last() {
+            slope += models.terminal_gradient.dot(dx_end);
+        }
+        slope
+    }
+
+    /// The point $\alpha$ along the direction and its $(\varphi, \theta)$
+    /// ([`Self::merit_parts`]); `None` for these if the point leaves the system's domain or a
+    /// value is not finite.
+    fn trial(
+        &self,
+        iterate: &Iterate<N, X>,
+        direction: &Direction<N, X>,
+        (barrier, ds): (&Barrier, &[f64]),
+        alpha: f64,
+    ) -> (Iterate<N, X>, Option<(f64, f64)>) {
+        let trial = Iterate {
+            x: iterate
+                .x
+                .iter()
+                .zip(&direction.dx)
+                .map(|(x, d)| x + d * alpha)
+                .collect(),
+            u: iterate
+                .u
+                .iter()
+                .zip(&direction.du)
+                .map(|(u, d)| u + d * alpha)
+                .collect(),
+        };
+        let parts = self
+            .problem
+            .guard::<S, M>(&trial)
+            .ok()
+            .and_then(|()| self.merit_parts(&trial, barrier, ds, alpha));
+        (trial, parts)
+    }
+
+    /// The filter line search from the fraction-to-the-boundary step, halving: the accepted
+    /// point, or `None` once the step length falls below IPOPT's $\alpha_{\min} =
+    /// \gamma_\alpha \min(\gamma_\theta, \gamma_\varphi \theta / (-\nabla\varphi^T d), \delta
+    /// \theta^{s_\theta} / (-\nabla\varphi^T d)^{s_\varphi})$ (or after
+    /// [`crate::bvp::PlanOptions::max_backtracks`] halvings); [`Failure::TimeLimit`] if the
+    /// budget runs out between trials.
+    pub(super) fn filter_search(
+        &self,
+        iterate: &Iterate<N, X>,
+        models: &Models<N, X>,
+        direction: &Direction<N, X>,
+        (barrier, ds): (&Barrier, &[f64]),
+        filter: &mut Filter,
+    ) -> Result<Option<Accepted<N, X>>, Failure> {
+        let options = &self.problem.options;
+        let slope = self.slope(models, direction, barrier, ds);
+        let (theta, phi) = (models.violation_l1(), models.barrier_cost);
+        if !slope.is_finite() {
+            return Ok(None);
+        }
+        // rounding of phi and of the defects (about eps |x| each)
+        let size: f64 = iterate.x.iter().map(|x| x.lp_norm(1)).sum();
+        let noise = 1e-14 * phi.abs().max(1.0);
+        let at_rounding = -slope <= noise && theta <= 1e-13 * size.max(1.0);
+        let alpha_min = if slope < 0.0 {
+            GAMMA_ALPHA
+                * GAMMA_THETA
+                    .min(GAMMA_PHI * theta / -slope)
+                    .min(DELTA * theta.powf(S_THETA) / (-slope).powf(S_PHI))
+        } else {
+            GAMMA_ALPHA * GAMMA_THETA
+        };
+        let mut alpha = barrier.max_step(ds);
+        for _ in 0..=options.max_backtracks {
+            if alpha < alpha_min && !at_rounding {
+                break;
+            }
+            if self.out_of_time() {
+                return Err(Failure::TimeLimit);
+            }
+            let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
+            if let Some((phi_t, theta_t)) = parts
+                && !filter.rejects(theta_t, phi_t)
+            {
+                let switching =
+                    slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
+                if theta <= filter.theta_min && switching {
+                    if phi_t <= phi + options.armijo * alpha * slope + noise {
+                        return Ok(Some((trial, alpha, at_rounding)));
+                    }
+                } else if theta_t <= (1.0 - GAMMA_THETA) * theta
+                    || phi_t <= phi - GAMMA_PHI * theta + noise
+                {
+                    filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
+                    return Ok(Some((trial, alpha, at_rounding)));
+                }
+            }
+            alpha *= 0.5;
+        }
+        Ok(None)
+    }
+
+    /// Backtracking on $\varphi + \pi \|c\|_1$ along the direction (where the filter finds no
+    /// step): the accepted point, the step length and whether the decrease was at rounding
+    /// level; [`Failure::LineSearch`] if no step is accepted, [`Failure::TimeLimit`] if the
+    /// budget runs out between trials.
+    pub(super) fn penalty_search(
+        &self,
+        iterate: &Iterate<N, X>,
+        models: &Models<N, X>,
+        direction: &Direction<N, X>,
+        (barrier, ds): (&Barrier, &[f64]),
+        penalty: &mut f64,
+    ) -> Result<Accepted<N, X>, Failure> {
+        let options = &self.problem.options;
+        let slope = self.slope(models, direction, barrier, ds);
+        let violation = models.violation_l1();
+        if violation > 0.0 {
+            // the model's decrease must pay for its curvature too (Nocedal and Wright, 18.36):
+            // pi >= (slope + max(0, d^T H d) / 2) / ((1 - 0.1) |c|_1), so that long steps
+            // toward feasibility are not cut by the cost they add; H without the barrier's
+            // h z/s grad g grad g^T, which near an active bound would make pi huge
+            // (with the dynamics alone, linear, a full step is feasible: no curvature needed)
+            let nonlinear = !self.problem.equalities.is_empty() || !barrier.s.is_empty();
+            let curvature = if nonlinear {
+                (self.curvature(models, direction)
+                    - barrier.curvature(&models.inequalities, ds, self.dynamics.h))
+                .max(0.0)
+            } else {
+                0.0
+            };
+            let needed = (slope + 0.5 * curvature) / (0.9 * violation);
+            if needed > *penalty {
+                *penalty = needed * 1.1;
+            }
+        }
+        let descent = slope - *penalty * violation;
+        let merit0 = models.barrier_cost + *penalty * violation;
+        if !descent.is_finite() {
+            return Err(Failure::LineSearch);
+        }
+        // rounding of the merit function: of J and of the defects (about eps |x| each)
+        let size: f64 = iterate.x.iter().map(|x| x.lp_norm(1)).sum();
+        let noise = 1e-14 * (models.barrier_cost.abs() + 2.0 * *penalty * size);
+        // a non-negative slope: the direction is at rounding level; take it as it is
+        let descent = descent.min(0.0);
+        let mut alpha = barrier.max_step(ds);
+        for _ in 0..=options.max_backtracks {
+            if self.out_of_time() {
+                return Err(Failure::TimeLimit);
+            }
+            let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
+            if parts.is_some_and(|(cost, violation)| {
+                cost + *penalty * violation <= merit0 + options.armijo * alpha * descent + noise
+            }) {
+                return Ok((trial, alpha, -descent <= noise));
+            }
+            alpha *= 0.5;
+        }
+        Err(Failure::LineSearch)
+    }
+}
