@@ -44,16 +44,19 @@ pub(super) enum Slot {
 }
 
 impl Barrier {
-    /// Slacks $s = \max(g, 0.1 \max(1, |g|))$ and $z = \mu / s$ at the first iterate, for
-    /// `count` inequalities per step and `nodes` per interior node over `steps` steps.
-    pub fn new(mu: f64, (count, nodes, steps): (usize, usize, usize), values: &[f64]) -> Self {
-        let s: Vec<f64> = values
-            .iter()
-            .map(|g| g.max(0.1 * g.abs().max(1.0)))
-            .collect();
+    /// Slacks $s = \max(g, 10^{-2})$ and multipliers $z = 1 / h$ at the first iterate (IPOPT's
+    /// `bound_push` and `bound_mult_init_val` 1 in the transcribed problem's units, where the
+    /// multiplier is $h z$), for `count` inequalities per step and `nodes` per interior node
+    /// over `steps` steps of length `h`.
+    pub fn new(
+        (mu, h): (f64, f64),
+        (count, nodes, steps): (usize, usize, usize),
+        values: &[f64],
+    ) -> Self {
+        let s: Vec<f64> = values.iter().map(|g| g.max(1e-2)).collect();
         Self {
             mu,
-            z: s.iter().map(|s| mu / s).collect(),
+            z: vec![1.0 / h; s.len()],
             s,
             count,
             nodes,
@@ -292,6 +295,18 @@ impl Barrier {
             .fold((0.0_f64, 0.0_f64), |(m, e), (z, s)| {
                 (m.max(z * s), e.max((z * s - self.mu).abs()))
             })
+    }
+
+    /// IPOPT's scales $(s_d, s_c)$ of the barrier problem's error, which keep large
+    /// multipliers from holding $\mu$ up: $s_d = \max(1, \bar\lambda / 100)$ with
+    /// $\bar\lambda$ the mean modulus of every multiplier in the transcribed problem's units
+    /// ($h z$ and the others', whose $\ell_1$ norm and number are `others`), $s_c = \max(1,
+    /// \overline{h z} / 100)$.
+    pub fn error_scales(&self, z: &[f64], h: f64, (others, count): (f64, usize)) -> (f64, f64) {
+        let sum: f64 = z.iter().map(|z| (h * z).abs()).sum();
+        let s_d = (sum + others) / (z.len() + count).max(1) as f64;
+        let s_c = sum / z.len().max(1) as f64;
+        ((s_d / 100.0).max(1.0), (s_c / 100.0).max(1.0))
     }
 
     /// $\max |g - s|$.

@@ -95,7 +95,8 @@ struct Subproblem<const N: usize, const X: usize> {
     certificate: Certificate,
     error: f64,
     /// The error of the barrier problem, IPOPT's $E_\mu$ per unit time: the absolute
-    /// stationarity $\sigma \times$ the relative one, the feasibility and $\max |z s - \mu|$.
+    /// stationarity $\sigma \times$ the relative one over $s_d$, the feasibility and $\max |z s
+    /// - \mu|$ over $s_c$ ([`Barrier::error_scales`]); see [`Sqp::barrier_error`].
     barrier_error: f64,
 }
 
@@ -477,7 +478,7 @@ where
         } else {
             0.0
         };
-        Some(Barrier::new(mu, layout, &values))
+        Some(Barrier::new((mu, self.dynamics.h), layout, &values))
     }
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
@@ -689,12 +690,10 @@ where
             // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
             let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
             let z = barrier.predicted(&ds);
-            let (momenta, certificate, scale) =
+            let (momenta, certificate, _) =
                 self.residuals(models, barrier, riccati.negative, &direction, &z);
+            let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
             let error = certificate.stationarity.max(certificate.feasibility);
-            let barrier_error = (scale * certificate.stationarity)
-                .max(certificate.feasibility)
-                .max(barrier.complementarity().1);
             Subproblem {
                 riccati,
                 rho,
@@ -715,6 +714,41 @@ where
         }
         let (riccati, rho) = self.factor_corrected(models, rho_last)?;
         Ok(solve(riccati, rho, false))
+    }
+
+    /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
+    /// `barrier_error`) at the models' iterate with the subproblem's solution `direction`:
+    /// the smaller of its values with the predicted inequality multipliers `z` and with the
+    /// current ones (the predicted ones are off by the whole dual step when the primal step
+    /// is short). $\infty$ without inequalities or with $\mu$ at its floor (it only decides
+    /// when $\mu$ decreases).
+    fn barrier_error(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        direction: &Direction<N, X>,
+        (z, momenta): (&[f64], &[SVector<f64, X>]),
+    ) -> f64 {
+        if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.problem.options.tolerance) {
+            return f64::INFINITY;
+        }
+        let h = self.dynamics.h;
+        let others = direction
+            .multipliers
+            .iter()
+            .map(|y| y.lp_norm(1))
+            .sum::<f64>()
+            + momenta.iter().map(|p| p.lp_norm(1)).sum::<f64>();
+        let count = direction.multipliers.len() * N + momenta.len() * X;
+        let compl = barrier.complementarity().1;
+        let error = |z: &[f64]| {
+            let (_, certificate, scale) = self.residuals(models, barrier, 0, direction, z);
+            let (s_d, s_c) = barrier.error_scales(z, h, (others, count));
+            (scale * certificate.stationarity / s_d)
+                .max(certificate.feasibility)
+                .max(compl / s_c)
+        };
+        error(z).min(error(&barrier.z))
     }
 
     /// The plan at the point reached by a full step, certified with the last subproblem's
