@@ -5,7 +5,8 @@
 //! `<name> J=<J> iterations=<n> time_ms=<t> max_violation=<v> min_reduced_hessian_eig=<e>`.
 //!
 //! Run: `cargo run --release --example constrained` (add `-- quick` for a smaller version of
-//! each problem: a tenth of the steps; the test target runs that).
+//! each problem: a tenth of the steps; `cargo test --example constrained` runs that as a test,
+//! and `cargo test --workspace` with it).
 
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -296,5 +297,22 @@ fn main() {
     }
     if failed {
         std::process::exit(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every problem of the suite at a tenth of its steps ends at a certified local minimum
+    /// at the default options (a plan is only returned certified, with no constraint
+    /// violated beyond the tolerance where it is imposed).
+    #[test]
+    fn the_suite_is_certified_at_a_tenth_of_its_steps() {
+        for suite in [cart_pole_suite, quadrotor_suite, parking_suite, chain_suite] {
+            if let Err(e) = suite(true) {
+                panic!("{e}");
+            }
+        }
     }
 }
