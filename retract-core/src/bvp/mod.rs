@@ -10,10 +10,10 @@
 //! whose multipliers are the momenta.
 //!
 //! - [`OptimalControlProblem`] minimises it (SQP with a Riccati KKT solve, inertia
-//!   correction, a line search on an exact penalty, stage equalities and interior-point
+//!   correction, IPOPT's filter line search, stage equalities and interior-point
 //!   inequalities) and returns only certified local minima ([`Plan`], [`Certificate`]); every
 //!   failure carries the last iterate ([`PlanError`]). Modules: `optimize` (the problem and its
-//!   results), `sqp` (the iteration), `riccati` (the KKT solve and its inertia),
+//!   results), `sqp` (the iteration; `sqp::line_search` its filter), `riccati` (the KKT solve and its inertia),
 //!   `constraints` and `barrier` (stage constraints), `certificate` (residuals, momenta,
 //!   curvature), `guess` (the spline guess), `curve` (guesses from a path $q(t)$,
 //!   [`Curve`]), `extrapolate` (Richardson extrapolation).
