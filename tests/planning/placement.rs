@@ -194,6 +194,62 @@ fn contradictions_are_refused_naming_the_constraint() {
     assert!((goal.violation - 0.5).abs() < 1e-12);
 }
 
+/// A solve that stalls at an infeasible point names the constraint violated most there:
+/// contradictory equalities (u0 = 1 and u0 = 2) at the first iteration, and a keep-out disc
+/// centred on the straight path of the guess (its centre a node of it: violated by r^2 there),
+/// with the last iterate attached.
+#[test]
+fn a_solve_stalled_at_an_infeasible_point_names_the_constraint() {
+    /// u0 - v.
+    #[jet_function(order = 2)]
+    fn forcing(_q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], v: f64) -> f64 {
+        ddq[0] - v
+    }
+    let stalled = |result: Result<Plan<2, 4>, retract::bvp::PlanError<2, 4>>| match result {
+        Err(e) => match e.failure {
+            Failure::StalledInfeasible(infeasibility) => {
+                let last = e.last.as_ref().expect("the last iterate");
+                assert!(
+                    last.certificate.feasibility >= infeasibility.violation,
+                    "{e}"
+                );
+                assert!(
+                    e.to_string().contains("stalled at an infeasible point"),
+                    "{e}"
+                );
+                infeasibility
+            }
+            other => panic!("not a stalled infeasibility: {other}"),
+        },
+        Ok(plan) => panic!("a plan of an infeasible problem: cost {}", plan.cost),
+    };
+    let system = PlanarEffort::new();
+    let (one, two) = (Forcing::new(1.0), Forcing::new(2.0));
+    let contradiction = stalled(
+        OptimalControlProblem::new(&system, &START, &GOAL, 4.0, 40)
+            .with_equality(&one)
+            .with_equality(&two)
+            .solve(PlanGuess::Spline),
+    );
+    assert_eq!(contradiction.constraint.kind, ConstraintKind::Equality);
+    assert!(contradiction.violation > 0.5, "{contradiction}");
+    let (radius, disc) = (0.5, Clearance::new(0.0, 0.0, 0.5));
+    for steps in [8, 40] {
+        let head_on = stalled(
+            OptimalControlProblem::new(&system, &START, &GOAL, 4.0, steps)
+                .with_inequality(&disc)
+                .solve(PlanGuess::Spline),
+        );
+        assert_eq!(head_on.constraint.kind, ConstraintKind::Inequality);
+        assert_eq!(head_on.constraint.index, 0);
+        assert_eq!(head_on.location, Location::Node(steps / 2), "N = {steps}");
+        assert!(
+            (head_on.violation - radius * radius).abs() < 1e-6,
+            "{head_on}"
+        );
+    }
+}
+
 /// `with_input_bounds` and `with_state_bounds` are the scalar bounds per component: the same
 /// plan, with the bounds active.
 #[test]

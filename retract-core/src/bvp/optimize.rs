@@ -367,6 +367,12 @@ pub enum Failure {
     /// its own data contradict themselves or leave no interior (equal sides: write an
     /// equality), or the fixed start or goal violates it at the node.
     Infeasible(Infeasibility),
+    /// The iteration stalled at a point that violates a constraint (the inertia correction or
+    /// the line search failed there): the constraint violated most at the last iterate, where,
+    /// and by how much. The constraints may contradict each other there (a point of local
+    /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
+    /// preferred.
+    StalledInfeasible(Infeasibility),
     /// The KKT conditions hold but the reduced Hessian has negative (or zero) curvature: a
     /// saddle, not a minimum.
     NotAMinimum {
@@ -419,6 +425,12 @@ impl core::fmt::Display for Failure {
                 "the inertia correction could not make the reduced Hessian positive definite"
             ),
             Failure::Infeasible(infeasibility) => write!(f, "infeasible: {infeasibility}"),
+            Failure::StalledInfeasible(infeasibility) => write!(
+                f,
+                "stalled at an infeasible point: {infeasibility}; check that the constraints \
+                 can hold together there, or start from a guess that satisfies them (around \
+                 an obstacle, not through it)"
+            ),
             Failure::NotAMinimum {
                 negative_directions: 0,
             } => write!(

@@ -548,8 +548,10 @@ where
             let sub = match self.subproblem(&models, &barrier, kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
-                    let unknown = super::optimize::unknown_certificate();
-                    return Err(fail(failure, &iterate, models.cost, unknown, vec![]));
+                    let mut partial = super::optimize::unknown_certificate();
+                    partial.feasibility = models.violation_max();
+                    let failure = self.name_infeasibility(failure, &iterate);
+                    return Err(fail(failure, &iterate, models.cost, partial, vec![]));
                 }
             };
             let Subproblem {
@@ -625,6 +627,7 @@ where
                     continue;
                 }
                 Err(failure) => {
+                    let failure = self.name_infeasibility(failure, &iterate);
                     return Err(fail(failure, &iterate, models.cost, certificate, momenta));
                 }
             };
@@ -642,6 +645,25 @@ where
             if alpha == 1.0 && rho == 0.0 && !stale && unconstrained && error <= CHORD_ERROR {
                 kept = Some((riccati, error));
             }
+        }
+    }
+
+    /// A failure of the inertia correction or the line search at an iterate that violates a
+    /// constraint beyond the tolerance, as [`Failure::StalledInfeasible`] naming the
+    /// constraint violated most (and where); any other failure as it is.
+    fn name_infeasibility(&self, failure: Failure, iterate: &Iterate<N, X>) -> Failure {
+        if !matches!(failure, Failure::Regularization | Failure::LineSearch) {
+            return failure;
+        }
+        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        match self.problem.violations(iterate, h, theta) {
+            (violations, Some(worst))
+                if violations.imposed().is_nan()
+                    || violations.imposed() > self.problem.options.tolerance =>
+            {
+                Failure::StalledInfeasible(worst)
+            }
+            _ => failure,
         }
     }
 
