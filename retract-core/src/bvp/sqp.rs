@@ -610,15 +610,8 @@ where
             }
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
-            let filter = filter.get_or_insert_with(|| Filter::new(models.violation_l1()));
-            let slacks = (&barrier, &ds[..]);
-            let searched = match self.filter_search(&iterate, &models, &direction, slacks, filter) {
-                Ok(Some(accepted)) => Ok(accepted),
-                Ok(None) => {
-                    self.penalty_search(&iterate, &models, &direction, slacks, &mut penalty)
-                }
-                Err(failure) => Err(failure),
-            };
+            let (slacks, globals) = ((&barrier, &ds[..]), (&mut filter, &mut penalty));
+            let searched = self.line_search(&iterate, &models, &direction, slacks, globals);
             let (next, alpha, at_rounding) = match searched {
                 Ok(accepted) => accepted,
                 Err(Failure::LineSearch) if stale => {

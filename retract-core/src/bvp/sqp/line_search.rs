@@ -186,13 +186,31 @@ where
         (trial, parts)
     }
 
+    /// The line search: [`Self::filter_search`] with `filter` (made at the first call from
+    /// the violation there), and where it finds no step [`Self::penalty_search`] with
+    /// `penalty`.
+    pub(super) fn line_search(
+        &self,
+        iterate: &Iterate<N, X>,
+        models: &Models<N, X>,
+        direction: &Direction<N, X>,
+        slacks: (&Barrier, &[f64]),
+        (filter, penalty): (&mut Option<Filter>, &mut f64),
+    ) -> Result<Accepted<N, X>, Failure> {
+        let filter = filter.get_or_insert_with(|| Filter::new(models.violation_l1()));
+        match self.filter_search(iterate, models, direction, slacks, filter)? {
+            Some(accepted) => Ok(accepted),
+            None => self.penalty_search(iterate, models, direction, slacks, penalty),
+        }
+    }
+
     /// The filter line search from the fraction-to-the-boundary step, halving: the accepted
     /// point, or `None` once the step length falls below IPOPT's $\alpha_{\min} =
     /// \gamma_\alpha \min(\gamma_\theta, \gamma_\varphi \theta / (-\nabla\varphi^T d), \delta
     /// \theta^{s_\theta} / (-\nabla\varphi^T d)^{s_\varphi})$ (or after
     /// [`crate::bvp::PlanOptions::max_backtracks`] halvings); [`Failure::TimeLimit`] if the
     /// budget runs out between trials.
-    pub(super) fn filter_search(
+    fn filter_search(
         &self,
         iterate: &Iterate<N, X>,
         models: &Models<N, X>,
@@ -252,7 +270,7 @@ where
     /// step): the accepted point, the step length and whether the decrease was at rounding
     /// level; [`Failure::LineSearch`] if no step is accepted, [`Failure::TimeLimit`] if the
     /// budget runs out between trials.
-    pub(super) fn penalty_search(
+    fn penalty_search(
         &self,
         iterate: &Iterate<N, X>,
         models: &Models<N, X>,
