@@ -310,12 +310,13 @@ fn an_active_state_bound_is_certified_at_theta_0_and_1() {
 }
 
 /// The constrained suite's cart-pole (C1 of `../shared/BENCHMARKS.md`: T = 2, |F| <= 12 and
-/// 10 at the midpoints, N = 200, the smoothstep guess) at the default options: certified, at
-/// the cost IPOPT reaches on the same transcription (CasADi 3.8.2, IPOPT 3.14.19, tol 1e-10:
-/// 34.13577956 and 37.6490895, whose bounds it relaxes by 1e-8 relative, so its costs are
-/// lower by about that), within 1.5 times its iterations (13 and 22). Before the curvature
-/// term of the merit penalty and the refinement near active bounds this stalled at
-/// stationarity 5e-4.
+/// 10, and T = 3, |F| <= 6, at the midpoints, N = 100 T, the smoothstep guess) at the default
+/// options: certified, at the cost IPOPT reaches on the same transcription (CasADi 3.8.2,
+/// IPOPT 3.14.19, tol 1e-10: 34.13577956, 37.6490895 and 22.45335986, whose bounds it relaxes
+/// by 1e-8 relative, so its costs are lower by about that), within 1.5 times its iterations
+/// (13, 22 and 55). Before the curvature term of the merit penalty and the refinement near
+/// active bounds this stalled at stationarity 5e-4; before the inertia correction shifted the
+/// slacks' Hessian too, T = 3 took 126 iterations.
 #[test]
 fn the_bounded_cart_pole_converges_at_the_default_options() {
     use super::cart_pole::{CartForce, CartPole, PoleTorque};
@@ -325,8 +326,14 @@ fn the_bounded_cart_pole_converges_at_the_default_options() {
     );
     let force = CartForce::new(1.0, 0.3, 0.5);
     let goal = [0.0, std::f64::consts::PI, 0.0, 0.0];
-    for (limit, ipopt_cost, ipopt_iterations) in [(12.0, 34.13577956, 13), (10.0, 37.6490895, 22)] {
-        let plan = OptimalControlProblem::new(&system, &[0.0; 4], &goal, 2.0, 200)
+    let cases = [
+        (2.0, 12.0, 34.13577956, 13),
+        (2.0, 10.0, 37.6490895, 22),
+        (3.0, 6.0, 22.45335986, 55),
+    ];
+    for (t_end, limit, ipopt_cost, ipopt_iterations) in cases {
+        let steps = (100.0 * t_end) as usize;
+        let plan = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, steps)
             .with_equality(&unactuated)
             .with_function_bounds(&force, -limit, limit)
             .solve(PlanGuess::Spline)

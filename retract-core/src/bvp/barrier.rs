@@ -14,7 +14,10 @@
 //! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
 //! \min(\mu / 5, \mu^{1.5}))$ in the transcribed problem's units (IPOPT's: its barrier term
-//! is $h \mu \sum \ln s$, so its parameter is $h \mu$).
+//! is $h \mu \sum \ln s$, so its parameter is $h \mu$). The first slacks are pushed into the
+//! interior as IPOPT's, the two sides of one interval sharing IPOPT's single slack
+//! ([`super::constraints::slack_push`]); the inertia correction shifts the eliminated slacks'
+//! Hessian too ([`Barrier::shift_slacks`]).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -44,16 +47,25 @@ pub(super) enum Slot {
 }
 
 impl Barrier {
-    /// Slacks $s = \max(g, 10^{-2})$ and multipliers $z = 1 / h$ at the first iterate (IPOPT's
-    /// `bound_push` and `bound_mult_init_val` 1 in the transcribed problem's units, where the
-    /// multiplier is $h z$), for `count` inequalities per step and `nodes` per interior node
-    /// over `steps` steps of length `h`.
+    /// Slacks $s = \min(\max(g, p_{\text{low}}), p_{\text{high}})$ with the clamps `push` of
+    /// [`super::constraints::slack_push`] (IPOPT's `bound_push`), and multipliers $z = 1 / h$
+    /// at the first iterate (IPOPT's `bound_mult_init_val` 1 in the transcribed problem's
+    /// units, where the multiplier is $h z$), for `count` inequalities per step and `nodes` per
+    /// interior node over `steps` steps of length `h`.
     pub fn new(
         (mu, h): (f64, f64),
         (count, nodes, steps): (usize, usize, usize),
         values: &[f64],
+        push: impl Fn(usize) -> (f64, f64),
     ) -> Self {
-        let s: Vec<f64> = values.iter().map(|g| g.max(1e-2)).collect();
+        let s: Vec<f64> = values
+            .iter()
+            .enumerate()
+            .map(|(k, g)| {
+                let (low, high) = push(k);
+                g.max(low).min(high)
+            })
+            .collect();
         Self {
             mu,
             z: vec![1.0 / h; s.len()],
@@ -202,6 +214,49 @@ impl Barrier {
             stage.hxx += c.gx * c.gx.transpose() * weight;
             stage.hux += c.gu * c.gx.transpose() * weight;
             stage.huu += c.gu * c.gu.transpose() * weight;
+        }
+    }
+
+    /// Adds the inertia correction `rho_h` of the eliminated slacks, $\rho_h \nabla g
+    /// \nabla g^T$ per inequality, to the stage and node Hessians (IPOPT corrects the
+    /// slacks' Hessian $\Sigma$ as every other variable's: eliminated, $\Sigma + \rho_h$
+    /// weighs $\nabla g \nabla g^T$).
+    pub fn shift_slacks<const N: usize, const X: usize>(
+        &self,
+        stages: &mut [StageModel<N, X>],
+        lin: &[Linearized<N, X>],
+        rho_h: f64,
+    ) {
+        if rho_h == 0.0 {
+            return;
+        }
+        for (k, c) in lin.iter().enumerate() {
+            self.add_outer(stages, k, c, rho_h);
+        }
+    }
+
+    /// Adds `weight` $\nabla g \nabla g^T$ of inequality `k` (linearised as `c`) to the
+    /// Hessian of its step's model, or of its node's terms.
+    pub fn add_outer<const N: usize, const X: usize>(
+        &self,
+        stages: &mut [StageModel<N, X>],
+        k: usize,
+        c: &Linearized<N, X>,
+        weight: f64,
+    ) {
+        match self.slot(k) {
+            Slot::Step(i) => {
+                let stage = &mut stages[i];
+                stage.hxx += c.gx * c.gx.transpose() * weight;
+                stage.hux += c.gu * c.gx.transpose() * weight;
+                stage.huu += c.gu * c.gu.transpose() * weight;
+            }
+            Slot::Node(i) => {
+                let node = stages[i]
+                    .node
+                    .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
+                node.0 += c.gx * c.gx.transpose() * weight;
+            }
         }
     }
 

@@ -222,6 +222,50 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
     }
 }
 
+/// IPOPT's push of the first slacks into the interior (`bound_push` = `bound_frac` =
+/// $\kappa = 10^{-2}$), per inequality of `list`: a side $\sigma(v - c) \ge 0$ alone starts
+/// at $s = \max(g, p)$ with $p = \kappa \max(1, |c|)$; the two sides of one interval
+/// $\ell \le v \le u$ share IPOPT's single slack $v_s \in [\ell + p_\ell, u - p_u]$,
+/// $p_\ell = \min(\kappa \max(1, |\ell|), \kappa (u - \ell))$ (and $p_u$ alike), so that each
+/// side's slack is $\min(\max(g, p_{\text{own}}), (u - \ell) - p_{\text{other}})$ and the two
+/// slacks sum to $u - \ell$ (a sum every Newton step keeps). Returned as the pair
+/// (lower clamp, upper clamp) of each entry.
+pub(super) fn slack_push<const N: usize, const K: usize>(
+    list: &[Inequality<'_, N, K>],
+) -> Vec<(f64, f64)> {
+    const KAPPA: f64 = 1e-2;
+    let alone = |c: &Inequality<'_, N, K>| KAPPA * c.value.abs().max(1.0);
+    list.iter()
+        .enumerate()
+        .map(|(j, c)| {
+            let partner = list.iter().enumerate().find(|(k, d)| {
+                *k != j && d.sign == -c.sign && d.index == c.index && same_origin(c, d)
+            });
+            match partner {
+                Some((_, d)) => {
+                    let width = c.sign * (d.value - c.value);
+                    let own = alone(c).min(KAPPA * width);
+                    let other = alone(d).min(KAPPA * width);
+                    (own, width - other)
+                }
+                None => (alone(c), f64::INFINITY),
+            }
+        })
+        .collect()
+}
+
+/// Whether two inequalities constrain the same value (one function or one variable).
+fn same_origin<const N: usize, const K: usize>(
+    a: &Inequality<'_, N, K>,
+    b: &Inequality<'_, N, K>,
+) -> bool {
+    match (a.source, b.source) {
+        (Source::Variable(x), Source::Variable(y)) => x == y,
+        (Source::Function(f), Source::Function(g)) => core::ptr::addr_eq(f, g),
+        _ => false,
+    }
+}
+
 fn read<const N: usize, const X: usize>(
     variable: Variable,
     x: &SVector<f64, X>,
@@ -260,4 +304,37 @@ pub(super) fn flat_hessian<const N: usize, const K: usize, const X: usize>(
         }
     }
     (hxx, hux, hs.uu * scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn side(value: f64, sign: f64, index: usize) -> Inequality<'static, 1, 2> {
+        Inequality {
+            source: Source::Variable(Variable::Top(0)),
+            value,
+            sign,
+            placement: Placement::Midpoints,
+            index,
+        }
+    }
+
+    /// The two sides of $-6 \le u \le 6$ share one slack: clamps $p = \min(0.06, 0.12)$ from
+    /// each end, so that the pushed slacks of any value sum to the width 12; a lone side
+    /// $u \ge 2$ is pushed to $0.02$ with no upper clamp.
+    #[test]
+    fn the_sides_of_an_interval_share_one_pushed_slack() {
+        let list = [side(-6.0, 1.0, 0), side(6.0, -1.0, 0), side(2.0, 1.0, 1)];
+        let push = slack_push(&list);
+        assert_eq!(push[0], (0.06, 12.0 - 0.06));
+        assert_eq!(push[1], (0.06, 12.0 - 0.06));
+        assert_eq!(push[2], (0.02, f64::INFINITY));
+        for u in [-9.0, -6.0, -5.99, 0.0, 5.97, 7.5] {
+            let lower = (u + 6.0_f64).max(push[0].0).min(push[0].1);
+            let upper = (6.0 - u).max(push[1].0).min(push[1].1);
+            assert!((lower + upper - 12.0).abs() < 1e-12, "u = {u}");
+            assert!(lower >= 0.06 && upper >= 0.06, "u = {u}");
+        }
+    }
 }

@@ -1,13 +1,14 @@
 //! The SQP iteration of [`super::OptimalControlProblem`]: stage models, the inertia-corrected
-//! Riccati solve, the convergence test and the line search on the exact penalty.
+//! Riccati solve, the convergence test and the second-order check; the filter line search in
+//! its own module (`line_search`).
 
 use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::barrier::{Barrier, Slot};
+use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
-use super::constraints::{Inequality, Linearized, flat_hessian};
+use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
 use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
@@ -346,16 +347,26 @@ where
     /// the reduced Hessian positive definite: none if the last iteration needed none (or
     /// little), else from a third of the `last` one (the correction decays geometrically
     /// instead of dropping to 0 at a point where the Hessian is barely definite), growing by 8
-    /// (100 from scratch) until the inertia is right. Fails with [`Failure::Regularization`]
+    /// (100 from scratch) until the inertia is right; with inequalities the correction shifts
+    /// the eliminated slacks' Hessian too, as IPOPT's ([`Barrier::shift_slacks`]: the stages
+    /// of `models` are left shifted by the correction found, for the solve that follows).
+    /// Fails with [`Failure::Regularization`]
     /// past $\rho = 10^{40}$, or [`Failure::TimeLimit`] when the budget runs out between
     /// factorisations.
     fn factor_corrected(
         &self,
-        models: &Models<N, X>,
+        models: &mut Models<N, X>,
+        barrier: &Barrier,
         last: f64,
     ) -> Result<(Riccati<N, X>, f64), Failure> {
         let h = self.dynamics.h;
-        let factor = |rho: f64| {
+        // (with inequalities the correction also shifts the eliminated slacks' Hessian)
+        let base = (!barrier.s.is_empty()).then(|| models.stages.clone());
+        let mut factor = |rho: f64| {
+            if let Some(base) = &base {
+                models.stages.clone_from_slice(base);
+                barrier.shift_slacks(&mut models.stages, &models.inequalities, rho);
+            }
             let (stages, end) = (&models.stages, &models.terminal);
             let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, self.deadline());
             if riccati.interrupted {
@@ -478,7 +489,16 @@ where
         } else {
             0.0
         };
-        Some(Barrier::new((mu, self.dynamics.h), layout, &values))
+        let (steps, nodes) = (slack_push(&self.at_steps), slack_push(&self.at_nodes));
+        let at_steps = layout.0 * layout.2;
+        let push = |k: usize| {
+            if k < at_steps {
+                steps[k % layout.0]
+            } else {
+                nodes[(k - at_steps) % layout.1]
+            }
+        };
+        Some(Barrier::new((mu, self.dynamics.h), layout, &values, push))
     }
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
@@ -526,7 +546,7 @@ where
                     return Ok(plan);
                 }
             }
-            let models = match self.models(&iterate, &y, &barrier) {
+            let mut models = match self.models(&iterate, &y, &barrier) {
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
                     let unknown = super::optimize::unknown_certificate();
@@ -545,7 +565,7 @@ where
                     });
                 }
             };
-            let sub = match self.subproblem(&models, &barrier, kept.take(), rho_last) {
+            let sub = match self.subproblem(&mut models, &barrier, kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
                     let mut partial = super::optimize::unknown_certificate();
@@ -611,8 +631,9 @@ where
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
             let (slacks, globals) = ((&barrier, &ds[..]), (&mut filter, &mut penalty));
-            let searched = self.line_search(&iterate, &models, &direction, slacks, globals);
-            let (next, alpha, at_rounding) = match searched {
+            let searched = (&iterate, &models, &direction);
+            let searched = self.line_search(searched, slacks, globals);
+            let accepted = match searched {
                 Ok(accepted) => accepted,
                 Err(Failure::LineSearch) if stale => {
                     // the simplified direction failed: solve this iterate's own subproblem
@@ -624,13 +645,9 @@ where
                     return Err(fail(failure, &iterate, models.cost, certificate, momenta));
                 }
             };
-            iterate = next;
-            barrier.update(&ds, alpha);
+            let state = (&mut iterate, &mut barrier, &mut y[..]);
+            let (alpha, at_rounding) = Self::advance(accepted, (&direction, &ds), state);
             stalled = if at_rounding { stalled + 1 } else { 0 };
-            // the equality multipliers move with the primal step
-            for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
-                *yi += (target - *yi) * alpha;
-            }
             // (worth trying when Newton's quadratic convergence will take the error from here
             // to below the tolerance)
             full_step = (alpha == 1.0 && error <= options.tolerance.sqrt()).then_some(direction);
@@ -669,66 +686,88 @@ where
     /// negative directions reported with it, 0, are those of the previous iterate.)
     fn subproblem(
         &self,
-        models: &Models<N, X>,
+        models: &mut Models<N, X>,
         barrier: &Barrier,
         kept: Option<(Riccati<N, X>, f64)>,
         rho_last: f64,
     ) -> Result<Subproblem<N, X>, Failure> {
-        // an active inequality's barrier Hessian h z/s grad g grad g^T this far above the rest
-        // costs the solve digits: refine it
-        let ill_conditioned = barrier
-            .z
-            .iter()
-            .zip(&barrier.s)
-            .any(|(z, s)| *z > REFINE_RATIO * s);
-        let solve = |riccati: Riccati<N, X>, rho: f64, stale: bool| {
-            let end = (&models.r_end, &models.terminal_gradient);
-            let rho_h = self.dynamics.h * rho;
-            let mut direction =
-                riccati.solve(&self.dynamics, &models.stages, rho_h, &models.r0, end);
-            if ill_conditioned {
-                let model = (&models.stages[..], &models.terminal);
-                for _ in 0..REFINEMENTS {
-                    refine(
-                        &riccati,
-                        &self.dynamics,
-                        model,
-                        rho_h,
-                        &models.r0,
-                        end,
-                        &mut direction,
-                    );
-                }
-            }
-            // the multipliers of the inequalities that go with the subproblem's solution: the
-            // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
-            // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
-            let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
-            let z = barrier.predicted(&ds);
-            let (momenta, certificate, _) =
-                self.residuals(models, barrier, riccati.negative, &direction, &z);
-            let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
-            let error = certificate.stationarity.max(certificate.feasibility);
-            Subproblem {
-                riccati,
-                rho,
-                stale,
-                direction,
-                momenta,
-                certificate,
-                error,
-                barrier_error,
-            }
-        };
         if let Some((riccati, e_prev)) = kept {
-            let sub = solve(riccati, 0.0, true);
+            let sub = self.solved((models, barrier), riccati, 0.0, true);
             let tolerance = self.problem.options.tolerance;
             if sub.error <= tolerance || sub.error * sub.error <= tolerance * e_prev {
                 return Ok(sub);
             }
         }
-        let (riccati, rho) = self.factor_corrected(models, rho_last)?;
-        Ok(solve(riccati, rho, false))
+        let (riccati, rho) = self.factor_corrected(models, barrier, rho_last)?;
+        Ok(self.solved((models, barrier), riccati, rho, false))
+    }
+
+    /// The subproblem solved with the factorisation `riccati` (inertia correction `rho`;
+    /// `stale` if it is the previous iterate's): its direction, the multipliers and residuals
+    /// that go with it, and the errors of the problem and of the barrier problem.
+    fn solved(
+        &self,
+        (models, barrier): (&Models<N, X>, &Barrier),
+        riccati: Riccati<N, X>,
+        rho: f64,
+        stale: bool,
+    ) -> Subproblem<N, X> {
+        let ends = (&models.r0, &models.r_end);
+        let direction = self.direction_with(&riccati, (models, &models.stages), rho, ends, barrier);
+        // the multipliers of the inequalities that go with the subproblem's solution: the
+        // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
+        // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
+        let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
+        let z = barrier.predicted(&ds);
+        let (momenta, certificate, _) =
+            self.residuals(models, barrier, riccati.negative, &direction, &z);
+        let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
+        let error = certificate.stationarity.max(certificate.feasibility);
+        Subproblem {
+            riccati,
+            rho,
+            stale,
+            direction,
+            momenta,
+            certificate,
+            error,
+            barrier_error,
+        }
+    }
+
+    /// The subproblem's solution with the factorisation `riccati` (inertia correction `rho`)
+    /// for the stage models `stages` (the models' own, or corrected ones), the models' end and
+    /// the boundary residuals `(r0, r_end)`; refined [`REFINEMENTS`] times where an active
+    /// inequality's barrier Hessian $h z / s \nabla g \nabla g^T$ is [`REFINE_RATIO`] above
+    /// the rest (it costs the solve digits).
+    fn direction_with(
+        &self,
+        riccati: &Riccati<N, X>,
+        (models, stages): (&Models<N, X>, &[StageModel<N, X>]),
+        rho: f64,
+        (r0, r_end): (&SVector<f64, X>, &SVector<f64, X>),
+        barrier: &Barrier,
+    ) -> Direction<N, X> {
+        let ill_conditioned =
+            (barrier.z.iter().zip(&barrier.s)).any(|(z, s)| *z > REFINE_RATIO * s);
+        let end = (r_end, &models.terminal_gradient);
+        let rho_h = self.dynamics.h * rho;
+        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end);
+        if ill_conditioned {
+            for _ in 0..REFINEMENTS {
+                let model = (stages, &models.terminal);
+                refine(
+                    riccati,
+                    &self.dynamics,
+                    model,
+                    rho_h,
+                    r0,
+                    end,
+                    &mut direction,
+                );
+            }
+        }
+        direction
     }
 
     /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
@@ -869,20 +908,7 @@ where
                 }
                 let sigma =
                     weight * scale / c.gx.norm_squared().max(c.gu.norm_squared()).max(1e-300);
-                match barrier.slot(k) {
-                    Slot::Step(i) => {
-                        let stage = &mut stages[i];
-                        stage.hxx += c.gx * c.gx.transpose() * sigma;
-                        stage.hux += c.gu * c.gx.transpose() * sigma;
-                        stage.huu += c.gu * c.gu.transpose() * sigma;
-                    }
-                    Slot::Node(i) => {
-                        let node = stages[i]
-                            .node
-                            .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
-                        node.0 += c.gx * c.gx.transpose() * sigma;
-                    }
-                }
+                barrier.add_outer(&mut stages, k, c, sigma);
             }
             let factor = Riccati::factor_with(&self.dynamics, &stages, 0.0, &models.terminal);
             let done = factor.positive_definite();

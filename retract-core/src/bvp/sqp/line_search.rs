@@ -11,6 +11,8 @@
 //! $((1 - \gamma_\theta) \theta, \varphi - \gamma_\varphi \theta)$. The filter is emptied when
 //! $\mu$ decreases.
 
+use nalgebra::SVector;
+
 use super::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::optimize::{Failure, Iterate, blocks};
@@ -68,7 +70,11 @@ impl Filter {
 
 /// An accepted trial point: the iterate, the step length and whether the decrease it was
 /// accepted on is at rounding level.
-pub(super) type Accepted<const N: usize, const X: usize> = (Iterate<N, X>, f64, bool);
+pub(super) struct Accepted<const N: usize, const X: usize> {
+    pub trial: Iterate<N, X>,
+    pub alpha: f64,
+    pub at_rounding: bool,
+}
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
@@ -186,19 +192,36 @@ where
         (trial, parts)
     }
 
+    /// Moves to the `accepted` point along `direction` with slack steps `ds`: the iterate;
+    /// the slacks and the multipliers $z$ by its step length; the stage equalities'
+    /// multipliers `y` toward the direction's by the same primal step length. Returns the
+    /// step length and whether the decrease was at rounding level.
+    pub(super) fn advance(
+        accepted: Accepted<N, X>,
+        (direction, ds): (&Direction<N, X>, &[f64]),
+        (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
+    ) -> (f64, bool) {
+        let alpha = accepted.alpha;
+        *iterate = accepted.trial;
+        barrier.update(ds, alpha);
+        for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
+            *yi += (target - *yi) * alpha;
+        }
+        (alpha, accepted.at_rounding)
+    }
+
     /// The line search: [`Self::filter_search`] with `filter` (made at the first call from
     /// the violation there), and where it finds no step [`Self::penalty_search`] with
     /// `penalty`.
     pub(super) fn line_search(
         &self,
-        iterate: &Iterate<N, X>,
-        models: &Models<N, X>,
-        direction: &Direction<N, X>,
+        (iterate, models, direction): (&Iterate<N, X>, &Models<N, X>, &Direction<N, X>),
         slacks: (&Barrier, &[f64]),
         (filter, penalty): (&mut Option<Filter>, &mut f64),
     ) -> Result<Accepted<N, X>, Failure> {
         let filter = filter.get_or_insert_with(|| Filter::new(models.violation_l1()));
-        match self.filter_search(iterate, models, direction, slacks, filter)? {
+        let searched = (iterate, models, direction);
+        match self.filter_search(searched, slacks, filter)? {
             Some(accepted) => Ok(accepted),
             None => self.penalty_search(iterate, models, direction, slacks, penalty),
         }
@@ -212,9 +235,7 @@ where
     /// budget runs out between trials.
     fn filter_search(
         &self,
-        iterate: &Iterate<N, X>,
-        models: &Models<N, X>,
-        direction: &Direction<N, X>,
+        (iterate, models, direction): (&Iterate<N, X>, &Models<N, X>, &Direction<N, X>),
         (barrier, ds): (&Barrier, &[f64]),
         filter: &mut Filter,
     ) -> Result<Option<Accepted<N, X>>, Failure> {
@@ -236,6 +257,24 @@ where
         } else {
             GAMMA_ALPHA * GAMMA_THETA
         };
+        // the filter's test of a trial point (phi_t, theta_t) at step length alpha
+        let mut accept = |phi_t: f64, theta_t: f64, alpha: f64| {
+            if filter.rejects(theta_t, phi_t) {
+                return false;
+            }
+            let switching =
+                slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
+            if theta <= filter.theta_min && switching {
+                phi_t <= phi + options.armijo * alpha * slope + noise
+            } else if theta_t <= (1.0 - GAMMA_THETA) * theta
+                || phi_t <= phi - GAMMA_PHI * theta + noise
+            {
+                filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
+                true
+            } else {
+                false
+            }
+        };
         let mut alpha = barrier.max_step(ds);
         for _ in 0..=options.max_backtracks {
             if alpha < alpha_min && !at_rounding {
@@ -245,21 +284,12 @@ where
                 return Err(Failure::TimeLimit);
             }
             let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
-            if let Some((phi_t, theta_t)) = parts
-                && !filter.rejects(theta_t, phi_t)
-            {
-                let switching =
-                    slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
-                if theta <= filter.theta_min && switching {
-                    if phi_t <= phi + options.armijo * alpha * slope + noise {
-                        return Ok(Some((trial, alpha, at_rounding)));
-                    }
-                } else if theta_t <= (1.0 - GAMMA_THETA) * theta
-                    || phi_t <= phi - GAMMA_PHI * theta + noise
-                {
-                    filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
-                    return Ok(Some((trial, alpha, at_rounding)));
-                }
+            if parts.is_some_and(|(phi_t, theta_t)| accept(phi_t, theta_t, alpha)) {
+                return Ok(Some(Accepted {
+                    trial,
+                    alpha,
+                    at_rounding,
+                }));
             }
             alpha *= 0.5;
         }
@@ -319,7 +349,11 @@ where
             if parts.is_some_and(|(cost, violation)| {
                 cost + *penalty * violation <= merit0 + options.armijo * alpha * descent + noise
             }) {
-                return Ok((trial, alpha, -descent <= noise));
+                return Ok(Accepted {
+                    trial,
+                    alpha,
+                    at_rounding: -descent <= noise,
+                });
             }
             alpha *= 0.5;
         }
