@@ -8,6 +8,53 @@ use syn::{Expr, Pat, Stmt};
 use super::{Binding, Lower, Output};
 use crate::signature::Attribute;
 
+/// The methods a generated Lagrangian's type already has, which an output of the same name
+/// would shadow (an inherent method wins over a trait's at a call `sys.name(..)`) or clash
+/// with: its constructor, those of the traits it implements (`Lagrangian`, `LiftedSystem`,
+/// `ReducedScheme`, `Separable`, the manifolds' `SphereSystem`, `So3System`, `Se3System`) and
+/// of its derives (`Clone`, `Debug`, `PartialEq`). Kept complete by a test that reads the
+/// traits' definitions.
+pub(crate) const RESERVED: &[&str] = &[
+    "new",
+    "clone",
+    "clone_from",
+    "fmt",
+    "eq",
+    "ne",
+    "gradient",
+    "hessian",
+    "lagrangian",
+    "momenta",
+    "top_derivative",
+    "check_domain",
+    "check_parameters",
+    "guards_quadratic",
+    "hamiltonian",
+    "jacobian",
+    "jacobian_initial",
+    "legendre",
+    "predictor",
+    "residual",
+    "state",
+    "step_cost",
+    "vector_field",
+    "closed_form_factors",
+    "core_offset",
+    "core_residual",
+    "core_system",
+    "forcing",
+    "forcing_jacobian",
+    "initial_part",
+    "linear_part",
+    "recover",
+    "recover_plain",
+    "kinetic_weight",
+    "chart",
+    "with_chart",
+    "centre",
+    "with_centre",
+];
+
 /// Whether a `let` is marked `#[output]`.
 pub(super) fn is_output(local: &syn::Local) -> bool {
     local.attrs.iter().any(|a| a.path().is_ident("output"))
@@ -77,6 +124,27 @@ impl Lower<'_> {
             // an error was reported where it was bound
             _ => return,
         };
+        if let Some(attr) = local.attrs.iter().find(|a| a.path().is_ident("output"))
+            && !matches!(attr.meta, syn::Meta::Path(_))
+        {
+            self.error(
+                attr.span(),
+                "`#[output]` takes no arguments: the method is named after the binding",
+            );
+            return;
+        }
+        let name = p.ident.to_string();
+        if RESERVED.contains(&name.as_str()) {
+            self.error(
+                p.ident.span(),
+                format!(
+                    "the output `{name}` would shadow the generated type's method `{name}`: \
+                     name it otherwise (reserved: {})",
+                    RESERVED.join(", ")
+                ),
+            );
+            return;
+        }
         if self.outputs.iter().any(|o| o.name == p.ident) {
             self.error(
                 p.ident.span(),
@@ -89,5 +157,44 @@ impl Lower<'_> {
             ids,
             array,
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RESERVED;
+
+    /// Every method of the traits a generated Lagrangian's type implements, read from their
+    /// definitions in retract-core, is reserved.
+    #[test]
+    fn every_trait_method_of_a_generated_type_is_reserved() {
+        let traits = [
+            ("system.rs", "Lagrangian"),
+            ("system.rs", "LiftedSystem"),
+            ("reduced.rs", "ReducedScheme"),
+            ("split.rs", "Separable"),
+            ("sphere.rs", "SphereSystem"),
+            ("so3/body.rs", "So3System"),
+            ("se3.rs", "Se3System"),
+        ];
+        let mut checked = 0;
+        for (file, name) in traits {
+            let path = format!("{}/../retract-core/src/{file}", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(&path).expect("retract-core's source");
+            let parsed = syn::parse_file(&text).expect("parses");
+            let item = parsed.items.iter().find_map(|item| match item {
+                syn::Item::Trait(t) if t.ident == name => Some(t),
+                _ => None,
+            });
+            let item = item.unwrap_or_else(|| panic!("trait {name} in {file}"));
+            for member in &item.items {
+                if let syn::TraitItem::Fn(f) = member {
+                    let method = f.sig.ident.to_string();
+                    assert!(RESERVED.contains(&method.as_str()), "{name}::{method}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 30, "{checked} methods");
     }
 }

@@ -31,4 +31,15 @@ fn on_sphere(q: [f64; 3], dq: [f64; 3], ddq: [f64; 3]) -> f64 {
     0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1] + ddq[2] * ddq[2]) + speed
 }
 
+#[higher_order_lagrangian(order = 2)]
+fn shadowing(q: [f64; 1], dq: [f64; 1], ddq: [f64; 1]) -> f64 {
+    #[output]
+    let lagrangian = q[0] + 100.0;
+    #[output]
+    let new = dq[0];
+    #[output(foo)]
+    let force = ddq[0];
+    0.5 * ddq[0] * ddq[0] + lagrangian + new + force
+}
+
 fn main() {}
