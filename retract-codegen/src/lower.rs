@@ -184,8 +184,11 @@ pub struct Lower<'a> {
     arrays: Vec<Vec<Id>>,
     /// The helper functions defined in the body, by name.
     helpers: HashMap<String, syn::ItemFn>,
-    /// Helper calls being inlined, innermost last (their count).
-    inlining: usize,
+    /// The helpers being inlined, innermost last.
+    inlining: Vec<String>,
+    /// Helper calls inlined so far (every call is inlined; capped by
+    /// `values::MAX_INLINED`), and whether the cap was reported.
+    inlined: (usize, bool),
     /// Names are looked up in `scopes[barrier..]` only: inside a helper, its own scopes.
     barrier: usize,
     /// The named outputs (`#[output] let`), in order.
@@ -232,7 +235,8 @@ impl<'a> Lower<'a> {
             too_long: false,
             arrays: Vec::new(),
             helpers: HashMap::new(),
-            inlining: 0,
+            inlining: Vec::new(),
+            inlined: (0, false),
             barrier: 0,
             outputs: Vec::new(),
             top_level: false,

@@ -17,8 +17,11 @@ use super::{Binding, Lower};
 use crate::graph::{Id, Var};
 use crate::signature::Kind;
 
-/// Helper calls nested deeper than this are an error (recursion is not supported).
+/// Helper calls nested deeper than this are an error.
 const MAX_INLINE_DEPTH: usize = 16;
+/// The most helper calls one expansion inlines (each call is inlined: helpers that call others
+/// several times multiply, e.g. nine deep, three calls each, are 19 683 inlinings).
+pub(super) const MAX_INLINED: usize = 4096;
 
 /// The value of an expression that may not be a number.
 pub(super) enum Value {
@@ -237,18 +240,45 @@ impl Lower<'_> {
         self.helpers.get(&name).cloned()
     }
 
+    /// Why a call of the helper `name` is not inlined, if it is not: `Some(message)` to
+    /// report (a call of a helper being inlined, i.e. recursion, with the chain of calls; nesting
+    /// deeper than [`MAX_INLINE_DEPTH`]; the first call past [`MAX_INLINED`]), `Some(None)`
+    /// past the cap once it was reported.
+    fn inline_refusal(&mut self, name: &str) -> Option<Option<String>> {
+        if let Some(first) = self.inlining.iter().position(|h| h == name) {
+            let chain = self.inlining[first..].join("` -> `");
+            return Some(Some(format!(
+                "`{name}` calls itself (`{chain}` -> `{name}`): recursion is not supported"
+            )));
+        }
+        if self.inlining.len() >= MAX_INLINE_DEPTH {
+            return Some(Some(format!(
+                "helper calls nest deeper than {MAX_INLINE_DEPTH} at `{name}`"
+            )));
+        }
+        if self.inlined.0 >= MAX_INLINED {
+            let first = !std::mem::replace(&mut self.inlined.1, true);
+            return Some(first.then(|| {
+                format!(
+                    "more than {MAX_INLINED} helper calls to inline at `{name}` (each call is \
+                     inlined, and helpers that call others several times multiply): compute a \
+                     repeated value once with `let`"
+                )
+            }));
+        }
+        None
+    }
+
     /// The call `c` of the helper `f`, inlined: its arguments bound to its parameters in a
     /// scope that sees nothing of the caller's, its statements lowered, its tail the value.
     pub(super) fn inline(&mut self, f: &syn::ItemFn, c: &syn::ExprCall) -> Value {
         let name = f.sig.ident.to_string();
-        if self.inlining >= MAX_INLINE_DEPTH {
-            return Value::Scalar(self.error(
-                c.span(),
-                format!(
-                    "helper calls nest deeper than {MAX_INLINE_DEPTH} at `{name}`: recursion is \
-                     not supported"
-                ),
-            ));
+        if let Some(message) = self.inline_refusal(&name) {
+            return Value::Scalar(match message {
+                Some(message) => self.error(c.span(), message),
+                // (reported once)
+                None => self.g.constant(0.0),
+            });
         }
         if f.sig.inputs.len() != c.args.len() {
             return Value::Scalar(self.error(
@@ -294,9 +324,10 @@ impl Lower<'_> {
         let barrier = std::mem::replace(&mut self.barrier, self.scopes.len());
         let top_level = std::mem::replace(&mut self.top_level, false);
         self.scopes.push(scope);
-        self.inlining += 1;
+        self.inlining.push(name);
+        self.inlined.0 += 1;
         let value = self.helper_body(f);
-        self.inlining -= 1;
+        self.inlining.pop();
         self.scopes.pop();
         self.barrier = barrier;
         self.top_level = top_level;
