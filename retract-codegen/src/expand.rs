@@ -241,6 +241,29 @@ mod tests {
         assert!(both.contains("norm") && both.contains("bar"), "{both}");
     }
 
+    /// Nesting past the limit is one error (not a deeper recursion); a sum of 400 terms, as
+    /// long as hand-written torques get, expands.
+    #[test]
+    fn deep_nesting_is_an_error_and_long_sums_expand() {
+        let expand = |body: String| {
+            pretty(
+                "order = 2",
+                &format!("fn l(q: [f64; 1], dq: [f64; 1], ddq: [f64; 1]) -> f64 {{ {body} }}"),
+            )
+        };
+        let chain = format!("ddq[0].powi(2) + q[0]{}", ".sin()".repeat(2000));
+        let message = expand(chain).unwrap_err();
+        assert_eq!(
+            message.matches("nest deeper than 512").count(),
+            1,
+            "{message}"
+        );
+        let sum = (0..400)
+            .map(|i| format!("{i}.0 * q[0].sin()"))
+            .collect::<Vec<_>>();
+        assert!(expand(format!("ddq[0].powi(2) + {}", sum.join(" + "))).is_ok());
+    }
+
     #[test]
     fn malformed_input_never_panics() {
         let cases = [

@@ -38,6 +38,9 @@ pub const METHODS: &str = "powi, powf, sqrt, exp, ln, sin, cos, tan, tanh, atan2
 
 /// Unrolled iterations allowed in one function (a guard against runaway expansion).
 const MAX_UNROLLED: usize = 10_000;
+/// The deepest nesting of expressions lowered (each operand, argument or receiver one level):
+/// far beyond hand-written formulas, short of what overflows the compiler's stack.
+const MAX_NESTING: usize = 512;
 
 #[derive(Clone, Copy, Debug)]
 enum Binding {
@@ -186,6 +189,9 @@ pub struct Lower<'a> {
     helpers: HashMap<String, syn::ItemFn>,
     /// The helpers being inlined, innermost last.
     inlining: Vec<String>,
+    /// The depth of expression nesting being lowered, and whether [`MAX_NESTING`] was
+    /// reported.
+    nesting: (usize, bool),
     /// Helper calls inlined so far (every call is inlined; capped by
     /// `values::MAX_INLINED`), and whether the cap was reported.
     inlined: (usize, bool),
@@ -237,6 +243,7 @@ impl<'a> Lower<'a> {
             helpers: HashMap::new(),
             inlining: Vec::new(),
             inlined: (0, false),
+            nesting: (0, false),
             barrier: 0,
             outputs: Vec::new(),
             top_level: false,
@@ -735,6 +742,37 @@ impl<'a> Lower<'a> {
 
     /// An f64 expression.
     pub fn expr(&mut self, e: &Expr) -> Id {
+        match self.enter(e) {
+            Some(refused) => refused,
+            None => {
+                let id = self.expr_inner(e);
+                self.nesting.0 -= 1;
+                id
+            }
+        }
+    }
+
+    /// Counts one more level of expression nesting before lowering `e`; past [`MAX_NESTING`]
+    /// refuses it (`Some`, with an error reported once per expansion) instead of recursing
+    /// further (deep nesting overflowed the compiler's stack).
+    fn enter(&mut self, e: &Expr) -> Option<Id> {
+        if self.nesting.0 >= MAX_NESTING {
+            if !std::mem::replace(&mut self.nesting.1, true) {
+                return Some(self.error(
+                    e.span(),
+                    format!(
+                        "expressions nest deeper than {MAX_NESTING} levels here: bind \
+                         intermediate values with `let`"
+                    ),
+                ));
+            }
+            return Some(self.g.constant(0.0));
+        }
+        self.nesting.0 += 1;
+        None
+    }
+
+    fn expr_inner(&mut self, e: &Expr) -> Id {
         match e {
             Expr::Lit(l) => match &l.lit {
                 Lit::Float(f) => match f.base10_parse::<f64>() {

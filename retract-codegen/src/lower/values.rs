@@ -101,6 +101,15 @@ impl Lower<'_> {
 
     /// The value of `e`: an array or tuple literal, a local array, a helper call, or a number.
     pub(super) fn value(&mut self, e: &Expr) -> Value {
+        if let Some(refused) = self.enter(e) {
+            return Value::Scalar(refused);
+        }
+        let value = self.value_inner(e);
+        self.nesting.0 -= 1;
+        value
+    }
+
+    fn value_inner(&mut self, e: &Expr) -> Value {
         match e {
             Expr::Array(a) => Value::Array(a.elems.iter().map(|x| self.expr(x)).collect()),
             Expr::Repeat(r) => {
