@@ -142,7 +142,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 continue;
             }
             for upper in list.iter().filter(|c| c.sign < 0.0) {
-                if !same_source(lower, upper) {
+                if !lower.same_source(upper) {
                     continue;
                 }
                 if lower.value >= upper.value {
@@ -202,22 +202,4 @@ fn definition(constraint: ConstraintRef, violation: f64) -> Infeasibility {
         location: Location::Definition,
         violation,
     }
-}
-
-/// Whether `lower` and `upper` bound the same value at a common place: the two sides of one
-/// constraint, or bounds of one variable.
-fn same_source<const N: usize, const K: usize>(
-    lower: &Inequality<'_, N, K>,
-    upper: &Inequality<'_, N, K>,
-) -> bool {
-    let overlap = (lower.placement.at_nodes() && upper.placement.at_nodes())
-        || (lower.placement.at_midpoints() && upper.placement.at_midpoints());
-    overlap
-        && match (lower.source, upper.source) {
-            (Source::Variable(a), Source::Variable(b)) => a == b,
-            (Source::Function(f), Source::Function(g)) => {
-                lower.index == upper.index && core::ptr::addr_eq(f, g)
-            }
-            _ => false,
-        }
 }

@@ -209,6 +209,21 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         }
     }
 
+    /// Whether `self` and `other` bound the same value at a common place: the two sides of
+    /// one constraint, or bounds of one variable.
+    pub fn same_source(&self, other: &Self) -> bool {
+        let overlap = (self.placement.at_nodes() && other.placement.at_nodes())
+            || (self.placement.at_midpoints() && other.placement.at_midpoints());
+        overlap
+            && match (self.source, other.source) {
+                (Source::Variable(a), Source::Variable(b)) => a == b,
+                (Source::Function(f), Source::Function(g)) => {
+                    self.index == other.index && core::ptr::addr_eq(f, g)
+                }
+                _ => false,
+            }
+    }
+
     /// Whether the constraint is well formed for jets of length `X`: a value that is not NaN
     /// (an infinite one is refused as a contradiction), a variable in range, and no node
     /// placement for what involves $u$.
@@ -239,7 +254,7 @@ pub(super) fn slack_push<const N: usize, const K: usize>(
         .enumerate()
         .map(|(j, c)| {
             let partner = list.iter().enumerate().find(|(k, d)| {
-                *k != j && d.sign == -c.sign && d.index == c.index && same_origin(c, d)
+                *k != j && d.sign == -c.sign && d.index == c.index && c.same_source(d)
             });
             match partner {
                 Some((_, d)) => {
@@ -252,18 +267,6 @@ pub(super) fn slack_push<const N: usize, const K: usize>(
             }
         })
         .collect()
-}
-
-/// Whether two inequalities constrain the same value (one function or one variable).
-fn same_origin<const N: usize, const K: usize>(
-    a: &Inequality<'_, N, K>,
-    b: &Inequality<'_, N, K>,
-) -> bool {
-    match (a.source, b.source) {
-        (Source::Variable(x), Source::Variable(y)) => x == y,
-        (Source::Function(f), Source::Function(g)) => core::ptr::addr_eq(f, g),
-        _ => false,
-    }
 }
 
 fn read<const N: usize, const X: usize>(

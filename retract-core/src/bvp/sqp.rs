@@ -360,10 +360,12 @@ where
         last: f64,
     ) -> Result<(Riccati<N, X>, f64), Failure> {
         let h = self.dynamics.h;
-        // (with inequalities the correction also shifts the eliminated slacks' Hessian)
-        let base = (!barrier.s.is_empty()).then(|| models.stages.clone());
+        // (with inequalities a correction also shifts the eliminated slacks' Hessian: the
+        // unshifted stages are kept from the first correction on, to shift each trial afresh)
+        let mut base: Option<Vec<StageModel<N, X>>> = None;
         let mut factor = |rho: f64| {
-            if let Some(base) = &base {
+            if rho > 0.0 && !barrier.s.is_empty() {
+                let base = base.get_or_insert_with(|| models.stages.clone());
                 models.stages.clone_from_slice(base);
                 barrier.shift_slacks(&mut models.stages, &models.inequalities, rho);
             }
@@ -703,8 +705,10 @@ where
     }
 
     /// The subproblem solved with the factorisation `riccati` (inertia correction `rho`;
-    /// `stale` if it is the previous iterate's): its direction, the multipliers and residuals
-    /// that go with it, and the errors of the problem and of the barrier problem.
+    /// `stale` if it is the previous iterate's): its direction (refined [`REFINEMENTS`] times
+    /// where an active inequality's barrier Hessian $h z / s \nabla g \nabla g^T$ is
+    /// [`REFINE_RATIO`] above the rest: it costs the solve digits), the multipliers and
+    /// residuals that go with it, and the errors of the problem and of the barrier problem.
     fn solved(
         &self,
         (models, barrier): (&Models<N, X>, &Barrier),
@@ -712,8 +716,25 @@ where
         rho: f64,
         stale: bool,
     ) -> Subproblem<N, X> {
-        let ends = (&models.r0, &models.r_end);
-        let direction = self.direction_with(&riccati, (models, &models.stages), rho, ends, barrier);
+        let ill_conditioned =
+            (barrier.z.iter().zip(&barrier.s)).any(|(z, s)| *z > REFINE_RATIO * s);
+        let (r0, end) = (&models.r0, (&models.r_end, &models.terminal_gradient));
+        let rho_h = self.dynamics.h * rho;
+        let mut direction = riccati.solve(&self.dynamics, &models.stages, rho_h, r0, end);
+        if ill_conditioned {
+            let model = (&models.stages[..], &models.terminal);
+            for _ in 0..REFINEMENTS {
+                refine(
+                    &riccati,
+                    &self.dynamics,
+                    model,
+                    rho_h,
+                    r0,
+                    end,
+                    &mut direction,
+                );
+            }
+        }
         // the multipliers of the inequalities that go with the subproblem's solution: the
         // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
         // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
@@ -733,41 +754,6 @@ where
             error,
             barrier_error,
         }
-    }
-
-    /// The subproblem's solution with the factorisation `riccati` (inertia correction `rho`)
-    /// for the stage models `stages` (the models' own, or corrected ones), the models' end and
-    /// the boundary residuals `(r0, r_end)`; refined [`REFINEMENTS`] times where an active
-    /// inequality's barrier Hessian $h z / s \nabla g \nabla g^T$ is [`REFINE_RATIO`] above
-    /// the rest (it costs the solve digits).
-    fn direction_with(
-        &self,
-        riccati: &Riccati<N, X>,
-        (models, stages): (&Models<N, X>, &[StageModel<N, X>]),
-        rho: f64,
-        (r0, r_end): (&SVector<f64, X>, &SVector<f64, X>),
-        barrier: &Barrier,
-    ) -> Direction<N, X> {
-        let ill_conditioned =
-            (barrier.z.iter().zip(&barrier.s)).any(|(z, s)| *z > REFINE_RATIO * s);
-        let end = (r_end, &models.terminal_gradient);
-        let rho_h = self.dynamics.h * rho;
-        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end);
-        if ill_conditioned {
-            for _ in 0..REFINEMENTS {
-                let model = (stages, &models.terminal);
-                refine(
-                    riccati,
-                    &self.dynamics,
-                    model,
-                    rho_h,
-                    r0,
-                    end,
-                    &mut direction,
-                );
-            }
-        }
-        direction
     }
 
     /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s

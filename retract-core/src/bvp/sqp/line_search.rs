@@ -257,24 +257,6 @@ where
         } else {
             GAMMA_ALPHA * GAMMA_THETA
         };
-        // the filter's test of a trial point (phi_t, theta_t) at step length alpha
-        let mut accept = |phi_t: f64, theta_t: f64, alpha: f64| {
-            if filter.rejects(theta_t, phi_t) {
-                return false;
-            }
-            let switching =
-                slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
-            if theta <= filter.theta_min && switching {
-                phi_t <= phi + options.armijo * alpha * slope + noise
-            } else if theta_t <= (1.0 - GAMMA_THETA) * theta
-                || phi_t <= phi - GAMMA_PHI * theta + noise
-            {
-                filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
-                true
-            } else {
-                false
-            }
-        };
         let mut alpha = barrier.max_step(ds);
         for _ in 0..=options.max_backtracks {
             if alpha < alpha_min && !at_rounding {
@@ -284,12 +266,26 @@ where
                 return Err(Failure::TimeLimit);
             }
             let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
-            if parts.is_some_and(|(phi_t, theta_t)| accept(phi_t, theta_t, alpha)) {
-                return Ok(Some(Accepted {
+            if let Some((phi_t, theta_t)) = parts
+                && !filter.rejects(theta_t, phi_t)
+            {
+                let accepted = Accepted {
                     trial,
                     alpha,
                     at_rounding,
-                }));
+                };
+                let switching =
+                    slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
+                if theta <= filter.theta_min && switching {
+                    if phi_t <= phi + options.armijo * alpha * slope + noise {
+                        return Ok(Some(accepted));
+                    }
+                } else if theta_t <= (1.0 - GAMMA_THETA) * theta
+                    || phi_t <= phi - GAMMA_PHI * theta + noise
+                {
+                    filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
+                    return Ok(Some(accepted));
+                }
             }
             alpha *= 0.5;
         }
