@@ -43,6 +43,7 @@ fn hand_plan<const N: usize, const X: usize>(h: f64, x: Vec<SVector<f64, X>>) ->
             min_reduced_hessian_eig: f64::NAN,
         },
         violations: Default::default(),
+        duals: Default::default(),
     }
 }
 

@@ -24,6 +24,9 @@ use nalgebra::{SMatrix, SVector};
 use super::constraints::Linearized;
 use super::riccati::{Direction, StageModel};
 
+/// The smallest slack of a warm start ([`Barrier::warm`]).
+pub(super) const WARM_SLACK_PUSH: f64 = 1e-3;
+
 /// Barrier parameter, slacks and multipliers: `count` per step (step-major), then `nodes`
 /// per interior node $x_1, \dots, x_{N-1}$ (node-major).
 pub(super) struct Barrier {
@@ -70,6 +73,35 @@ impl Barrier {
             mu,
             z: vec![1.0 / h; s.len()],
             s,
+            count,
+            nodes,
+            steps,
+        }
+    }
+
+    /// The barrier of a primal-dual warm start from `duals` (which fit the layout `(count,
+    /// nodes, steps)`): their multipliers, their slacks raised to at least
+    /// [`WARM_SLACK_PUSH`] (IPOPT's `warm_start_bound_push`: a slack at the rounding of an
+    /// active constraint would cap every step that moves it at the fraction to the
+    /// boundary), and their barrier parameter, at least `floor`: a plan's is at its floor, so
+    /// the barrier is not restarted from $\mu_0$ (which would first undo the plan's
+    /// complementarity), and an unfinished plan's (a real-time iteration's) goes on from
+    /// where it was.
+    pub fn warm<const N: usize>(
+        duals: &super::duals::Duals<N>,
+        (count, nodes, steps): (usize, usize, usize),
+        floor: f64,
+    ) -> Self {
+        let s = (duals.step_slacks.iter().chain(&duals.node_slacks))
+            .map(|s| s.max(WARM_SLACK_PUSH))
+            .collect();
+        let z = (duals.step_multipliers.iter().chain(&duals.node_multipliers))
+            .copied()
+            .collect();
+        Self {
+            mu: duals.barrier.max(floor),
+            s,
+            z,
             count,
             nodes,
             steps,

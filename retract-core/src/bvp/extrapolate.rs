@@ -334,6 +334,7 @@ mod tests {
             iterations: 0,
             certificate: super::super::optimize::unknown_certificate(),
             violations: Default::default(),
+            duals: Default::default(),
         };
         assert!(Extrapolated::from_plans([plan(3), plan(6), plan(12)]).is_ok());
         let error = Extrapolated::from_plans([plan(3), plan(6), plan(11)]).unwrap_err();

@@ -76,6 +76,7 @@ mod certificate;
 mod constrain;
 mod constraints;
 mod curve;
+mod duals;
 mod extrapolate;
 mod guess;
 mod optimize;
@@ -86,6 +87,7 @@ mod violations;
 
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
+pub use duals::Duals;
 pub use extrapolate::Extrapolated;
 pub use optimize::{
     Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions, RealTime,

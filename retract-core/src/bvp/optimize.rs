@@ -31,6 +31,7 @@ use nalgebra::SVector;
 
 use super::constraints::{Inequality, Placement};
 use super::curve::Curve;
+use super::duals::Duals;
 use super::guess::Hermite;
 use super::riccati::Dynamics;
 use super::sqp::Sqp;
@@ -143,7 +144,9 @@ pub enum PlanGuess<'a, const N: usize, const X: usize> {
     /// the smoothstep $q_0 + (q_T - q_0)(3s^2 - 2s^3)$), $u$ its $k$-th derivative at the
     /// evaluation points.
     Spline,
-    /// A previous plan with the same number of steps (warm start).
+    /// A previous plan with the same number of steps (warm start): its jets and top
+    /// derivatives, and its [`Duals`] where they fit the problem's inequalities (else the
+    /// barrier starts afresh).
     Plan(&'a Plan<N, X>),
     /// Jets $x_0, \dots, x_N$ and top derivatives $u_0, \dots, u_{N-1}$ chosen by the caller.
     Path {
@@ -225,6 +228,10 @@ pub struct Plan<const N: usize, const X: usize> {
     /// interpolant ([`Violations`]).
     #[cfg_attr(feature = "serde", serde(default))]
     pub violations: Violations,
+    /// The multipliers, slacks and barrier parameter at this point: a warm start from this
+    /// plan ([`PlanGuess::Plan`]) starts from them too.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub duals: Duals<N>,
 }
 
 impl<const N: usize, const X: usize> Plan<N, X> {
@@ -308,8 +315,8 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     /// The plan shifted one step forward in time, for a receding-horizon warm start
     /// ([`PlanGuess::Plan`]): $x_i \leftarrow x_{i+1}$, $u_i \leftarrow u_{i+1}$, the last
     /// top derivative repeated and the new last jet one step of the scheme's $x$-equations
-    /// from the old end with it. The momenta are shifted alike (the last one repeated); the
-    /// certificate is that of the unshifted plan.
+    /// from the old end with it. The momenta and the duals are shifted alike (the last ones
+    /// repeated); the certificate is that of the unshifted plan.
     pub fn shifted(&self) -> Self {
         let mut out = self.clone();
         let (Some(&last_x), Some(&last_u)) = (self.x.last(), self.u.last()) else {
@@ -324,6 +331,7 @@ impl<const N: usize, const X: usize> Plan<N, X> {
             out.momenta.remove(0);
             out.momenta.push(last_p);
         }
+        out.duals = self.duals.shifted(self.u.len());
         out
     }
 }
@@ -801,6 +809,10 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
+        let warm = match guess {
+            PlanGuess::Plan(plan) => Some(&plan.duals),
+            _ => None,
+        };
         let iterate = self.initial(guess).map_err(invalid)?;
         self.check_terminal_cost(&iterate).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
@@ -826,7 +838,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 placed(Placement::at_nodes)
             },
         }
-        .run(iterate)
+        .run(iterate, warm)
     }
 
     /// Real-time iteration for receding horizons (as acados' RTI): at most `iterations` SQP

@@ -9,6 +9,7 @@ use nalgebra::{SMatrix, SVector};
 use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
+use super::duals::Duals;
 use super::optimize::{
     Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
 };
@@ -455,15 +456,27 @@ where
         (momenta, certificate, scale)
     }
 
+    /// The plan at the point `state` (iterate, stage-equality multipliers, barrier).
     fn plan(
         &self,
-        iterate: &Iterate<N, X>,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         cost: f64,
         iterations: usize,
         momenta: Vec<SVector<f64, X>>,
         certificate: Certificate,
     ) -> Plan<N, X> {
+        let (iterate, y, barrier) = state;
         let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        let (step_slacks, node_slacks) = barrier.s.split_at(barrier.at_steps());
+        let (step_multipliers, node_multipliers) = barrier.z.split_at(barrier.at_steps());
+        let duals = Duals {
+            equalities: y.to_vec(),
+            step_slacks: step_slacks.to_vec(),
+            step_multipliers: step_multipliers.to_vec(),
+            node_slacks: node_slacks.to_vec(),
+            node_multipliers: node_multipliers.to_vec(),
+            barrier: barrier.mu,
+        };
         Plan {
             h,
             theta,
@@ -474,18 +487,25 @@ where
             iterations,
             certificate,
             violations: self.problem.violations(iterate, h, theta).0,
+            duals,
         }
     }
 
-    /// The barrier at the first iterate ([`Barrier::new`] with $\mu = \mu_0 / h$ per unit time,
-    /// $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without inequalities);
-    /// `None` if an inequality is not finite there.
-    fn initial_barrier(&self, iterate: &Iterate<N, X>) -> Option<Barrier> {
+    /// The barrier at the first iterate: from the `warm` start's duals if they fit the
+    /// problem's inequalities ([`Barrier::warm`]), else [`Barrier::new`] with $\mu = \mu_0 / h$
+    /// per unit time, $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without
+    /// inequalities; `None` if an inequality is not finite there.
+    fn initial_barrier(&self, iterate: &Iterate<N, X>, warm: Option<&Duals<N>>) -> Option<Barrier> {
         let values: Vec<f64> = self.inequalities(iterate).iter().map(|c| c.value).collect();
         if !values.iter().all(|v| v.is_finite()) {
             return None;
         }
         let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
+        let fits = |d: &&Duals<N>| d.fit(layout.2, layout.0, layout.1);
+        if let Some(duals) = warm.filter(fits).filter(|_| layout.0 + layout.1 > 0) {
+            let floor = barrier_floor(self.problem.options.tolerance);
+            return Some(Barrier::warm(duals, layout, floor));
+        }
         let mu = if layout.0 + layout.1 > 0 {
             self.problem.options.initial_barrier / self.dynamics.h
         } else {
@@ -512,17 +532,24 @@ where
     /// its own subproblem. Without stage constraints, a full step from an error below
     /// `CHORD_ERROR` keeps its factorisation for the next iterate's subproblem (a simplified
     /// Newton step, [`Self::subproblem`]); a point is never certified with a kept one.
-    pub fn run(&self, mut iterate: Iterate<N, X>) -> Result<Plan<N, X>, PlanError<N, X>> {
+    pub fn run(
+        &self,
+        mut iterate: Iterate<N, X>,
+        warm: Option<&Duals<N>>,
+    ) -> Result<Plan<N, X>, PlanError<N, X>> {
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
         let count = self.at_steps.len() + self.at_nodes.len();
-        let mut barrier = self.initial_barrier(&iterate).ok_or(PlanError {
+        let mut barrier = self.initial_barrier(&iterate, warm).ok_or(PlanError {
             failure: Failure::NonFinite,
             last: None,
         })?;
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        let mut y = vec![SVector::<f64, N>::zeros(); iterate.u.len()];
+        let mut y = match warm {
+            Some(duals) if duals.equalities.len() == iterate.u.len() => duals.equalities.clone(),
+            _ => vec![SVector::<f64, N>::zeros(); iterate.u.len()],
+        };
         let mut full_step: Option<Direction<N, X>> = None;
         let mut kept: Option<(Riccati<N, X>, f64)> = None;
         let mut filter: Option<Filter> = None;
@@ -530,15 +557,9 @@ where
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
-            let fail = |failure, iterate: &Iterate<N, X>, cost, certificate, momenta| PlanError {
+            let fail = |failure, state, cost, certificate, momenta| PlanError {
                 failure,
-                last: Some(Box::new(self.plan(
-                    iterate,
-                    cost,
-                    done,
-                    momenta,
-                    certificate,
-                ))),
+                last: Some(Box::new(self.plan(state, cost, done, momenta, certificate))),
             };
             // after a full step the last subproblem's multipliers are the Newton estimates
             // here: if they already certify this point, no subproblem is solved at it
@@ -554,7 +575,7 @@ where
                     let unknown = super::optimize::unknown_certificate();
                     return Err(fail(
                         Failure::TimeLimit,
-                        &iterate,
+                        (&iterate, &y, &barrier),
                         f64::NAN,
                         unknown,
                         vec![],
@@ -573,7 +594,13 @@ where
                     let mut partial = super::optimize::unknown_certificate();
                     partial.feasibility = models.violation_max();
                     let failure = self.name_infeasibility(failure, &iterate);
-                    return Err(fail(failure, &iterate, models.cost, partial, vec![]));
+                    return Err(fail(
+                        failure,
+                        (&iterate, &y, &barrier),
+                        models.cost,
+                        partial,
+                        vec![],
+                    ));
                 }
             };
             let Subproblem {
@@ -607,8 +634,13 @@ where
                 );
                 match certified {
                     Ok(certificate) => {
-                        let plan =
-                            self.plan(&iterate, models.cost, iterations, momenta, certificate);
+                        let plan = self.plan(
+                            (&iterate, &y, &barrier),
+                            models.cost,
+                            iterations,
+                            momenta,
+                            certificate,
+                        );
                         // (no plan with a constraint violated beyond the tolerance where it is
                         // imposed: iterate on)
                         if plan.violations.imposed() <= options.tolerance {
@@ -617,7 +649,13 @@ where
                         momenta = plan.momenta;
                     }
                     Err((failure, certificate)) => {
-                        return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                        return Err(fail(
+                            failure,
+                            (&iterate, &y, &barrier),
+                            models.cost,
+                            certificate,
+                            momenta,
+                        ));
                     }
                 }
             }
@@ -628,7 +666,13 @@ where
                 } else {
                     Failure::IterationLimit
                 };
-                return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                return Err(fail(
+                    failure,
+                    (&iterate, &y, &barrier),
+                    models.cost,
+                    certificate,
+                    momenta,
+                ));
             }
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
@@ -644,7 +688,13 @@ where
                 }
                 Err(failure) => {
                     let failure = self.name_infeasibility(failure, &iterate);
-                    return Err(fail(failure, &iterate, models.cost, certificate, momenta));
+                    return Err(fail(
+                        failure,
+                        (&iterate, &y, &barrier),
+                        models.cost,
+                        certificate,
+                        momenta,
+                    ));
                 }
             };
             let state = (&mut iterate, &mut barrier, &mut y[..]);
@@ -812,7 +862,7 @@ where
             return None;
         }
         let certificate = self.certify(state, &models, None, certificate).ok()?;
-        let plan = self.plan(iterate, models.cost, iterations, momenta, certificate);
+        let plan = self.plan(state, models.cost, iterations, momenta, certificate);
         (plan.violations.imposed() <= options.tolerance).then_some(plan)
     }
 
