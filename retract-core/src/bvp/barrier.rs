@@ -7,7 +7,9 @@
 //! satisfy the inequalities. With multipliers $z \approx \mu / s$ and the residual
 //! $r = g - s$, eliminating $\delta s = \nabla g^T \delta y + r$ and $\delta z$ from the
 //! primal-dual Newton system leaves, per constraint, the gradient
-//! $-h \nabla g\thinspace(\mu/s - (z/s)\thinspace r)$ and the Hessian $h (z/s) \nabla g \nabla g^T - h z \nabla^2 g$
+//! $-h \nabla g\thinspace(\mu/s - (z/s)\thinspace r)$ and the Hessian $h (z/s) \nabla g \nabla g^T - h y \nabla^2 g$
+//! ($y$ the multipliers of $g - s = 0$, which follow $z$ with the primal step: IPOPT's
+//! $y_d$)
 //! added to the model of $h L$ of its step (in $(x_\theta, u)$) or of its node (in $x_i$);
 //! then $\delta z = (\mu - z s - z\thinspace\delta s)/s$. The slacks
 //! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$
@@ -33,6 +35,12 @@ pub(super) struct Barrier {
     pub mu: f64,
     pub s: Vec<f64>,
     pub z: Vec<f64>,
+    /// The multipliers $y$ of $g - s = 0$ (per unit time, as `z`), which weigh the
+    /// constraints' curvature $-h y \nabla^2 g$ in the Hessian of the Lagrangian (IPOPT's
+    /// $y_d$): they take the primal step towards $z + \delta z$, while `z` takes its own
+    /// (a violated constraint's $z$ grows as $\mu / s$ while its slack collapses; $y$ stays
+    /// with the step). Equal to $z$ at a solution.
+    pub y: Vec<f64>,
     /// Inequalities per step.
     pub count: usize,
     /// Inequalities per interior node.
@@ -72,6 +80,7 @@ impl Barrier {
         Self {
             mu,
             z: vec![1.0 / h; s.len()],
+            y: vec![1.0 / h; s.len()],
             s,
             count,
             nodes,
@@ -95,12 +104,13 @@ impl Barrier {
         let s = (duals.step_slacks.iter().chain(&duals.node_slacks))
             .map(|s| s.max(WARM_SLACK_PUSH))
             .collect();
-        let z = (duals.step_multipliers.iter().chain(&duals.node_multipliers))
+        let z: Vec<f64> = (duals.step_multipliers.iter().chain(&duals.node_multipliers))
             .copied()
             .collect();
         Self {
             mu: duals.barrier.max(floor),
             s,
+            y: z.clone(),
             z,
             count,
             nodes,
@@ -403,10 +413,14 @@ impl Barrier {
             .fold(0.0, |m, (c, s)| m.max((c.value - s).abs()))
     }
 
-    /// Takes the step: slacks by `alpha` along `ds`, multipliers by their own length.
+    /// Takes the step: slacks by `alpha` along `ds`, the multipliers $z$ by their own
+    /// length, the multipliers $y$ by `alpha` towards $z + \delta z$.
     pub fn update(&mut self, ds: &[f64], alpha: f64) {
         let dz = self.dual_steps(ds);
         let alpha_z = self.dual_step_length(&dz);
+        for ((y, z), dzk) in self.y.iter_mut().zip(&self.z).zip(&dz) {
+            *y += alpha * (z + dzk - *y);
+        }
         for (((z, s), d), dzk) in self.z.iter_mut().zip(self.s.iter_mut()).zip(ds).zip(&dz) {
             *s += alpha * d;
             *z = (*z + alpha_z * dzk).clamp(self.mu / (1e10 * *s), 1e10 * self.mu / *s);
@@ -417,5 +431,29 @@ impl Barrier {
     /// parameter $h \mu$: $\mu \leftarrow \max(\mu_{\min}, \min(\mu / 5, (h \mu)^{1.5} / h))$.
     pub fn decrease(&mut self, floor: f64, h: f64) {
         self.mu = (self.mu / 5.0).min((h * self.mu).powf(1.5) / h).max(floor);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A half step ($\alpha = 1/2$): the slack moves by half its step, $z$ by its own length
+    /// (here the whole Newton step), and the curvature multiplier $y$ by half the way from
+    /// its value to the Newton value $z + \delta z$.
+    #[test]
+    fn the_curvature_multiplier_follows_the_primal_step() {
+        let mut barrier = Barrier::new((0.1, 1.0), (1, 0, 1), &[0.5], |_| (0.01, f64::INFINITY));
+        barrier.y = vec![3.0];
+        let (s, z) = (barrier.s[0], barrier.z[0]);
+        let ds = -0.45;
+        let dz = (barrier.mu - z * s - z * ds) / s;
+        let alpha = 0.5;
+        barrier.update(&[ds], alpha);
+        let expected_y = 3.0 + alpha * (z + dz - 3.0);
+        assert!((barrier.y[0] - expected_y).abs() <= 1e-14 * expected_y.abs());
+        assert!((barrier.s[0] - (s + alpha * ds)).abs() <= 1e-15);
+        // z grows here (dz > 0): the full step, clipped only by the safeguard
+        assert!(dz > 0.0 && (barrier.z[0] - (z + dz)).abs() <= 1e-14 * (z + dz));
     }
 }

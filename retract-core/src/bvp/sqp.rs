@@ -134,7 +134,8 @@ where
         iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
     }
 
-    /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h z^T g^{\ge}$,
+    /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h y_g^T g^{\ge}$
+    /// ($y_g$: the multipliers of $g - s = 0$, [`Barrier::y`]),
     /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
     /// own terms are added by [`Barrier::add_to_stage`]).
     #[inline(always)]
@@ -181,8 +182,8 @@ where
             }
         }
         for (j, c) in self.at_steps.iter().enumerate() {
-            let z = barrier.z[i * barrier.count + j];
-            if let Some((cxx, cux, cuu)) = c.weighted_hessian(&xt, u, -h * z) {
+            let y = barrier.y[i * barrier.count + j];
+            if let Some((cxx, cux, cuu)) = c.weighted_hessian(&xt, u, -h * y) {
                 hxx += cxx;
                 hux += cux;
                 huu += cuu;
@@ -193,7 +194,7 @@ where
         stage
     }
 
-    /// The curvature $-h z \nabla^2 g$ of the inequalities at node `i` (interior nodes
+    /// The curvature $-h y \nabla^2 g$ of the inequalities at node `i` (interior nodes
     /// only), as node terms with a zero gradient; `None` where there are none.
     fn node_curvature(
         &self,
@@ -207,8 +208,8 @@ where
         let (h, zero) = (self.dynamics.h, SVector::<f64, N>::zeros());
         let mut hessian = SMatrix::<f64, X, X>::zeros();
         for (j, c) in self.at_nodes.iter().enumerate() {
-            let z = barrier.z[barrier.node_index(i, j)];
-            if let Some((cxx, _, _)) = c.weighted_hessian(&iterate.x[i], &zero, -h * z) {
+            let y = barrier.y[barrier.node_index(i, j)];
+            if let Some((cxx, _, _)) = c.weighted_hessian(&iterate.x[i], &zero, -h * y) {
                 hessian += cxx;
             }
         }
