@@ -114,3 +114,21 @@ fn bad_ends_are_invalid() {
         .unwrap_err();
     assert!(matches!(error.failure, Failure::Invalid(_)), "{error}");
 }
+
+/// Every end component free: the straight lines q = a + b t cost nothing, so the minimum is
+/// flat along them (a singular reduced Hessian without negative directions). It is certified
+/// as a minimum, not a strict one (smallest eigenvalue 0), not refused as a saddle.
+#[test]
+fn a_problem_flat_along_its_free_ends_is_a_minimum() {
+    for steps in [2, 3, 20] {
+        let plan = OptimalControlProblem::new(&Effort, &[0.0, 0.0], &[1.0, 0.0], 1.0, steps)
+            .with_free_end(&[0, 1])
+            .with_free_start(&[0, 1])
+            .solve(PlanGuess::Spline)
+            .unwrap_or_else(|e| panic!("N = {steps}: {e}"));
+        assert!(plan.cost.abs() < 1e-20, "N = {steps}: J = {}", plan.cost);
+        let c = &plan.certificate;
+        assert_eq!(c.negative_directions, 0);
+        assert_eq!(c.min_reduced_hessian_eig, 0.0, "N = {steps}");
+    }
+}

@@ -181,7 +181,10 @@ pub struct Certificate {
     /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
     /// u_{N-1})$; positive for a strict local minimum. With inequalities, the active ones
     /// enter as the penalties of the second-order check (a lower bound on the value on their
-    /// null space too). NaN if [`PlanOptions::min_eigenvalue`] is off or the end $x_N$ has free
+    /// null space too). Exactly 0 where the reduced Hessian is positive semidefinite and
+    /// singular: a minimum, but not a strict one (the cost is flat to second order along
+    /// some direction, e.g. ends that nothing fixes).
+    /// NaN if [`PlanOptions::min_eigenvalue`] is off or the end $x_N$ has free
     /// components (the inertia count proves positivity either way).
     /// With `serde`, NaN is written as "none" (JSON `null`) and read back as NaN.
     #[cfg_attr(feature = "serde", serde(with = "nan_as_none"))]
@@ -381,8 +384,11 @@ pub enum Failure {
     /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
     /// preferred.
     StalledInfeasible(Infeasibility),
-    /// The KKT conditions hold but the reduced Hessian has negative (or zero) curvature: a
-    /// saddle, not a minimum.
+    /// The KKT conditions hold but the reduced Hessian has negative curvature: a saddle, not
+    /// a minimum. (With 0 negative directions: the second-order check could not be made,
+    /// the stage constraints being dependent at the point. A reduced Hessian that is only
+    /// singular, positive semidefinite, is a minimum flat along some direction: certified
+    /// with [`Certificate::min_reduced_hessian_eig`] 0.)
     NotAMinimum {
         /// Negative eigenvalues of the reduced Hessian.
         negative_directions: usize,
@@ -443,9 +449,9 @@ impl core::fmt::Display for Failure {
                 negative_directions: 0,
             } => write!(
                 f,
-                "the KKT point found is not a strict minimum: its reduced Hessian is singular \
-                 (a direction of zero curvature, or constraints dependent there); fix the \
-                 free directions (e.g. an end) or start from another guess"
+                "the second-order check failed at the KKT point found: the stage \
+                 constraints are dependent there; remove the redundant ones or start from \
+                 another guess"
             ),
             Failure::NotAMinimum {
                 negative_directions,

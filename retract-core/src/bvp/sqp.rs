@@ -44,6 +44,11 @@ const REFINEMENTS: usize = 2;
 /// $|\nabla g|^2$), tried in turn.
 const FINSLER_WEIGHTS: [f64; 3] = [1e2, 1e4, 1e6];
 
+/// The shift of the stage Hessians, relative to their largest entry, under which a singular
+/// reduced Hessian without negative directions counts as positive semidefinite
+/// ([`Sqp::shifted_factor`]): a few hundred roundings of the largest entry.
+const SEMIDEFINITE_SHIFT: f64 = 1e-13;
+
 /// One run of the SQP iteration.
 pub(super) struct Sqp<
     'p,
@@ -888,10 +893,10 @@ where
         factored: Option<&Riccati<N, X>>,
         mut certificate: Certificate,
     ) -> Result<Certificate, (Failure, Certificate)> {
-        let (iterate, y, barrier) = state;
+        let barrier = state.2;
         let refactored;
         let exact = if !barrier.s.is_empty() {
-            refactored = self.penalized_factor(iterate, y, barrier, models);
+            refactored = self.penalized_factor(state, models, 0.0);
             &refactored
         } else if let Some(riccati) = factored {
             riccati
@@ -902,8 +907,17 @@ where
         };
         certificate.negative_directions = exact.negative;
         if !exact.positive_definite() {
+            // singular without a negative pivot: semidefinite if a shift of the rounding's
+            // size makes it definite (a minimum, flat along some direction: not strict)
+            let shifted = (exact.negative == 0).then(|| self.shifted_factor(state, models));
+            if shifted.as_ref().is_some_and(|f| f.positive_definite()) {
+                certificate.min_reduced_hessian_eig = 0.0;
+                return Ok(certificate);
+            }
+            let negative = shifted.map_or(exact.negative, |f| f.negative);
+            certificate.negative_directions = negative;
             let failure = Failure::NotAMinimum {
-                negative_directions: exact.negative,
+                negative_directions: negative,
             };
             return Err((failure, certificate));
         }
@@ -915,25 +929,45 @@ where
         Ok(certificate)
     }
 
-    /// The factorisation of the Lagrangian's stage models (no barrier terms) with the active
-    /// inequalities as penalties, for the first weight of [`FINSLER_WEIGHTS`] that makes it
-    /// positive definite (else the last one's).
-    fn penalized_factor(
+    /// The factorisation of the second-order check ([`Self::certify`]) with every stage
+    /// Hessian shifted by [`SEMIDEFINITE_SHIFT`] times the largest entry of the Lagrangian's
+    /// stage Hessians ($h$ at least): positive definite where the reduced Hessian is
+    /// positive semidefinite and singular, with the negative directions counted where it is
+    /// not.
+    fn shifted_factor(
         &self,
-        iterate: &Iterate<N, X>,
-        y: &[SVector<f64, N>],
-        barrier: &Barrier,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         models: &Models<N, X>,
     ) -> Riccati<N, X> {
-        let h = self.dynamics.h;
+        if !state.2.s.is_empty() {
+            return self.penalized_factor(state, models, SEMIDEFINITE_SHIFT);
+        }
+        let shift = SEMIDEFINITE_SHIFT * self.hessian_scale(&models.stages);
+        Riccati::factor_with(&self.dynamics, &models.stages, shift, &models.terminal)
+    }
+
+    /// The largest entry of the stage Hessians $H_{xx}$, $H_{uu}$, and $h$ at least.
+    fn hessian_scale(&self, stages: &[StageModel<N, X>]) -> f64 {
+        stages.iter().fold(self.dynamics.h, |m, s| {
+            m.max(crate::newton::max_abs(&s.hxx))
+                .max(crate::newton::max_abs(&s.huu))
+        })
+    }
+
+    /// The factorisation of the Lagrangian's stage models (no barrier terms) with the active
+    /// inequalities as penalties, for the first weight of [`FINSLER_WEIGHTS`] that makes it
+    /// positive definite (else the last one's); every stage Hessian shifted by `shift` times
+    /// their scale ([`Self::hessian_scale`]).
+    fn penalized_factor(
+        &self,
+        (iterate, y, barrier): (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        models: &Models<N, X>,
+        shift: f64,
+    ) -> Riccati<N, X> {
         let base: Vec<StageModel<N, X>> = (0..iterate.u.len())
             .map(|i| self.stage(iterate, i, &y[i], barrier))
             .collect();
-        let largest = base.iter().fold(0.0_f64, |m, s| {
-            m.max(crate::newton::max_abs(&s.hxx))
-                .max(crate::newton::max_abs(&s.huu))
-        });
-        let scale = largest.max(h);
+        let scale = self.hessian_scale(&base);
         let lin = &models.inequalities;
         let mut stages = base.clone();
         let mut riccati = None;
@@ -947,14 +981,16 @@ where
                     weight * scale / c.gx.norm_squared().max(c.gu.norm_squared()).max(1e-300);
                 barrier.add_outer(&mut stages, k, c, sigma);
             }
-            let factor = Riccati::factor_with(&self.dynamics, &stages, 0.0, &models.terminal);
+            let factor =
+                Riccati::factor_with(&self.dynamics, &stages, shift * scale, &models.terminal);
             let done = factor.positive_definite();
             riccati = Some(factor);
             if done {
                 break;
             }
         }
-        riccati
-            .unwrap_or_else(|| Riccati::factor_with(&self.dynamics, &base, 0.0, &models.terminal))
+        riccati.unwrap_or_else(|| {
+            Riccati::factor_with(&self.dynamics, &base, shift * scale, &models.terminal)
+        })
     }
 }
