@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
-use super::optimize::{Failure, OptimalControlProblem, Plan, PlanError, PlanGuess};
+use super::optimize::{OptimalControlProblem, PlanGuess};
+use super::plan::{Failure, Plan, PlanError};
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// A plan extrapolated to $h \to 0$ from the plans with $N$, $2N$ and $4N$ steps
@@ -332,7 +333,7 @@ mod tests {
             momenta: vec![SVector::zeros(); steps + 1],
             cost: 0.0,
             iterations: 0,
-            certificate: super::super::optimize::unknown_certificate(),
+            certificate: super::super::plan::unknown_certificate(),
             violations: Default::default(),
             duals: Default::default(),
         };

@@ -13,7 +13,8 @@
 //!   correction, IPOPT's filter line search, stage equalities and interior-point
 //!   inequalities) and returns only certified local minima ([`Plan`], [`Certificate`]); every
 //!   failure carries the last iterate ([`PlanError`]). Modules: `optimize` (the problem and its
-//!   results), `sqp` (the iteration; `sqp::line_search` its filter), `riccati` (the KKT solve and its inertia),
+//!   solve), `plan` (the results: plan, certificate, failures), `duals` (a plan's
+//!   multipliers, for warm starts), `sqp` (the iteration; `sqp::line_search` its filter), `riccati` (the KKT solve and its inertia),
 //!   `constraints` and `barrier` (stage constraints), `certificate` (residuals, momenta,
 //!   curvature), `guess` (the spline guess), `curve` (guesses from a path $q(t)$,
 //!   [`Curve`]), `extrapolate` (Richardson extrapolation).
@@ -80,6 +81,7 @@ mod duals;
 mod extrapolate;
 mod guess;
 mod optimize;
+mod plan;
 mod refine;
 mod riccati;
 mod sqp;
@@ -89,9 +91,8 @@ pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use duals::Duals;
 pub use extrapolate::Extrapolated;
-pub use optimize::{
-    Certificate, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions, RealTime,
-};
+pub use optimize::{OptimalControlProblem, PlanGuess, PlanOptions};
+pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 
 mod root_finder;

@@ -10,9 +10,8 @@ use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
 use super::duals::Duals;
-use super::optimize::{
-    Certificate, Failure, Iterate, OptimalControlProblem, Plan, PlanError, blocks,
-};
+use super::optimize::{Iterate, OptimalControlProblem, blocks};
+use super::plan::{Certificate, Failure, Plan, PlanError};
 use super::refine::refine;
 use super::riccati::{Direction, Dynamics, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
 use crate::newton::all_finite;
@@ -578,7 +577,7 @@ where
             let mut models = match self.models(&iterate, &y, &barrier) {
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
-                    let unknown = super::optimize::unknown_certificate();
+                    let unknown = super::plan::unknown_certificate();
                     return Err(fail(
                         Failure::TimeLimit,
                         (&iterate, &y, &barrier),
@@ -597,7 +596,7 @@ where
             let sub = match self.subproblem(&mut models, &barrier, kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
-                    let mut partial = super::optimize::unknown_certificate();
+                    let mut partial = super::plan::unknown_certificate();
                     partial.feasibility = models.violation_max();
                     let failure = self.name_infeasibility(failure, &iterate);
                     return Err(fail(

@@ -15,7 +15,8 @@ use nalgebra::SVector;
 
 use super::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
-use crate::bvp::optimize::{Failure, Iterate, blocks};
+use crate::bvp::optimize::{Iterate, blocks};
+use crate::bvp::plan::Failure;
 use crate::bvp::riccati::Direction;
 use crate::{Lagrangian, LiftedSystem};
 
