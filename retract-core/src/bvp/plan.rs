@@ -313,6 +313,16 @@ impl core::fmt::Display for Failure {
     }
 }
 
+impl<const N: usize, const X: usize> PlanError<N, X> {
+    /// A failure before the first iterate was formed.
+    pub(super) fn without_iterate(failure: Failure) -> Self {
+        Self {
+            failure,
+            last: None,
+        }
+    }
+}
+
 impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(f, "{}", self.failure)?;

@@ -545,16 +545,15 @@ where
         let options = &self.problem.options;
         let theta = self.dynamics.theta;
         let count = self.at_steps.len() + self.at_nodes.len();
-        let mut barrier = self.initial_barrier(&iterate, warm).ok_or(PlanError {
-            failure: Failure::NonFinite,
-            last: None,
-        })?;
+        let mut barrier = (self.initial_barrier(&iterate, warm))
+            .ok_or(PlanError::without_iterate(Failure::NonFinite))?;
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        let mut y = match warm {
-            Some(duals) if duals.equalities.len() == iterate.u.len() => duals.equalities.clone(),
-            _ => vec![SVector::<f64, N>::zeros(); iterate.u.len()],
-        };
+        // (the stage equalities' multipliers: a warm start's, else 0)
+        let mut y = warm
+            .map(|duals| duals.equalities.clone())
+            .filter(|y| y.len() == iterate.u.len())
+            .unwrap_or_else(|| vec![SVector::zeros(); iterate.u.len()]);
         let mut full_step: Option<Direction<N, X>> = None;
         let mut kept: Option<(Riccati<N, X>, f64)> = None;
         let mut filter: Option<Filter> = None;
@@ -562,9 +561,15 @@ where
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
-            let fail = |failure, state, cost, certificate, momenta| PlanError {
+            let fail = |failure, cost, certificate, momenta| PlanError {
                 failure,
-                last: Some(Box::new(self.plan(state, cost, done, momenta, certificate))),
+                last: Some(Box::new(self.plan(
+                    (&iterate, &y, &barrier),
+                    cost,
+                    done,
+                    momenta,
+                    certificate,
+                ))),
             };
             // after a full step the last subproblem's multipliers are the Newton estimates
             // here: if they already certify this point, no subproblem is solved at it
@@ -578,20 +583,9 @@ where
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
                     let unknown = super::plan::unknown_certificate();
-                    return Err(fail(
-                        Failure::TimeLimit,
-                        (&iterate, &y, &barrier),
-                        f64::NAN,
-                        unknown,
-                        vec![],
-                    ));
+                    return Err(fail(Failure::TimeLimit, f64::NAN, unknown, vec![]));
                 }
-                Err(failure) => {
-                    return Err(PlanError {
-                        failure,
-                        last: None,
-                    });
-                }
+                Err(failure) => return Err(PlanError::without_iterate(failure)),
             };
             let sub = match self.subproblem(&mut models, &barrier, kept.take(), rho_last) {
                 Ok(sub) => sub,
@@ -599,13 +593,7 @@ where
                     let mut partial = super::plan::unknown_certificate();
                     partial.feasibility = models.violation_max();
                     let failure = self.name_infeasibility(failure, &iterate);
-                    return Err(fail(
-                        failure,
-                        (&iterate, &y, &barrier),
-                        models.cost,
-                        partial,
-                        vec![],
-                    ));
+                    return Err(fail(failure, models.cost, partial, vec![]));
                 }
             };
             let Subproblem {
@@ -654,13 +642,7 @@ where
                         momenta = plan.momenta;
                     }
                     Err((failure, certificate)) => {
-                        return Err(fail(
-                            failure,
-                            (&iterate, &y, &barrier),
-                            models.cost,
-                            certificate,
-                            momenta,
-                        ));
+                        return Err(fail(failure, models.cost, certificate, momenta));
                     }
                 }
             }
@@ -671,13 +653,7 @@ where
                 } else {
                     Failure::IterationLimit
                 };
-                return Err(fail(
-                    failure,
-                    (&iterate, &y, &barrier),
-                    models.cost,
-                    certificate,
-                    momenta,
-                ));
+                return Err(fail(failure, models.cost, certificate, momenta));
             }
             iterations += 1;
             let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
@@ -693,13 +669,7 @@ where
                 }
                 Err(failure) => {
                     let failure = self.name_infeasibility(failure, &iterate);
-                    return Err(fail(
-                        failure,
-                        (&iterate, &y, &barrier),
-                        models.cost,
-                        certificate,
-                        momenta,
-                    ));
+                    return Err(fail(failure, models.cost, certificate, momenta));
                 }
             };
             let state = (&mut iterate, &mut barrier, &mut y[..]);
