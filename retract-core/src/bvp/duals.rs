@@ -52,20 +52,19 @@ impl<const N: usize> Duals<N> {
             .all(|v| positive(v))
     }
 
-    /// The duals one step later ([`super::Plan::shifted`]) of a plan of `steps` steps: every
-    /// step's and every interior node's block moved one forward, the last one repeated.
-    pub(super) fn shifted(&self, steps: usize) -> Self {
-        let mut out = self.clone();
+    /// Shifts these duals of a plan of `steps` steps one step later, in place
+    /// ([`super::Plan::shifted`]): every step's and every interior node's block moved one
+    /// forward, the last one repeated.
+    pub(super) fn shift(&mut self, steps: usize) {
         let (per_step, per_node) = (
             self.step_slacks.len() / steps.max(1),
             self.node_slacks.len() / steps.saturating_sub(1).max(1),
         );
-        shift_blocks(&mut out.equalities, 1);
-        shift_blocks(&mut out.step_slacks, per_step);
-        shift_blocks(&mut out.step_multipliers, per_step);
-        shift_blocks(&mut out.node_slacks, per_node);
-        shift_blocks(&mut out.node_multipliers, per_node);
-        out
+        shift_blocks(&mut self.equalities, 1);
+        shift_blocks(&mut self.step_slacks, per_step);
+        shift_blocks(&mut self.step_multipliers, per_step);
+        shift_blocks(&mut self.node_slacks, per_node);
+        shift_blocks(&mut self.node_multipliers, per_node);
     }
 }
 
@@ -99,7 +98,8 @@ mod tests {
         };
         assert!(duals.fit(3, 1, 2));
         assert!(!duals.fit(3, 2, 1));
-        let shifted = duals.shifted(3);
+        let mut shifted = duals.clone();
+        shifted.shift(3);
         let first: Vec<f64> = shifted.equalities.iter().map(|y| y[0]).collect();
         assert_eq!(first, vec![2.0, 3.0, 3.0]);
         assert_eq!(shifted.step_slacks, vec![2.0, 3.0, 3.0]);

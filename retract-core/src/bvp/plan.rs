@@ -183,7 +183,7 @@ impl<const N: usize, const X: usize> Plan<N, X> {
             out.momenta.remove(0);
             out.momenta.push(last_p);
         }
-        out.duals = self.duals.shifted(self.u.len());
+        out.duals.shift(self.u.len());
         out
     }
 }

@@ -506,8 +506,8 @@ where
             return None;
         }
         let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
-        let fits = |d: &&Duals<N>| d.fit(layout.2, layout.0, layout.1);
-        if let Some(duals) = warm.filter(fits).filter(|_| layout.0 + layout.1 > 0) {
+        let fits = |d: &&Duals<N>| layout.0 + layout.1 > 0 && d.fit(layout.2, layout.0, layout.1);
+        if let Some(duals) = warm.filter(fits) {
             let floor = barrier_floor(self.problem.options.tolerance);
             return Some(Barrier::warm(duals, layout, floor));
         }
