@@ -46,19 +46,16 @@ fn lateral(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64) -> f64 {
     m * ddq[0] * q[2].cos() + (m * ddq[1] + m * 9.81) * q[2].sin()
 }
 
-/// A rotor's thrust, `side` -1 for f1 and +1 for f2.
+/// The rotor thrusts (f1, f2) = Th/2 -+ tq/(2a): one function with two components, each
+/// bounded to [0, fmax].
 #[jet_function(order = 2)]
-fn rotor(
-    q: [f64; 3],
-    _dq: [f64; 3],
-    ddq: [f64; 3],
-    m: f64,
-    inertia: f64,
-    arm: f64,
-    side: f64,
-) -> f64 {
+fn rotors(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> [f64; 2] {
     let thrust = -m * ddq[0] * q[2].sin() + (m * ddq[1] + m * 9.81) * q[2].cos();
-    0.5 * thrust + side * inertia * ddq[2] / (2.0 * arm)
+    let torque = inertia * ddq[2];
+    [
+        0.5 * thrust - torque / (2.0 * arm),
+        0.5 * thrust + torque / (2.0 * arm),
+    ]
 }
 
 /// Clearance of the disc of radius 0.3 about (1, 0.5): (x - 1)^2 + (z - 0.5)^2 - 0.3^2.
@@ -192,10 +189,7 @@ fn quadrotor_suite(quick: bool) -> Outcome {
     let (m, inertia, arm) = (1.0, 0.01, 0.1);
     let system = Quadrotor::new(m, inertia, arm);
     let no_lateral = Lateral::new(m);
-    let (f1, f2) = (
-        Rotor::new(m, inertia, arm, -1.0),
-        Rotor::new(m, inertia, arm, 1.0),
-    );
+    let thrusts = Rotors::new(m, inertia, arm);
     let disc = Clearance::new();
     for fmax in [15.0, 6.0] {
         let name = format!("quadrotor-f{fmax}");
@@ -208,8 +202,7 @@ fn quadrotor_suite(quick: bool) -> Outcome {
             steps(2.0, quick),
         )
         .with_equality(&no_lateral)
-        .with_function_bounds(&f1, 0.0, fmax)
-        .with_function_bounds(&f2, 0.0, fmax)
+        .with_vector_bounds(&thrusts, &[0.0; 2], &[fmax; 2])
         .with_inequality(&disc)
         .solve(PlanGuess::Spline);
         outcome = outcome.and(report(&name, start, result));

@@ -320,6 +320,43 @@ impl<'a> Lower<'a> {
         }
     }
 
+    /// The whole body of a jet function returning `[f64; m]`: statements, then the tail, an
+    /// array of `m` numbers (a literal, a local array or a helper's result); `m` placeholders
+    /// where it is in error (the errors are in `self.errors`).
+    pub fn vector_body(&mut self, block: &Block, m: usize) -> Vec<Id> {
+        let Some((last, init)) = block.stmts.split_last() else {
+            let msg = format!("the body is empty: return an array of {m} f64 expressions");
+            return vec![self.error(block.span(), msg); m];
+        };
+        self.statements(init);
+        let tail = match last {
+            Stmt::Expr(Expr::Return(r), _) => r.expr.as_deref(),
+            Stmt::Expr(e, None) => Some(e),
+            _ => None,
+        };
+        let Some(tail) = tail else {
+            let msg = format!(
+                "the body must end with the function's value, an array of {m} f64 expressions \
+                 (without `;`)"
+            );
+            return vec![self.error(last.span(), msg); m];
+        };
+        match self.value(tail) {
+            values::Value::Array(ids) if ids.len() == m => ids,
+            values::Value::Array(ids) => {
+                let msg = format!(
+                    "the value has {} components, but the return type `[f64; {m}]` has {m}",
+                    ids.len()
+                );
+                vec![self.error(tail.span(), msg); m]
+            }
+            _ => {
+                let msg = format!("the value must be an array of {m} f64 expressions");
+                vec![self.error(tail.span(), msg); m]
+            }
+        }
+    }
+
     /// Statements before the tail expression of a body (for a body whose tail is not one
     /// value: the points of a discretization map).
     pub fn statements(&mut self, stmts: &[Stmt]) {

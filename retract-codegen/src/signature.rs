@@ -116,6 +116,9 @@ pub struct Signature {
     pub space: Space,
     /// The attribute that is expanded.
     pub attribute: Attribute,
+    /// The number m of components of a jet function returning `[f64; m]`; `None` for a
+    /// scalar (every Lagrangian, and a jet function returning `f64`).
+    pub components: Option<usize>,
 }
 
 /// The configuration space of a Lagrangian or jet function.
@@ -366,6 +369,17 @@ fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
     match &sig.output {
         _ if errors.attribute == Attribute::Map => {}
         ReturnType::Type(_, ty) if kind_of(ty) == Some(Kind::Scalar) => {}
+        ReturnType::Type(_, ty) if errors.attribute == Attribute::JetFunction => {
+            if vector_components(&sig.output).is_none() {
+                errors.fail(
+                    ty.span(),
+                    format!(
+                        "a jet function returns `f64` or `[f64; m]` with 1 <= m <= \
+                         {MAX_COMPONENTS} (one bound per component)"
+                    ),
+                );
+            }
+        }
         ReturnType::Type(_, ty) => errors.fail(
             ty.span(),
             "a Lagrangian returns a scalar: the return type must be `f64`".into(),
@@ -374,6 +388,20 @@ fn check_qualifiers(sig: &syn::Signature, errors: &mut Errors) {
             sig.ident.span(),
             "a Lagrangian returns a scalar: add `-> f64`".into(),
         ),
+    }
+}
+
+/// The most components of a jet function returning `[f64; m]`.
+pub const MAX_COMPONENTS: usize = 64;
+
+/// The length m of a `-> [f64; m]` return type, 1 <= m <= [`MAX_COMPONENTS`].
+fn vector_components(output: &ReturnType) -> Option<usize> {
+    match output {
+        ReturnType::Type(_, ty) => match kind_of(ty) {
+            Some(Kind::Array(m)) if m <= MAX_COMPONENTS => Some(m),
+            _ => None,
+        },
+        ReturnType::Default => None,
     }
 }
 
@@ -811,5 +839,9 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         check: options.check,
         space,
         attribute,
+        components: match attribute {
+            Attribute::JetFunction => vector_components(&sig.output),
+            _ => None,
+        },
     })
 }

@@ -92,7 +92,7 @@ pub use state::{Jet, State};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};
-pub use system::{Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem};
+pub use system::{Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction};
 
 /// The linear-algebra crate of the public API, re-exported so users and generated code
 /// name the same version.

@@ -93,6 +93,50 @@ pub trait JetFunction<const N: usize, const K: usize> {
     }
 }
 
+/// A vector function $g(x, u) = (g_0, \dots, g_{m-1})$ of the jet and the top derivative on
+/// $\mathbb{R}^N$ with $K = k$, component by component with gradients and Hessians: a stage
+/// constraint with one bound per component ($\ell_c \le g_c \le u_c$,
+/// [`crate::bvp::OptimalControlProblem::with_vector_bounds`]), written as plain Rust returning
+/// `[f64; m]` under `#[jet_function(order = k)]`. Each component $c < m$ is evaluated from its
+/// own straight-line code, so a component costs what it would as a scalar [`JetFunction`].
+pub trait VectorJetFunction<const N: usize, const K: usize> {
+    /// The number $m \ge 1$ of components.
+    fn components(&self) -> usize;
+
+    /// $g_c(x, u)$ (NaN for $c \ge m$).
+    fn component_value(&self, c: usize, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> f64;
+
+    /// $(\partial g_c/\partial x_0, \dots, \partial g_c/\partial x_{k-1}, \partial g_c/\partial u)$
+    /// (zero for $c \ge m$).
+    fn component_gradient(
+        &self,
+        c: usize,
+        x: &[SVector<f64, N>; K],
+        u: &SVector<f64, N>,
+    ) -> Gradient<N, K>;
+
+    /// The Hessian of $g_c$ in $(x, u)$, by blocks (zero for $c \ge m$).
+    fn component_hessian(
+        &self,
+        c: usize,
+        x: &[SVector<f64, N>; K],
+        u: &SVector<f64, N>,
+    ) -> Hessian<N, K>;
+
+    /// Whether $g_c$ depends on the top derivative $u = q^{(k)}$ (as
+    /// [`JetFunction::involves_top`], component by component; the default, `true`, is right
+    /// for any $g$).
+    fn component_involves_top(&self, c: usize) -> bool {
+        let _ = c;
+        true
+    }
+
+    /// A name for messages (`#[jet_function]`: the generated type's name).
+    fn name(&self) -> &'static str {
+        "vector jet function"
+    }
+}
+
 /// A $k$-th order Lagrangian $L(x, u)$ on $\mathbb{R}^N$ with $K = k$.
 pub trait Lagrangian<const N: usize, const K: usize> {
     /// $L(x, u)$.

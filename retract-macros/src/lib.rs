@@ -46,6 +46,11 @@ pub fn higher_order_lagrangian(attr: TokenStream, item: TokenStream) -> TokenStr
 /// `value`, `gradient` and `hessian` in (x, u) are generated, on a type named after the
 /// function (`PoleTorque`) with the parameters as public fields and `new`. The function
 /// stays callable.
+///
+/// A function returning `[f64; m]` (1 <= m <= 64; the body ends with an array: a literal, a
+/// local array or a helper's result) becomes a `retract::VectorJetFunction` instead: each
+/// component g_c with its own value, gradient and Hessian, bounded component by component
+/// by `OptimalControlProblem::with_vector_bounds`.
 #[proc_macro_attribute]
 pub fn jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand_jet_function(attr.into(), item.into()).into()

@@ -19,6 +19,7 @@ mod optimize;
 mod placement;
 mod stage_systems;
 mod typed_data;
+mod vector_bounds;
 mod warm_start;
 
 // the cart-pole of the swing-up suite, shared with the examples

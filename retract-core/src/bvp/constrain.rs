@@ -6,7 +6,7 @@
 use super::constraints::{ConstraintRef, Inequality, Placement, Source, Variable};
 use super::optimize::OptimalControlProblem;
 use super::violations::{Infeasibility, Location};
-use crate::JetFunction;
+use crate::{JetFunction, VectorJetFunction};
 
 impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     OptimalControlProblem<'a, Sys, N, K, X>
@@ -63,6 +63,58 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let index = self.function_inequalities;
         self.function_inequalities += 1;
         self.push_interval(Source::Function(constraint), lower, upper, placement, index);
+        self
+    }
+
+    /// Bounds `lower[c]` $\le g_c \le$ `upper[c]` on each component of a vector function
+    /// $g(x, u) \in \mathbb{R}^m$ (`#[jet_function]` returning `[f64; m]`; infinite entries: no
+    /// bound on that side), each component placed as [`Self::with_inequality`] from its own
+    /// dependence on $u$. One constraint (one index in messages, which name the component),
+    /// $m$ scalar intervals for the barrier: two thrusts in $[0, f_{\max}]$ are one call.
+    /// [`Self::solve`] refuses `lower` or `upper` of a length other than $m$.
+    pub fn with_vector_bounds(
+        self,
+        constraint: &'a (dyn VectorJetFunction<N, K> + Sync),
+        lower: &[f64],
+        upper: &[f64],
+    ) -> Self {
+        self.with_vector_bounds_placed(constraint, lower, upper, None)
+    }
+
+    /// [`Self::with_vector_bounds`] with every component placed at `placement`.
+    pub fn with_vector_bounds_at(
+        self,
+        constraint: &'a (dyn VectorJetFunction<N, K> + Sync),
+        lower: &[f64],
+        upper: &[f64],
+        placement: Placement,
+    ) -> Self {
+        self.with_vector_bounds_placed(constraint, lower, upper, Some(placement))
+    }
+
+    fn with_vector_bounds_placed(
+        mut self,
+        constraint: &'a (dyn VectorJetFunction<N, K> + Sync),
+        lower: &[f64],
+        upper: &[f64],
+        placement: Option<Placement>,
+    ) -> Self {
+        let index = self.function_inequalities;
+        self.function_inequalities += 1;
+        let m = constraint.components();
+        if lower.len() != m || upper.len() != m {
+            // (a NaN side: refused by `validate` with the other malformed bounds)
+            let source = Source::Component(constraint, 0);
+            let placement = Placement::Midpoints;
+            self.push_interval(source, f64::NAN, f64::INFINITY, placement, index);
+            return self;
+        }
+        for (c, (&lower, &upper)) in lower.iter().zip(upper).enumerate() {
+            let placement = placement
+                .unwrap_or_else(|| default_placement(constraint.component_involves_top(c)));
+            let source = Source::Component(constraint, c);
+            self.push_interval(source, lower, upper, placement, index);
+        }
         self
     }
 

@@ -7,7 +7,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::optimize::blocks;
-use crate::{Hessian, JetFunction};
+use crate::{Gradient, Hessian, JetFunction, VectorJetFunction};
 
 /// A variable of a step that a bound applies to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +62,9 @@ pub enum ConstraintKind {
     /// An inequality on a function ([`super::OptimalControlProblem::with_inequality`],
     /// [`super::OptimalControlProblem::with_function_bounds`]).
     Inequality,
+    /// The bounds of component `c` of a vector function
+    /// ([`super::OptimalControlProblem::with_vector_bounds`]; indexed with the inequalities).
+    Component(usize),
     /// A bound on a variable ([`super::OptimalControlProblem::with_bounds`] and the vector
     /// forms).
     Bound(Variable),
@@ -88,6 +91,13 @@ impl core::fmt::Display for ConstraintRef {
             ConstraintKind::Inequality => {
                 write!(f, "inequality #{} ({})", self.index, self.name)
             }
+            ConstraintKind::Component(c) => {
+                write!(
+                    f,
+                    "inequality #{} ({}, component {c})",
+                    self.index, self.name
+                )
+            }
             ConstraintKind::Bound(Variable::Jet(r)) => {
                 write!(f, "bound #{} on jet entry {r}", self.index)
             }
@@ -103,6 +113,8 @@ impl core::fmt::Display for ConstraintRef {
 pub(super) enum Source<'a, const N: usize, const K: usize> {
     /// $g(x, u)$.
     Function(&'a (dyn JetFunction<N, K> + Sync)),
+    /// Component `c` of $g(x, u) \in \mathbb{R}^m$ (valid for $c < m$).
+    Component(&'a (dyn VectorJetFunction<N, K> + Sync), usize),
     /// One variable.
     Variable(Variable),
 }
@@ -135,6 +147,11 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
                 index: self.index,
                 name: g.name(),
             },
+            Source::Component(g, c) => ConstraintRef {
+                kind: ConstraintKind::Component(c),
+                index: self.index,
+                name: g.name(),
+            },
             Source::Variable(v) => ConstraintRef {
                 kind: ConstraintKind::Bound(v),
                 index: self.index,
@@ -147,6 +164,7 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
     pub fn involves_top(&self) -> bool {
         match self.source {
             Source::Function(g) => g.involves_top(),
+            Source::Component(g, c) => g.component_involves_top(c),
             Source::Variable(v) => matches!(v, Variable::Top(_)),
         }
     }
@@ -155,6 +173,7 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
     pub fn value<const X: usize>(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> f64 {
         let v = match self.source {
             Source::Function(g) => g.value(&blocks::<N, K, X>(x), u),
+            Source::Component(g, c) => g.component_value(c, &blocks::<N, K, X>(x), u),
             Source::Variable(variable) => read(variable, x, u),
         };
         self.sign * (v - self.value)
@@ -167,15 +186,22 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         u: &SVector<f64, N>,
     ) -> Linearized<N, X> {
         let sign = self.sign;
+        let of_gradient = |value: f64, grad: Gradient<N, K>| Linearized {
+            value: sign * (value - self.value),
+            gx: SVector::from_fn(|r, _| sign * grad.x[r / N][r % N]),
+            gu: grad.u * sign,
+        };
         match self.source {
             Source::Function(g) => {
                 let xb = blocks::<N, K, X>(x);
-                let grad = g.gradient(&xb, u);
-                Linearized {
-                    value: sign * (g.value(&xb, u) - self.value),
-                    gx: SVector::from_fn(|r, _| sign * grad.x[r / N][r % N]),
-                    gu: grad.u * sign,
-                }
+                of_gradient(g.value(&xb, u), g.gradient(&xb, u))
+            }
+            Source::Component(g, c) => {
+                let xb = blocks::<N, K, X>(x);
+                of_gradient(
+                    g.component_value(c, &xb, u),
+                    g.component_gradient(c, &xb, u),
+                )
             }
             Source::Variable(variable) => {
                 let (mut gx, mut gu) = (SVector::zeros(), SVector::zeros());
@@ -205,6 +231,10 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
                 &g.hessian(&blocks::<N, K, X>(x), u),
                 weight * self.sign,
             )),
+            Source::Component(g, c) if weight != 0.0 => Some(flat_hessian::<N, K, X>(
+                &g.component_hessian(c, &blocks::<N, K, X>(x), u),
+                weight * self.sign,
+            )),
             _ => None,
         }
     }
@@ -220,16 +250,20 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
                 (Source::Function(f), Source::Function(g)) => {
                     self.index == other.index && core::ptr::addr_eq(f, g)
                 }
+                (Source::Component(f, a), Source::Component(g, b)) => {
+                    self.index == other.index && a == b && core::ptr::addr_eq(f, g)
+                }
                 _ => false,
             }
     }
 
     /// Whether the constraint is well formed for jets of length `X`: a value that is not NaN
-    /// (an infinite one is refused as a contradiction), a variable in range, and no node
+    /// (an infinite one is refused as a contradiction), a variable or component in range, and no node
     /// placement for what involves $u$.
     pub fn valid<const X: usize>(&self) -> bool {
         let inside = match self.source {
             Source::Function(_) => true,
+            Source::Component(g, c) => c < g.components(),
             Source::Variable(Variable::Jet(r)) => r < X,
             Source::Variable(Variable::Top(a)) => a < N,
         };

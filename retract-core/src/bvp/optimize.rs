@@ -309,7 +309,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             return invalid(
                 "bounds",
                 "bounds need values that are not NaN, a jet index < n k (a block j < k) or a \
-                 top index < n, and no node placement for what involves the top derivative",
+                 top index < n, one lower and one upper value per component of a vector \
+                 function, and no node placement for what involves the top derivative",
             );
         }
         let free_end = self
