@@ -980,11 +980,11 @@ mod tests {
         WORK.with(|w| w.get())
     }
 
-    /// Issue 14, item 5: each chain is collected once and balanced with a heap, so the work
-    /// of a sum of m terms is O(m log m) (it was O(m^3): a balancing at every node of the
-    /// chain, each with a linear search per merge, about 1.7e11 steps at m = 10 000).
+    /// Each chain is collected once and balanced with a heap, so the work of a sum of m terms
+    /// is O(m log m) (it was O(m^3): a balancing at every node of the chain, each with a
+    /// linear search per merge, about 1.7e11 steps at m = 10 000).
     #[test]
-    fn item_5_chains_cost_m_log_m_work() {
+    fn a_sum_of_m_terms_costs_m_log_m_work() {
         for m in [10, 100, 1000, 10_000] {
             let work = long_sum_work(m);
             let bound = 24 * m * (m.ilog2() as usize + 1);
@@ -995,11 +995,11 @@ mod tests {
         assert!(large <= 15 * small, "{small} -> {large}");
     }
 
-    /// Issue 14, item 6: a recurrence x <- x * y + 1 through 5000 inlined nodes, or a chain
-    /// whose balanced tree is a path (operands known ever later), is emitted nesting at most
-    /// `MAX_DEPTH + 2` levels, and computes the same values.
+    /// A recurrence x <- x * y + 1 through 5000 inlined nodes, or a chain whose balanced tree
+    /// is a path (operands known ever later), is emitted nesting at most `MAX_DEPTH + 2`
+    /// levels, and computes the same values.
     #[test]
-    fn item_6_deep_graphs_are_emitted_with_bounded_nesting() {
+    fn deep_graphs_are_emitted_with_bounded_nesting() {
         let mut g = Graph::default();
         let (y, z) = (g.var(Var::Z0(0)), g.var(Var::Z0(1)));
         let one = g.constant(1.0);

@@ -1,9 +1,9 @@
-//! Issue 14, item 10: a fixed sample of the grammar fuzzer's Lagrangians
+//! A fixed sample of the grammar fuzzer's Lagrangians
 //! (`retract-codegen/tests/expansion/grammar_fuzz.rs`, fixed seed, smooth mode: every singular
 //! operation with an argument bounded away from its singular set), compiled through the
 //! macro, with the generated gradient and Hessian checked against fourth-order central
 //! finite differences at 8 points each. The section between the markers is written by the
-//! fuzzer (`RETRACT_BLESS_CORPUS=1 cargo test -p retract-codegen --test grammar_fuzz`), which
+//! fuzzer (`RETRACT_BLESS_CORPUS=1 cargo test -p retract-codegen --test expansion`), which
 //! also fails when it differs from what the generator makes.
 
 #![allow(unused_variables, unused_mut, clippy::all)]
@@ -66,7 +66,7 @@ fn check<L: Lagrangian<N, K>, const N: usize, const K: usize>(name: &str, l: &L)
 }
 
 #[test]
-fn item_10_compiled_fuzz_corpus_derivatives_match_finite_differences() {
+fn compiled_fuzz_corpus_derivatives_match_finite_differences() {
     corpus::corpus_checks();
 }
 

@@ -189,7 +189,7 @@ fn every_guarded_kind_is_checked() {
     expect(first_step_kind(&WithSqrt {}), DomainKind::SqrtArgument, "q");
     expect(first_step_kind(&WithLn {}), DomainKind::LnArgument, "q");
     expect(first_step_kind(&WithPowf {}), DomainKind::PowfBase, "q");
-    // the functions of issue 17, item 7: cbrt (singular derivative at 0), log2, ln_1p, asin
+    // the methods beyond the elementary ones: cbrt (singular derivative at 0), log2, ln_1p, asin
     expect(first_step_kind(&WithCbrt {}), DomainKind::Denominator, "q");
     expect(first_step_kind(&WithLog2 {}), DomainKind::LnArgument, "q");
     expect(

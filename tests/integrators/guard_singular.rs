@@ -1,4 +1,4 @@
-//! Issue 14, item 9: the singularity guard covers every singular operation the macro accepts
+//! The singularity guard covers every singular operation the macro accepts
 //! (`/`, `/=`, `recip`, `powi` and `powf` with a negative exponent, `powf` with a fractional
 //! one, `ln`, `sqrt`, `tan`, `atan2`, `hypot`), and a guarded expression that vanishes
 //! without changing sign (an even power, a sum of squares) is caught as well as one that
@@ -125,42 +125,42 @@ fn towards_zero<Sys: LiftedSystem<2, 3>>(system: &Sys, kind: DomainKind, express
 }
 
 #[test]
-fn item_9_negative_powi() {
+fn a_negative_powi_is_guarded_at_zero() {
     towards_zero(&NegativePowi {}, DomainKind::Denominator, "q");
 }
 
 #[test]
-fn item_9_powf_with_a_negative_integer_exponent() {
+fn powf_with_a_negative_integer_exponent_is_guarded_at_zero() {
     towards_zero(&NegativePowf {}, DomainKind::Denominator, "q");
 }
 
 #[test]
-fn item_9_powf_with_a_negative_fractional_exponent() {
+fn powf_with_a_negative_fractional_exponent_is_guarded_at_zero() {
     towards_zero(&FractionalNegativePowf {}, DomainKind::PowfBase, "q");
 }
 
 #[test]
-fn item_9_recip() {
+fn recip_is_guarded_at_zero() {
     towards_zero(&WithRecip {}, DomainKind::Denominator, "q");
 }
 
 #[test]
-fn item_9_div_assign_by_an_odd_power() {
+fn div_assign_by_an_odd_power_is_guarded_at_zero() {
     towards_zero(&DivAssign {}, DomainKind::Denominator, "q * q * q");
 }
 
 #[test]
-fn item_9_ln_of_an_even_power_vanishing_without_sign_change() {
+fn ln_of_an_even_power_is_guarded_where_it_vanishes_without_sign_change() {
     towards_zero(&LnOfSquare {}, DomainKind::LnArgument, "q * q");
 }
 
 #[test]
-fn item_9_sqrt_of_an_even_power_vanishing_without_sign_change() {
+fn sqrt_of_an_even_power_is_guarded_where_it_vanishes_without_sign_change() {
     towards_zero(&SqrtOfSquare {}, DomainKind::SqrtArgument, "q * q");
 }
 
 #[test]
-fn item_9_tan_where_cos_crosses_zero() {
+fn tan_is_guarded_where_cos_crosses_zero() {
     // q(0) = pi/2 - 0.05, q' = 1: cos q changes sign at t = 0.05
     let q0 = core::f64::consts::FRAC_PI_2 - 0.05;
     crosses_and_nears(
@@ -175,13 +175,13 @@ fn item_9_tan_where_cos_crosses_zero() {
 }
 
 #[test]
-fn item_9_abs_is_a_kink_not_a_singularity() {
+fn abs_is_a_kink_not_a_singularity() {
     // documented: |q| has a bounded derivative, so crossing 0 is not a domain error
     assert!(one_step(&WithAbs {}, [0.05, -1.0], 0.06).is_ok());
 }
 
 #[test]
-fn item_9_forward_speed_barrier_on_a_line() {
+fn a_forward_speed_barrier_on_a_line_is_guarded_where_the_speed_vanishes() {
     // q'(0) = 0.05, q'' = -1: q' changes sign at t = 0.05, but q'^2 stays positive at the
     // start (2.5e-3), the evaluation point (4e-4) and the end (1e-4) of a step of 0.06
     let system = SpeedBarrier1d { tau: 1e-12 };
@@ -194,7 +194,7 @@ fn item_9_forward_speed_barrier_on_a_line() {
 }
 
 #[test]
-fn item_9_forward_speed_barrier_in_the_plane() {
+fn a_forward_speed_barrier_in_the_plane_is_guarded_where_the_speed_vanishes() {
     // q' = (0.05, 0) - (t, 0): |q'|^2 touches 0 at t = 0.05 without changing sign
     let system = SpeedBarrier { tau: 1e-12 };
     let through = [0.0, 0.0, 0.05, 0.0, -1.0, 0.0, 0.0, 0.0];
@@ -210,7 +210,7 @@ fn item_9_forward_speed_barrier_in_the_plane() {
 }
 
 #[test]
-fn item_9_atan2_and_hypot_at_the_origin() {
+fn atan2_and_hypot_are_guarded_at_the_origin() {
     // q = (0.05, 0) - (t, 0): through the origin, where both arguments vanish
     let through = [0.05, 0.0, -1.0, 0.0];
     let atan2 = |h: f64| one_step(&WithAtan2 {}, through, h);

@@ -124,7 +124,7 @@ fn nan_and_infinite_inputs_and_parameters() {
         let (system, z0) = body(bad, jet);
         let result = trajectory(&system, &z0, 0.01, 10, &StepOptions::default());
         sound(&result);
-        // named (issue 16, item 7), not a bare non-finite residual
+        // named, not a bare non-finite residual
         let error = result.unwrap_err().error;
         assert!(
             matches!(error, Error::NonFiniteParameter { name: "tau", .. }),

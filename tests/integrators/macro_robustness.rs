@@ -1,13 +1,14 @@
-//! Issue 14, the macro: hostile but valid inputs compile to code that computes what the
+//! The macro on hostile but valid inputs: they compile to code that computes what the
 //! annotated function computes, with the right derivatives. (Inputs that must be rejected are
-//! in `validation/tests/ui/fail/item_*.rs`; the expansion itself is tested in
-//! `retract-codegen/tests/expansion/robustness_items.rs`.)
+//! in `validation/tests/ui/fail/signature/function_name_that_makes_no_type_name.rs` and
+//! `validation/tests/ui/fail/expressions/loop_too_long_at_the_i64_limits.rs`; the expansion
+//! itself is tested in `retract-codegen/tests/expansion/extreme_inputs.rs`.)
 
 use retract::Lagrangian;
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 
-// ---- item 2: function names that camel-case to no type name, with `name = ...` ----------
+// ---- function names that camel-case to no type name, with `name = ...` ----------
 
 #[higher_order_lagrangian(order = 1, name = Arm2d)]
 fn _2d_arm(q: f64, dq: f64) -> f64 {
@@ -20,13 +21,13 @@ fn self_(q: f64, dq: f64) -> f64 {
 }
 
 #[test]
-fn item_2_function_names_with_an_explicit_type_name() {
+fn a_function_name_that_makes_no_type_name_compiles_with_an_explicit_name() {
     let (x, u) = ([SVector::from([0.3])], SVector::from([0.5]));
     assert_eq!(Arm2d {}.lagrangian(&x, &u), _2d_arm(0.3, 0.5));
     assert_eq!(SelfLike {}.lagrangian(&x, &u), self_(0.3, 0.5));
 }
 
-// ---- item 3: integers at the ends of i32 and i64 ----------------------------------------
+// ---- integers at the ends of i32 and i64 ----------------------------------------
 
 #[higher_order_lagrangian(order = 1)]
 fn extreme_exponent(q: f64, dq: f64) -> f64 {
@@ -48,7 +49,7 @@ fn extreme_loops(q: f64, dq: f64) -> f64 {
 }
 
 #[test]
-fn item_3_compile_time_integer_overflow() {
+fn extreme_exponents_and_loop_bounds_give_exact_values_and_derivatives() {
     let n = i32::MIN;
     let sys = ExtremeExponent {};
     for q in [1.0_f64, -1.0, 1.0 + 1e-9, -1.0 + 1e-9, 0.999_999_9] {
@@ -74,7 +75,7 @@ fn item_3_compile_time_integer_overflow() {
     assert_eq!(sys.gradient(&x, &u).x[0][0], 23.0);
 }
 
-// ---- item 4: indices above u16::MAX ------------------------------------------------------
+// ---- indices above u16::MAX ------------------------------------------------------
 
 #[higher_order_lagrangian(order = 1)]
 fn long_parameters(q: f64, dq: f64, c: [f64; 70000], obs: &[[f64; 70000]]) -> f64 {
@@ -86,7 +87,7 @@ fn long_parameters(q: f64, dq: f64, c: [f64; 70000], obs: &[[f64; 70000]]) -> f6
 }
 
 #[test]
-fn item_4_indices_above_u16() {
+fn indices_above_u16_read_the_right_entries() {
     // values at the indices read, and large ones where truncated or wrapped indices land
     let fill = |c: &mut [f64; 70000]| {
         c[69999] = 2.0;
@@ -112,7 +113,7 @@ fn item_4_indices_above_u16() {
     assert!((sys.lagrangian(&x, &u) - direct).abs() < 1e-12);
 }
 
-// ---- item 7: constants that are NaN or infinite at compile time -------------------------
+// ---- constants that are NaN or infinite at compile time -------------------------
 
 #[higher_order_lagrangian(order = 1)]
 #[allow(clippy::zero_divided_by_zero, clippy::eq_op)]
@@ -132,7 +133,7 @@ fn negative_zero(q: f64, dq: f64) -> f64 {
 }
 
 #[test]
-fn item_7_non_finite_constants() {
+fn non_finite_constants_evaluate_as_the_function_does() {
     let (q, dq) = (0.5, 0.25);
     let (x, u) = ([SVector::from([q])], SVector::from([dq]));
     let value = NanConstant {}.lagrangian(&x, &u);

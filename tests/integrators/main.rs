@@ -19,7 +19,7 @@ mod guard_quadratic;
 mod guard_singular;
 mod hard_cases;
 mod helpers;
-mod item_6_deep_nesting;
+mod long_recurrence;
 mod macro_robustness;
 mod macro_vs_handwritten;
 mod map_macro;

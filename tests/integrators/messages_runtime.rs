@@ -1,7 +1,6 @@
-//! Runtime messages that fit the situation (issue 16, item 7): a boundary-value line search
-//! does not advise step halving, a start or goal no guess can repair says so, an initial
-//! state outside the domain is flagged at step 0, and `{:?}` of an interrupted trajectory is
-//! a summary. Every test asserts on the message text.
+//! Runtime messages that fit the situation: a boundary-value line search does not advise step
+//! halving, a start or goal no guess can repair says so, an initial state outside the domain
+//! is flagged at step 0, and `{:?}` of an interrupted trajectory is a summary. Every test asserts on the message text.
 
 use crate::common;
 
@@ -435,7 +434,7 @@ fn disc_list(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2], tau: f64, discs: &[[f64;
     l
 }
 
-/// A NaN parameter is named (issue 16, item 7) by steps, the reduced step and solves, not
+/// A NaN parameter is named by steps, the reduced step and solves, not
 /// reported as a non-finite residual.
 #[test]
 fn a_nan_parameter_is_named() {

@@ -1,6 +1,5 @@
-//! Regression tests of runtime items 12 and 13 of the robustness issue (issue 14): the domain
-//! check samples the chord of a step (item 12), and the reduced step conserves the angular
-//! momentum of a rotation-invariant system (item 13).
+//! The domain check samples the chord of a step, and the reduced step conserves the angular
+//! momentum of a rotation-invariant system.
 
 use crate::common;
 
@@ -38,7 +37,7 @@ fn both_steps(system: &Scene, z0: &Z, h: f64, options: &StepOptions) -> [Result<
 }
 
 #[test]
-fn item_12_a_step_jumping_over_a_small_obstacle_is_an_error() {
+fn a_step_jumping_over_a_small_obstacle_is_an_error() {
     // a disc of radius 0.05 at (-0.075, 0.03); the step of h = 0.1 at speed 3 goes from
     // x = -0.15 to x = 0.15 along y = 0, 0.08 of it inside the disc: x0, the midpoint x = 0
     // and x1 are all 0.08 or more from the centre, and the quadratic fit of the denominator
@@ -83,7 +82,7 @@ fn item_12_a_step_jumping_over_a_small_obstacle_is_an_error() {
 }
 
 #[test]
-fn item_12_a_step_passing_near_an_obstacle_stays_ok() {
+fn a_step_passing_near_an_obstacle_stays_ok() {
     // the same step 0.06 beside the disc's centre (0.01 outside its radius) is accepted,
     // with the full chord check, by both steps, and so is a trajectory along it
     let system = Scene {
@@ -128,7 +127,7 @@ fn angular_momentum(z: &SVector<f64, 8>) -> f64 {
 }
 
 #[test]
-fn item_13_the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
+fn the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
     // The midpoint rule conserves the angular momentum of a rotation-invariant Lagrangian
     // exactly; solved by the general step it stays within 9e-13 (relative) over 1e7 steps, a
     // random walk of rounding errors. The reduced step drifted linearly, 6.5e-17 per step
@@ -171,8 +170,9 @@ fn the_uncompensated_reduced_step_is_the_same_map_but_lets_the_momentum_drift() 
     // StepOptions::compensated off: each entry of w one rounded sum of T z0 - A^{-1} n. Step
     // by step it agrees with the compensated step to rounding; over 1e6 steps its angular
     // momentum drifts linearly (6.5e-17 a step: about 6.5e-11), the compensated one stays at
-    // rounding (4.2e-13, item 13). The bounds sit between the two; the lower one on the plain
-    // step's drift is what shows that the option really takes the plain recovery.
+    // rounding (4.2e-13, measured in the test above). The bounds sit between the two; the
+    // lower one on the plain step's drift is what shows that the option really takes the
+    // plain recovery.
     let (system, z0) = common::models::bounded_pais_uhlenbeck();
     let j0 = angular_momentum(&z0);
     let (on, off) = (

@@ -1,6 +1,5 @@
-//! Regression tests of the runtime items of the robustness issue (issue 14): a step is
-//! accepted only with a small residual row by row (item 11), the reduced stepper's cache of
-//! factorisations (item 14), and sizes too large for memory (item 15).
+//! Robustness of the runtime: a step is accepted only with a small residual row by row, the
+//! reduced stepper's cache of factorisations, and sizes too large for memory.
 
 use crate::common;
 
@@ -33,7 +32,7 @@ fn scaled_residual(system: &RigidBody, z0: &Z, w: &SVector<f64, 15>, h: f64) -> 
 }
 
 #[test]
-fn item_11_converged_means_a_small_residual() {
+fn converged_means_a_small_residual_in_every_row() {
     // one huge entry (a momentum of 1e154) made every Newton step small against |w|_inf, so
     // the general step returned an iterate whose position rows were off by 1 (residual 1.05
     // against terms of 1.05: the y position of the step was 0 instead of 1.05)
@@ -86,7 +85,7 @@ fn item_11_converged_means_a_small_residual() {
 }
 
 #[test]
-fn item_14_alternating_up_to_16_step_sizes_factorises_once_per_size() {
+fn alternating_up_to_16_step_sizes_factorises_once_per_size() {
     assert_eq!(CACHE_SIZE, 16);
     let (system, z0) = body();
     let options = StepOptions::default();
@@ -143,7 +142,7 @@ fn assert_too_large(error: &Error, name: &str) {
 }
 
 #[test]
-fn item_15_sizes_too_large_for_memory_are_invalid_arguments() {
+fn sizes_too_large_for_memory_are_invalid_arguments() {
     let (system, z0) = body();
     let options = StepOptions::default();
     // trajectories: no `capacity overflow`, no overflow in steps + 1, no allocation abort

@@ -1,10 +1,12 @@
-//! Compile-time behaviour of `#[higher_order_lagrangian]`: every mistake in `tests/ui/fail`
-//! is an error at its span with the message in the `.stderr` beside it; every file in
-//! `tests/ui/pass` compiles and runs. Refresh the messages with `TRYBUILD=overwrite`.
+//! Compile-time behaviour of `#[higher_order_lagrangian]`: every mistake in `tests/ui/fail`,
+//! sorted by topic (`signature`, `syntax`, `expressions`, `helpers`, `outputs`, `maps`,
+//! `manifolds`, `legendre`), is an error at its span with the message in the `.stderr` beside
+//! it; every file in `tests/ui/pass` compiles and runs. Refresh the messages with
+//! `TRYBUILD=overwrite`.
 
 #[test]
 fn ui() {
     let t = trybuild::TestCases::new();
-    t.compile_fail("tests/ui/fail/*.rs");
+    t.compile_fail("tests/ui/fail/*/*.rs");
     t.pass("tests/ui/pass/*.rs");
 }

@@ -1,8 +1,8 @@
-//! Regression tests of issue 14, items 5, 6 and 8, at the level of the expansion: long sums
-//! expand in quasi-linear time, deep inputs expand to code of bounded nesting, and inputs
-//! beyond the documented limits are errors at their span, never an abort. (The work of the
+//! Limits of the expansion, tested on tokens: long sums expand in quasi-linear time, deep
+//! inputs expand to code of bounded nesting, and inputs beyond the documented limits are
+//! errors at their span, never an abort. (The work of the
 //! chains is counted in `codegen`'s unit tests; a deep case is compiled in the workspace's
-//! `tests/integrators/item_6_deep_nesting.rs`.)
+//! `tests/integrators/long_recurrence.rs`.)
 
 use std::time::{Duration, Instant};
 
@@ -54,7 +54,7 @@ fn scalar(params: &str, body: &str, tail: &str) -> String {
 }
 
 #[test]
-fn item_5_long_sums_expand_in_quasi_linear_time() {
+fn long_sums_expand_in_quasi_linear_time() {
     // a sum of m terms (and its gradient and Hessian, sums of m terms too); the balancing of
     // each chain was cubic in m: 1000 terms took about a minute, 10 000 would take hours
     let time = |m: usize| {
@@ -79,7 +79,7 @@ fn item_5_long_sums_expand_in_quasi_linear_time() {
 }
 
 #[test]
-fn item_6_deep_lets_and_long_recurrences_nest_boundedly() {
+fn deep_lets_and_long_recurrences_nest_boundedly() {
     // 1000 chained `let`s, each a few operations on the last: the value of the last inlined
     // into one expression nested about 4 parentheses per `let`, which overflowed rustc's stack
     let mut body = String::from("let a0 = q;");
@@ -112,7 +112,7 @@ fn error(attr: &str, item: &str) -> String {
 }
 
 #[test]
-fn item_8_sizes_beyond_the_limits_are_errors() {
+fn sizes_beyond_the_limits_are_errors() {
     let jet = |k: usize, n: &str| {
         let args: Vec<String> = (0..=k).map(|o| format!("d{o}: [f64; {n}]")).collect();
         format!(

@@ -1,4 +1,4 @@
-//! Issue 14, item 10: a grammar-based fuzzer. It generates Lagrangians from the documented
+//! A grammar-based fuzzer. It generates Lagrangians from the documented
 //! syntax (docs/guide.md, "What a Lagrangian may contain": jets of order 1 to 3, scalar and array
 //! jets, `f64`, array and slice parameters, nesting, long sums, `const`s, `let` and `let mut`
 //! with every compound assignment, unrolled and run-time loops, every supported method in
@@ -9,7 +9,7 @@
 //! Each run takes `CASES` cases from a fixed seed and `CASES` from a random one (printed; set
 //! `RETRACT_FUZZ_SEED` to replay it). A sample of well-behaved Lagrangians from the fixed
 //! seed is compiled in the workspace's `tests/integrators/fuzz_corpus.rs`, whose derivatives are checked
-//! against finite differences there; `item_10_compiled_corpus_is_the_fixed_seed_sample`
+//! against finite differences there; `the_compiled_corpus_is_the_fixed_seed_sample`
 //! keeps that file equal to what the generator makes (`RETRACT_BLESS_CORPUS=1` rewrites it).
 
 use std::fmt::Write as _;
@@ -509,7 +509,7 @@ fn run(seed: u64) -> (usize, usize) {
 }
 
 #[test]
-fn item_10_grammar_fuzzer_fixed_seed() {
+fn fuzzed_lagrangians_of_the_fixed_seed_expand_or_error_without_panic() {
     let (expanded, _) = run(FIXED_SEED);
     // the generator must exercise the expansion, not only the error paths
     assert!(
@@ -519,7 +519,7 @@ fn item_10_grammar_fuzzer_fixed_seed() {
 }
 
 #[test]
-fn item_10_grammar_fuzzer_random_seed() {
+fn fuzzed_lagrangians_of_a_random_seed_expand_or_error_without_panic() {
     let seed = match std::env::var("RETRACT_FUZZ_SEED") {
         Ok(s) => u64::from_str_radix(s.trim_start_matches("0x"), 16).expect("a hex seed"),
         Err(_) => std::time::SystemTime::now()
@@ -570,7 +570,7 @@ const BEGIN: &str =
 const END: &str = "// ---- END GENERATED ----\n";
 
 #[test]
-fn item_10_compiled_corpus_is_the_fixed_seed_sample() {
+fn the_compiled_corpus_is_the_fixed_seed_sample() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../tests/integrators/fuzz_corpus.rs"

@@ -83,9 +83,9 @@ fn transcendental(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], alpha: f64) -> f64 {
         + (1.0 + q[0].powi(2) + dq[1].powi(2)).sqrt()
 }
 
-/// k = 2 with every method beyond the elementary ones (issue 17, item 7): asin, acos, atan,
-/// sinh, cosh, cbrt, ln_1p, exp_m1, log2, log10, mul_add, smooth_max and smooth_min, in q, q'
-/// and q'' (the arguments kept inside their domains at the sample points).
+/// k = 2 with every method beyond the elementary ones: asin, acos, atan, sinh, cosh, cbrt,
+/// ln_1p, exp_m1, log2, log10, mul_add, smooth_max and smooth_min, in q, q' and q'' (the
+/// arguments kept inside their domains at the sample points).
 #[higher_order_lagrangian(order = 2)]
 fn special(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], eps: f64) -> f64 {
     let weight = 1.0 + 0.1 * (0.2 * q[0]).sinh().powi(2) + 0.05 * (0.3 * q[1]).cosh();
@@ -103,7 +103,7 @@ fn special(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], eps: f64) -> f64 {
 }
 
 /// n = 7 (above nalgebra's `SVector::new`, n <= 6), constant weights on q' with a coupling:
-/// the closed-form Legendre inverse (issue 14, item 1).
+/// the closed-form Legendre inverse.
 #[higher_order_lagrangian(order = 1)]
 fn chain7(q: [f64; 7], dq: [f64; 7], kappa: f64) -> f64 {
     let mut l = 0.0;
@@ -371,10 +371,10 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
 
-    /// Issue 14, item 1: n >= 7 with constant weights on the top derivative compiles (the
-    /// closed-form Legendre inverse), and all derivatives match finite differences.
+    /// n >= 7 with constant weights on the top derivative compiles (the closed-form Legendre
+    /// inverse), and all derivatives match finite differences.
     #[test]
-    fn item_1_dimension_seven_and_more(v in point(48, -1.0, 1.0), kappa in 0.1..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
+    fn dimension_seven_and_more_matches_finite_differences_and_inverts_the_momentum(v in point(48, -1.0, 1.0), kappa in 0.1..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
         check_all(&Chain7 { kappa }, &v, h, theta);
         check_all(&Chain12 { kappa }, &v, h, theta);
         check_all(&Chain24 { kappa }, &v, h, theta);
