@@ -79,6 +79,41 @@ fn a_keep_out_disc_holds_at_nodes_and_midpoints_at_every_n() {
     }
 }
 
+/// Interior samples: a bound q <= 0.3 on the line that the unbounded plan (from q' = 2 to
+/// q' = -2 back at 0 in T = 2) would pass. At N = 8 the plan holds it at the nodes and
+/// midpoints but its interpolant peaks above it between them (by about 1e-2); with 3 samples
+/// a step less, and with the 15 that `Violations::interpolant` checks not at all (within the
+/// tolerance), each at a higher cost. The test's own evaluation of the plan's interpolant,
+/// on a grid finer than the samples, agrees.
+#[test]
+fn interior_samples_hold_the_interpolant_between_the_nodes() {
+    let system = LineEffort::new();
+    let solve = |samples| {
+        OptimalControlProblem::new(&system, &[0.0, 2.0], &[0.0, -2.0], 2.0, 8)
+            .with_bounds(Variable::Jet(0), f64::NEG_INFINITY, 0.3)
+            .with_options(PlanOptions::default().with_interior_samples(samples))
+            .solve(PlanGuess::Spline)
+            .expect("a certified plan")
+    };
+    let plans = [solve(0), solve(3), solve(15)];
+    let between = plans.each_ref().map(|p| p.violations.interpolant);
+    assert!(between[0] > 5e-3, "{between:?}");
+    assert!(between[1] < between[0] / 10.0, "{between:?}");
+    assert!(between[2] <= 1e-9, "{between:?}");
+    assert!(plans[0].cost < plans[1].cost && plans[1].cost < plans[2].cost);
+    for plan in &plans {
+        assert!(plan.violations.imposed() <= 1e-9);
+    }
+    let peak = |plan: &Plan<1, 2>| {
+        (0..=8 * 64)
+            .map(|j| plan.evaluate(2.0 * j as f64 / 512.0).expect("inside")[0])
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    assert!(peak(&plans[0]) > 0.3 + 5e-3);
+    // at the samples within the tolerance, between them by O((h / 16)^2)
+    assert!(peak(&plans[2]) <= 0.3 + 1e-4, "{}", peak(&plans[2]));
+}
+
 /// Placed at the midpoints only, the same constraint leaves the nodes free: the coarse plan
 /// puts a node inside the disc, and the plan says so ([`retract::bvp::Violations::nodes`]),
 /// while the midpoints hold.

@@ -104,7 +104,7 @@ fn components_and_their_derivatives_agree_with_the_function_and_differences() {
         for c in 0..2 {
             let gradient = torques.component_gradient(c, &x, &u);
             let hessian = flat_hessian(&torques.component_hessian(c, &x, &u));
-            for r in 0..6 {
+            for (r, row) in hessian.iter().enumerate() {
                 let (xp, up) = moved(&x, &u, r, e);
                 let (xm, um) = moved(&x, &u, r, -e);
                 let fd = (torques.component_value(c, &xp, &up)
@@ -115,9 +115,8 @@ fn components_and_their_derivatives_agree_with_the_function_and_differences() {
                     torques.component_gradient(c, &xp, &up),
                     torques.component_gradient(c, &xm, &um),
                 );
-                for s in 0..6 {
+                for (s, &exact) in row.iter().enumerate() {
                     let fd = (flat(&gp, s) - flat(&gm, s)) / (2.0 * e);
-                    let exact = hessian[r][s];
                     assert!(
                         (fd - exact).abs() <= 1e-6 * (1.0 + fd.abs()),
                         "component {c}, entry ({r}, {s}): {exact} against {fd}"

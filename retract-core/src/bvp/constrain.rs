@@ -176,6 +176,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     sign,
                     placement,
                     index,
+                    sample: None,
                 });
             }
         }

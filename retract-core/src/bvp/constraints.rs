@@ -6,6 +6,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::guess::Hermite;
 use super::optimize::blocks;
 use crate::{Gradient, Hessian, JetFunction, VectorJetFunction};
 
@@ -129,6 +130,76 @@ pub(super) struct Inequality<'a, const N: usize, const K: usize> {
     pub placement: Placement,
     /// The index of the user's constraint (one `with_*_bounds` call may add two).
     pub index: usize,
+    /// For a constraint of the jet alone imposed at an interior sample of each step
+    /// ([`super::PlanOptions::interior_samples`]): the sample, a linear function of the
+    /// step's $(x_\theta, u)$; `None` where it is imposed at $(x_\theta, u)$ or at a node.
+    pub sample: Option<Sample>,
+}
+
+/// The most orders $k$ for which interior samples are formed.
+pub(super) const SAMPLE_MAX_ORDER: usize = 4;
+
+/// The jet $x(t_i + \tau h)$ of the plan's interpolant inside a step as a linear function of
+/// the step's evaluation point $x_\theta$ and top derivative $u$: the nodes are
+/// $x_i = x_\theta - \theta h (A x_\theta + B u)$ and $x_{i+1} = x_\theta + (1-\theta) h
+/// (A x_\theta + B u)$ (the scheme's $x$-equations with no defect; $A$ the block shift, $B$ the
+/// last block), and $x(t_i + \tau h)$ is the Hermite polynomial of degree $2k-1$ between them
+/// ([`super::Plan::evaluate`]'s interpolant). Coordinates do not mix: block $j$ of the sample
+/// is $\sum_{c<k} w_{jc} x_{\theta,c} + w_{jk} u$.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Sample {
+    /// The fraction $\tau \in (0, 1)$ of the step.
+    pub fraction: f64,
+    /// `weights[j][c]` $= w_{jc}$ ($j < k \le 4$, $c \le k$).
+    weights: [[f64; SAMPLE_MAX_ORDER + 1]; SAMPLE_MAX_ORDER],
+}
+
+impl Sample {
+    /// The sample at `fraction` of a step of length `h` with scheme parameter `theta`, for
+    /// jets of order `k` (`None` for $k > 4$ or a degenerate step).
+    pub fn new(fraction: f64, h: f64, theta: f64, k: usize) -> Option<Self> {
+        if k == 0 || k > SAMPLE_MAX_ORDER {
+            return None;
+        }
+        let mut weights = [[0.0; SAMPLE_MAX_ORDER + 1]; SAMPLE_MAX_ORDER];
+        for c in 0..=k {
+            // the scalar jets (x_theta, u) = e_c and the nodes they give
+            let unit = |l: usize| if l == c { 1.0 } else { 0.0 };
+            let rate = |l: usize| unit(l + 1);
+            let start: Vec<f64> = (0..k).map(|l| unit(l) - theta * h * rate(l)).collect();
+            let end: Vec<f64> = (0..k)
+                .map(|l| unit(l) + (1.0 - theta) * h * rate(l))
+                .collect();
+            let piece = Hermite::new(&start, &end, h, 1, k).ok()?;
+            for (j, row) in weights.iter_mut().enumerate().take(k) {
+                row[c] = piece.jet_entry(j, fraction * h);
+            }
+        }
+        Some(Self { fraction, weights })
+    }
+
+    /// The sample's jet from the step's $(x_\theta, u)$.
+    fn point<const N: usize, const K: usize, const X: usize>(
+        &self,
+        x: &SVector<f64, X>,
+        u: &SVector<f64, N>,
+    ) -> SVector<f64, X> {
+        let w = &self.weights;
+        SVector::from_fn(|r, _| {
+            let (j, a) = (r / N, r % N);
+            (0..K).map(|c| w[j][c] * x[c * N + a]).sum::<f64>() + w[j][K] * u[a]
+        })
+    }
+
+    /// The map $(x_\theta, u) \mapsto x$ as its two blocks $(T, U)$.
+    fn blocks<const N: usize, const K: usize, const X: usize>(
+        &self,
+    ) -> (SMatrix<f64, X, X>, SMatrix<f64, X, N>) {
+        let w = &self.weights;
+        let t = SMatrix::from_fn(|r, s| if r % N == s % N { w[r / N][s / N] } else { 0.0 });
+        let u = SMatrix::from_fn(|r, a| if r % N == a { w[r / N][K] } else { 0.0 });
+        (t, u)
+    }
 }
 
 /// Value, gradient $(\partial_x, \partial_u)$ of a stage constraint at $(x_\theta, u)$.
@@ -169,8 +240,16 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         }
     }
 
-    /// $\sigma (v(x, u) - c)$.
+    /// $\sigma (v(x, u) - c)$, at the sample of `(x, u)` for an interior sample.
     pub fn value<const X: usize>(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> f64 {
+        if let Some(sample) = &self.sample {
+            return self.at_point(&sample.point::<N, K, X>(x, u), u);
+        }
+        self.at_point(x, u)
+    }
+
+    /// $\sigma (v(x, u) - c)$ at `(x, u)` itself.
+    fn at_point<const X: usize>(&self, x: &SVector<f64, X>, u: &SVector<f64, N>) -> f64 {
         let v = match self.source {
             Source::Function(g) => g.value(&blocks::<N, K, X>(x), u),
             Source::Component(g, c) => g.component_value(c, &blocks::<N, K, X>(x), u),
@@ -179,8 +258,27 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         self.sign * (v - self.value)
     }
 
-    /// Value and gradient.
+    /// Value and gradient (in the step's $(x_\theta, u)$ for an interior sample: $T^T \nabla
+    /// g$, $U^T \nabla g$ with the sample's blocks, [`Sample`]).
     pub fn linearize<const X: usize>(
+        &self,
+        x: &SVector<f64, X>,
+        u: &SVector<f64, N>,
+    ) -> Linearized<N, X> {
+        let Some(sample) = &self.sample else {
+            return self.linearize_at_point(x, u);
+        };
+        let at = self.linearize_at_point(&sample.point::<N, K, X>(x, u), u);
+        let (t, tu) = sample.blocks::<N, K, X>();
+        Linearized {
+            value: at.value,
+            gx: t.transpose() * at.gx,
+            gu: tu.transpose() * at.gx + at.gu,
+        }
+    }
+
+    /// Value and gradient at `(x, u)` itself.
+    fn linearize_at_point<const X: usize>(
         &self,
         x: &SVector<f64, X>,
         u: &SVector<f64, N>,
@@ -219,8 +317,29 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
     }
 
     /// `weight` times the Hessian blocks $(H_{xx}, H_{ux}, H_{uu})$ of $\sigma v$ (none for a
-    /// bound).
+    /// bound); for an interior sample of a function of the jet alone $(T^T H T, U^T H T,
+    /// U^T H U)$ with the sample's blocks.
     pub fn weighted_hessian<const X: usize>(
+        &self,
+        x: &SVector<f64, X>,
+        u: &SVector<f64, N>,
+        weight: f64,
+    ) -> Option<(SMatrix<f64, X, X>, SMatrix<f64, N, X>, SMatrix<f64, N, N>)> {
+        let Some(sample) = &self.sample else {
+            return self.hessian_at_point(x, u, weight);
+        };
+        let (hxx, _, _) = self.hessian_at_point(&sample.point::<N, K, X>(x, u), u, weight)?;
+        let (t, tu) = sample.blocks::<N, K, X>();
+        let ht = hxx * t;
+        Some((
+            t.transpose() * ht,
+            tu.transpose() * ht,
+            tu.transpose() * hxx * tu,
+        ))
+    }
+
+    /// `weight` times the Hessian blocks at `(x, u)` itself.
+    fn hessian_at_point<const X: usize>(
         &self,
         x: &SVector<f64, X>,
         u: &SVector<f64, N>,
@@ -245,6 +364,7 @@ impl<const N: usize, const K: usize> Inequality<'_, N, K> {
         let overlap = (self.placement.at_nodes() && other.placement.at_nodes())
             || (self.placement.at_midpoints() && other.placement.at_midpoints());
         overlap
+            && self.sample.map(|s| s.fraction) == other.sample.map(|s| s.fraction)
             && match (self.source, other.source) {
                 (Source::Variable(a), Source::Variable(b)) => a == b,
                 (Source::Function(f), Source::Function(g)) => {
@@ -346,6 +466,7 @@ pub(super) fn flat_hessian<const N: usize, const K: usize, const X: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{Gradient, Hessian};
 
     fn side(value: f64, sign: f64, index: usize) -> Inequality<'static, 1, 2> {
         Inequality {
@@ -354,6 +475,110 @@ mod tests {
             sign,
             placement: Placement::Midpoints,
             index,
+            sample: None,
+        }
+    }
+
+    /// $g = q_0^2 q_1' + q_1 \sin q_0'$ on $\mathbb{R}^2$, $k = 2$ (a function of the jet alone).
+    struct Curved;
+
+    impl JetFunction<2, 2> for Curved {
+        fn value(&self, x: &[SVector<f64, 2>; 2], _u: &SVector<f64, 2>) -> f64 {
+            x[0][0] * x[0][0] * x[1][1] + x[0][1] * x[1][0].sin()
+        }
+        fn gradient(&self, x: &[SVector<f64, 2>; 2], _u: &SVector<f64, 2>) -> Gradient<2, 2> {
+            let mut g = Gradient::zeros();
+            g.x[0] = SVector::from([2.0 * x[0][0] * x[1][1], x[1][0].sin()]);
+            g.x[1] = SVector::from([x[0][1] * x[1][0].cos(), x[0][0] * x[0][0]]);
+            g
+        }
+        fn hessian(&self, x: &[SVector<f64, 2>; 2], _u: &SVector<f64, 2>) -> Hessian<2, 2> {
+            let mut h = Hessian::zeros();
+            h.xx[0][0] = SMatrix::from([[2.0 * x[1][1], 0.0], [0.0, 0.0]]);
+            // rows: entries of x_0, columns: entries of x_1 (column-major literals)
+            h.xx[0][1] = SMatrix::from([[0.0, x[1][0].cos()], [2.0 * x[0][0], 0.0]]);
+            h.xx[1][0] = h.xx[0][1].transpose();
+            h.xx[1][1] = SMatrix::from([[-x[0][1] * x[1][0].sin(), 0.0], [0.0, 0.0]]);
+            h
+        }
+        fn involves_top(&self) -> bool {
+            false
+        }
+    }
+
+    /// The sample at tau of (x_theta, u) is the Hermite polynomial between the nodes that the
+    /// scheme's equations give (at tau = 0 and 1 the nodes themselves), for k = 3; and the
+    /// chain rule through it (gradient and Hessian in (x_theta, u)) agrees with central
+    /// differences of the sampled constraint for k = 2.
+    #[test]
+    fn a_sample_is_the_interpolant_and_its_derivatives_follow_the_chain_rule() {
+        let (h, theta) = (0.3, 0.4);
+        // k = 3, n = 1: x_theta = (q, q', q''), u = q'''
+        let (xt, u) = (
+            SVector::<f64, 3>::new(0.2, -1.1, 0.7),
+            SVector::<f64, 1>::new(2.5),
+        );
+        let rate = SVector::<f64, 3>::new(xt[1], xt[2], u[0]);
+        let (start, end) = (xt - rate * (theta * h), xt + rate * ((1.0 - theta) * h));
+        let piece = Hermite::new(start.as_slice(), end.as_slice(), h, 1, 3).unwrap();
+        for tau in [0.0, 0.25, 0.7, 1.0] {
+            let point = Sample::new(tau, h, theta, 3)
+                .unwrap()
+                .point::<1, 3, 3>(&xt, &u);
+            for r in 0..3 {
+                assert!(
+                    (point[r] - piece.jet_entry(r, tau * h)).abs() < 1e-13,
+                    "{tau} {r}"
+                );
+            }
+        }
+        // k = 2, n = 2: the chain rule against differences in (x_theta, u)
+        let c = Inequality {
+            source: Source::Function(&Curved),
+            value: 0.1,
+            sign: -1.0,
+            placement: Placement::NodesAndMidpoints,
+            index: 0,
+            sample: Sample::new(0.3, h, theta, 2),
+        };
+        let (x, u) = (
+            SVector::<f64, 4>::new(0.4, -0.3, 1.2, 0.8),
+            SVector::<f64, 2>::new(-0.6, 1.5),
+        );
+        let lin = c.linearize(&x, &u);
+        let (hxx, hux, huu) = c.weighted_hessian(&x, &u, 1.0).unwrap();
+        let pick = |l: &Linearized<2, 4>, s: usize| if s < 4 { l.gx[s] } else { l.gu[s - 4] };
+        let e = 1e-6;
+        for r in 0..6 {
+            let moved = |d: f64| {
+                let (mut x, mut u) = (x, u);
+                if r < 4 {
+                    x[r] += d;
+                } else {
+                    u[r - 4] += d;
+                }
+                (x, u)
+            };
+            let ((xp, up), (xm, um)) = (moved(e), moved(-e));
+            let slope = (c.value(&xp, &up) - c.value(&xm, &um)) / (2.0 * e);
+            assert!(
+                (slope - pick(&lin, r)).abs() < 1e-8,
+                "gradient {r}: {slope}"
+            );
+            let (gp, gm) = (c.linearize(&xp, &up), c.linearize(&xm, &um));
+            for s in 0..6 {
+                let fd = (pick(&gp, s) - pick(&gm, s)) / (2.0 * e);
+                let exact = match (r < 4, s < 4) {
+                    (true, true) => hxx[(s, r)],
+                    (true, false) => hux[(s - 4, r)],
+                    (false, true) => hux[(r - 4, s)],
+                    (false, false) => huu[(s - 4, r - 4)],
+                };
+                assert!(
+                    (fd - exact).abs() < 1e-7,
+                    "hessian ({r}, {s}): {fd} vs {exact}"
+                );
+            }
         }
     }
 

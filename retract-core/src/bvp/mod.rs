@@ -91,7 +91,7 @@ pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use duals::Duals;
 pub use extrapolate::Extrapolated;
-pub use optimize::{OptimalControlProblem, PlanGuess, PlanOptions};
+pub use optimize::{MAX_INTERIOR_SAMPLES, OptimalControlProblem, PlanGuess, PlanOptions};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 

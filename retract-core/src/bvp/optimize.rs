@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::SVector;
 
-use super::constraints::{Inequality, Placement};
+use super::constraints::{Inequality, Placement, SAMPLE_MAX_ORDER, Sample};
 use super::curve::Curve;
 use super::guess::Hermite;
 use super::plan::{Failure, Plan, PlanError, RealTime};
@@ -81,7 +81,19 @@ pub struct PlanOptions {
     /// [`OptimalControlProblem::solve_real_time`]. The inertia count that proves the reduced
     /// Hessian positive definite is always done.
     pub min_eigenvalue: bool,
+    /// Interior sample points per step (0 by default, at most
+    /// [`MAX_INTERIOR_SAMPLES`]): each constraint placed at the nodes (of the jet alone) is
+    /// also imposed at $t_i + \tau h$, $\tau = j / (m + 1)$, $j = 1, \dots, m$, inside every
+    /// step, on the plan's interpolant written in the step's $(x_\theta, u)$ (exact where the
+    /// scheme's equations hold; a sample at the evaluation point itself is skipped). With
+    /// $m = 15$ the samples are the points [`super::Violations::interpolant`] checks, so a
+    /// certified plan's interpolant violation is within the tolerance there. Orders $k \le 4$.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub interior_samples: usize,
 }
+
+/// The most interior samples per step ([`PlanOptions::interior_samples`]).
+pub const MAX_INTERIOR_SAMPLES: usize = 63;
 
 impl Default for PlanOptions {
     fn default() -> Self {
@@ -97,6 +109,7 @@ impl Default for PlanOptions {
             max_backtracks: 40,
             initial_barrier: 0.1,
             min_eigenvalue: true,
+            interior_samples: 0,
         }
     }
 }
@@ -125,6 +138,12 @@ impl PlanOptions {
     /// Also computes the smallest eigenvalue of the reduced Hessian for the certificate.
     pub fn with_min_eigenvalue(mut self, min_eigenvalue: bool) -> Self {
         self.min_eigenvalue = min_eigenvalue;
+        self
+    }
+    /// Imposes the constraints of the jet alone at `samples` interior points of every step
+    /// too ([`Self::interior_samples`]).
+    pub fn with_interior_samples(mut self, samples: usize) -> Self {
+        self.interior_samples = samples;
         self
     }
     /// Sets the chord spacing and the cap on chord pieces of the singularity guard
@@ -299,6 +318,28 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         self.t_end / self.steps as f64
     }
 
+    /// The constraints placed at the nodes, again at each interior sample of the steps
+    /// ([`PlanOptions::interior_samples`]; sample-major), for jets of order `k`.
+    fn interior_samples(&self, k: usize) -> Vec<Inequality<'a, N, K>> {
+        let (m, theta) = (self.options.interior_samples, self.options.theta);
+        let mut out = Vec::new();
+        for j in 1..=m {
+            let fraction = j as f64 / (m + 1) as f64;
+            if fraction == theta {
+                continue;
+            }
+            let Some(sample) = Sample::new(fraction, self.h(), theta, k) else {
+                continue;
+            };
+            let nodes = self.inequalities.iter().filter(|c| c.placement.at_nodes());
+            out.extend(nodes.map(|c| Inequality {
+                sample: Some(sample),
+                ..*c
+            }));
+        }
+        out
+    }
+
     fn validate(&self, n: usize, k: usize) -> Result<(), Error> {
         let invalid = |name, requirement| Err(Error::InvalidArgument { name, requirement });
         let o = &self.options;
@@ -354,6 +395,14 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             return invalid(
                 "options",
                 "need a finite tolerance > 0 and max_iterations >= 1",
+            );
+        }
+        if o.interior_samples > MAX_INTERIOR_SAMPLES
+            || (o.interior_samples > 0 && k > SAMPLE_MAX_ORDER)
+        {
+            return invalid(
+                "options",
+                "at most 63 interior samples per step, for orders k <= 4",
             );
         }
         if !(o.initial_barrier.is_finite() && o.initial_barrier > 0.0) {
@@ -472,13 +521,15 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         }
         let placed = |at: fn(Placement) -> bool| {
             let list = self.inequalities.iter().filter(|c| at(c.placement));
-            list.copied().collect()
+            list.copied().collect::<Vec<_>>()
         };
+        let mut at_steps = placed(Placement::at_midpoints);
+        at_steps.extend(self.interior_samples(K));
         Sqp::<Sys, N, K, X, S, M> {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started,
-            at_steps: placed(Placement::at_midpoints),
+            at_steps,
             // (at theta = 0 or 1 the evaluation points are nodes: no second copy there)
             at_nodes: if self.options.theta == 0.0 || self.options.theta == 1.0 {
                 placed(|p| p == Placement::Nodes)
