@@ -4,6 +4,13 @@
 //! its id, so common subexpressions are shared by construction. Constructors simplify:
 //! constant folding, `x + 0`, `x * 1`, `x * 0`, `-(-x)`, `x - x`, `x^0`, `x^1`, and
 //! commutative operands in a canonical order.
+//!
+//! While the user's function is lowered ([`Graph::keep_domain`]), folds that would change
+//! it where it is not finite are not made: `x / x`, `0 / x` stay unless `x` is a constant,
+//! and `0 * x`, `x - x`, `(x - b) + b` and `a - (a - c)` unless the expression folded away is
+//! total (finite wherever the jet is: no division, negative power, `powf`, or function with a
+//! restricted domain). The derivatives built afterwards fold freely: they are needed only
+//! where the function is finite.
 
 use std::collections::HashMap;
 
@@ -188,7 +195,12 @@ pub enum Node {
 #[derive(Default, Debug)]
 pub struct Graph {
     nodes: Vec<Node>,
+    /// Whether each node is total (module docs), by id.
+    total: Vec<bool>,
     index: HashMap<Node, Id>,
+    /// Folds keep the function's domain (module docs): set while the user's function is
+    /// lowered.
+    pub keep_domain: bool,
     /// Source text of the named constants (paths), for emission.
     pub named: Vec<String>,
 }
@@ -240,9 +252,52 @@ impl Graph {
         for child in children(&node) {
             assert!(child < id, "children before parents");
         }
+        let total = self.node_is_total(&node);
         self.nodes.push(node.clone());
+        self.total.push(total);
         self.index.insert(node, id);
         id
+    }
+
+    /// Whether `node` is finite wherever its children are and the jet is (finite constants,
+    /// symbols, `+ - *`, non-negative powers, entire functions; `exp` counts though it
+    /// overflows).
+    fn node_is_total(&self, node: &Node) -> bool {
+        let all = |ids: &[Id]| ids.iter().all(|c| self.total[c.0 as usize]);
+        match node {
+            Node::Const(bits) => f64::from_bits(*bits).is_finite(),
+            Node::Var(_) | Node::Named(_) => true,
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) => all(&[*a, *b]),
+            Node::Atan2(a, b) | Node::Hypot(a, b) => all(&[*a, *b]),
+            Node::Neg(a) => all(&[*a]),
+            Node::Powi(a, n) => *n >= 0 && all(&[*a]),
+            Node::Unary(f, a) => {
+                let entire = matches!(
+                    f,
+                    Func::Exp
+                        | Func::Sin
+                        | Func::Cos
+                        | Func::Tanh
+                        | Func::Abs
+                        | Func::Signum
+                        | Func::Atan
+                        | Func::Sinh
+                        | Func::Cosh
+                        | Func::Cbrt
+                        | Func::ExpM1
+                        | Func::Stumpff(_)
+                );
+                entire && all(&[*a])
+            }
+            Node::Sum { body, .. } => all(&[*body]),
+            Node::Div(..) | Node::Powf(..) => false,
+        }
+    }
+
+    /// Whether folding `id` away keeps the function (always, unless [`Self::keep_domain`]
+    /// asks for a total `id`).
+    fn foldable(&self, id: Id) -> bool {
+        !self.keep_domain || self.total[id.0 as usize]
     }
 
     /// The constant `value`, by its bits: `-0.0` stays negative (`1 / -0.0` is `-inf`) and
@@ -303,12 +358,14 @@ impl Graph {
         if let Node::Sub(x, c) = *self.node(a)
             && c == b
             && !self.is_non_finite(b)
+            && self.foldable(b)
         {
             return x;
         }
         if let Node::Sub(x, c) = *self.node(b)
             && c == a
             && !self.is_non_finite(a)
+            && self.foldable(a)
         {
             return x;
         }
@@ -321,7 +378,7 @@ impl Graph {
         if let (Some(x), Some(y)) = (self.as_const(a), self.as_const(b)) {
             return self.constant(x - y);
         }
-        if a == b {
+        if a == b && self.foldable(a) {
             return self.constant(0.0);
         }
         match (self.as_const(a), self.as_const(b)) {
@@ -336,12 +393,14 @@ impl Graph {
         if let Node::Sub(x, c) = *self.node(b)
             && x == a
             && !self.is_non_finite(a)
+            && self.foldable(a)
         {
             return c;
         }
         if let Node::Sub(x, c) = *self.node(a)
             && x == b
             && !self.is_non_finite(b)
+            && self.foldable(b)
         {
             return self.neg(c);
         }
@@ -351,7 +410,8 @@ impl Graph {
     pub fn mul(&mut self, a: Id, b: Id) -> Id {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x * y),
-            (Some(0.0), _) | (_, Some(0.0)) => return self.constant(0.0),
+            (Some(0.0), _) if self.foldable(b) => return self.constant(0.0),
+            (_, Some(0.0)) if self.foldable(a) => return self.constant(0.0),
             (Some(1.0), _) => return b,
             (_, Some(1.0)) => return a,
             (Some(-1.0), _) => return self.neg(b),
@@ -391,12 +451,12 @@ impl Graph {
         match (self.as_const(a), self.as_const(b)) {
             // exactly as f64 evaluates it: 0 / 0 is NaN, x / 0 is +-inf
             (Some(x), Some(y)) => return self.constant(x / y),
-            (Some(0.0), _) => return self.constant(0.0),
+            (Some(0.0), _) if !self.keep_domain => return self.constant(0.0),
             (_, Some(1.0)) => return a,
             (_, Some(-1.0)) => return self.neg(a),
             _ => {}
         }
-        if a == b {
+        if a == b && !self.keep_domain {
             return self.constant(1.0);
         }
         self.add(Node::Div(a, b))
@@ -652,5 +712,41 @@ pub mod tests {
         let n = g.neg(x);
         let nn = g.neg(n);
         assert_eq!(nn, x);
+    }
+
+    /// While the user's function is lowered, `x / x`, `0 * (1 / x)`, `0 / x` and `y - y`,
+    /// `(2 - y) + y` for y = 1 / x stay (they are NaN at x = 0, as the function is); folds
+    /// of total expressions (`0 * sin x`, `x - x`) and every fold after the lowering are made.
+    #[test]
+    fn folds_keep_the_domain_while_the_function_is_lowered() {
+        let mut g = Graph::default();
+        let x = q(&mut g, 0);
+        let (zero, one, c) = (g.constant(0.0), g.constant(1.0), g.constant(2.0));
+        g.keep_domain = true;
+        let y = g.div(one, x);
+        let kept = [
+            (g.div(x, x), "(q0_0 / q0_0)"),
+            (g.mul(zero, y), "(0 * (1 / q0_0))"),
+            (g.div(zero, x), "(0 / q0_0)"),
+            (g.sub(y, y), "((1 / q0_0) - (1 / q0_0))"),
+        ];
+        for (id, want) in kept {
+            assert_eq!(show(&g, id), want);
+        }
+        let shifted = g.sub(c, y);
+        assert_ne!(g.add_op(shifted, y), c);
+        let sine = g.unary(Func::Sin, x);
+        let folded = g.mul(zero, sine);
+        assert!(g.is_const(folded, 0.0));
+        let folded = g.sub(x, x);
+        assert!(g.is_const(folded, 0.0));
+        g.keep_domain = false;
+        let folded = g.div(x, x);
+        assert!(g.is_const(folded, 1.0));
+        let folded = g.mul(zero, y);
+        assert!(g.is_const(folded, 0.0));
+        let folded = g.sub(y, y);
+        assert!(g.is_const(folded, 0.0));
+        assert_eq!(g.add_op(shifted, y), c);
     }
 }

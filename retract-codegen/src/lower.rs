@@ -203,9 +203,18 @@ pub struct Lower<'a> {
     top_level: bool,
 }
 
+impl Drop for Lower<'_> {
+    /// The lowering is over: the graph folds freely again (the derivatives).
+    fn drop(&mut self) {
+        self.g.keep_domain = false;
+    }
+}
+
 impl<'a> Lower<'a> {
     /// A lowering context with the arguments of `sig` in scope.
     pub fn new(g: &'a mut Graph, sig: &'a Signature) -> Self {
+        // folds keep the user's function where it is not finite until the lowering ends
+        g.keep_domain = true;
         let mut top = HashMap::new();
         for (position, name) in sig.jet.iter().enumerate() {
             // a map's (q, v) is the 2n-dimensional point (q, v) of order 0

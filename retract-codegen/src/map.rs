@@ -203,6 +203,20 @@ mod tests {
         assert!(out.contains("fn m("), "{out}");
     }
 
+    /// `v * sqrt(q0 - 5) / sqrt(q0 - 5)` is not `v` (it is NaN for q0 < 5): the points are
+    /// computed as written (before, the quotient was folded to 1 and the map was defined
+    /// everywhere); the conditions hold where it is defined.
+    #[test]
+    fn a_quotient_of_equal_factors_is_not_folded_out_of_the_map() {
+        let guarded = "q[0] + v[0] * (q[0] - 5.0).sqrt() / (q[0] - 5.0).sqrt()";
+        let out = map("order = 1", ["q[0]", "q[1]"], [guarded, "q[1] + v[1]"]).unwrap();
+        let points = &out[out.find("fn points(").unwrap()..out.find("fn jacobians(").unwrap()];
+        assert!(
+            points.contains(".sqrt()") && points.contains(" / "),
+            "{points}"
+        );
+    }
+
     #[test]
     fn the_conditions_are_checked_at_compile_time() {
         let ok = |r1: [&str; 2], r2: [&str; 2]| map("order = 1", r1, r2);

@@ -211,3 +211,43 @@ fn every_guarded_kind_is_checked() {
     let z0 = WithSqrt {}.legendre(&SVector::from([1.0, -1.0]));
     assert!(step(&WithSqrt {}, &z0, 0.06, &StepOptions::default()).is_ok());
 }
+
+/// `q[1] / q[1] + 0.0 * (1.0 / q[0])` is NaN where q[1] = 0 or q[0] = 0, and 1 elsewhere.
+#[higher_order_lagrangian(order = 2)]
+fn folded_terms(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+    0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1]) + q[1] / q[1] + 0.0 * (1.0 / q[0])
+}
+
+/// Folding keeps the domain: the generated L equals the function as written, NaN where it
+/// is (before, `x / x -> 1` and `0 * x -> 0` made it 1 + 1/2 |u|^2 everywhere), and a step
+/// across q[0] = 0 is refused by the guard, naming the denominator.
+#[test]
+fn folded_terms_keep_the_function_and_its_guard() {
+    use retract::Lagrangian;
+    let system = FoldedTerms {};
+    let u = SVector::from([0.3, -0.4]);
+    let at = |q0: f64, q1: f64| {
+        let x = [SVector::from([q0, q1]), SVector::from([0.2, 0.1])];
+        (
+            system.lagrangian(&x, &u),
+            folded_terms([q0, q1], [0.2, 0.1], [0.3, -0.4]),
+        )
+    };
+    let (generated, written) = at(0.7, -1.2);
+    assert!((generated - written).abs() < 1e-15 && (generated - 1.125).abs() < 1e-15);
+    for (q0, q1) in [(0.0, 1.0), (1.0, 0.0)] {
+        let (generated, written) = at(q0, q1);
+        assert!(
+            generated.is_nan() && written.is_nan(),
+            "{generated} at ({q0}, {q1})"
+        );
+    }
+    // moving right through q[0] = 0 at unit speed
+    let z0 = system.legendre(&SVector::from([-0.05, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]));
+    match step(&system, &z0, 0.1, &StepOptions::default()) {
+        Err(Error::Domain(v)) => {
+            assert_eq!((v.kind, v.expression), (DomainKind::Denominator, "q[0]"));
+        }
+        other => panic!("a step across q[0] = 0: {other:?}"),
+    }
+}
