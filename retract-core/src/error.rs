@@ -162,6 +162,16 @@ pub enum Error {
         /// The clearance there.
         clearance: f64,
     },
+    /// A converged boundary-value solution's step `step` leaves the domain of the Lagrangian
+    /// (the step's singularity guard, [`crate::step::check_step_domain`]: a pole at its
+    /// evaluation point or between its nodes, e.g. a path through an obstacle whose barrier
+    /// is a term of $L$): the solution is not a plan.
+    SolutionOutsideDomain {
+        /// Index of the step.
+        step: usize,
+        /// The violated condition.
+        violation: DomainViolation,
+    },
     /// The first guess of a boundary-value solve passes through obstacle `obstacle` (at
     /// state `step`), so Newton cannot pick a side of it.
     GuessThroughObstacle {
@@ -413,6 +423,12 @@ impl fmt::Display for Error {
                 "the solution passes through obstacle {obstacle} (clearance {clearance:e} at \
                  state {step}); inside an obstacle the cost is unbounded below, so this is not \
                  a plan: start from a guess that goes around it or raise the barrier weight"
+            ),
+            Error::SolutionOutsideDomain { step, violation } => write!(
+                f,
+                "the solution's step {step} leaves the domain of the Lagrangian ({violation}): \
+                 a pole lies on it, so this is not a plan; use more steps or a guess that stays \
+                 clear of the singular set (around an obstacle, not through it)"
             ),
             Error::GuessThroughObstacle {
                 obstacle,

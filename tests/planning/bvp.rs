@@ -434,3 +434,25 @@ fn linear_solvers_agree() {
         }
     }
 }
+
+/// A converged solution whose step crosses a pole of L between its nodes is refused with the
+/// step named (the guard of every step, as a step runs it), not returned as a plan: a small
+/// disc between the nodes of a coarse transcription (N = 4 and 6, whose guesses and
+/// solutions keep every node outside it; before, both were returned as plans).
+#[test]
+fn a_solution_through_a_pole_between_its_nodes_is_refused() {
+    let (start, goal) = (
+        [-2.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    );
+    for (steps, crossing) in [(4, 2), (6, 3)] {
+        match solve_scene(&[[0.7, 0.02, 0.2]], 1e-3, &start, &goal, 4.0, steps) {
+            Err(Error::SolutionOutsideDomain { step, violation }) => {
+                assert_eq!(step, crossing);
+                assert_eq!(violation.kind, retract::DomainKind::Denominator);
+                assert_eq!(violation.element, Some(0));
+            }
+            other => panic!("N = {steps}: {other:?}"),
+        }
+    }
+}

@@ -20,7 +20,9 @@
 //! (warm start, [`BvpSolution::shifted`] for receding horizons, [`continuation`] in a
 //! parameter). A solution whose clearance to an obstacle is negative is an error
 //! ([`Error::ThroughObstacle`]): inside an obstacle the cost is unbounded below, so such a
-//! stationary point is not a plan.
+//! stationary point is not a plan; so is one with a step that the singularity guard refuses,
+//! run on every step as a step runs it, between the nodes too
+//! ([`Error::SolutionOutsideDomain`]).
 
 //!
 //! It solves the KKT system of the transcription without looking at the cost, so it can stop
@@ -565,7 +567,8 @@ where
     /// [`Error::GuessThroughObstacle`] for a first guess through an obstacle; Newton failures
     /// ([`Error::NonFinite`], [`Error::SingularJacobian`],
     /// [`Error::BoundaryValueLineSearchFailed`], [`Error::BoundaryValueNoConvergence`]);
-    /// [`Error::ThroughObstacle`] for a solution with negative clearance.
+    /// [`Error::ThroughObstacle`] for a solution with negative clearance;
+    /// [`Error::SolutionOutsideDomain`] for one with a step the singularity guard refuses.
     pub fn solve(&self, guess: Guess<'_, S, M>) -> Result<BvpSolution<S, M>, Error> {
         let system = self.system;
         let (h, theta) = (self.h(), self.options.theta);
@@ -789,6 +792,18 @@ where
         None
     }
 
+    /// The singularity guard of every step of a converged solution, as a step runs it
+    /// ([`crate::step::check_step_domain`]: the evaluation point, both nodes and the chord
+    /// between them).
+    fn guard(&self, states: &[SVector<f64, S>], unknowns: &[SVector<f64, M>]) -> Result<(), Error> {
+        let options = crate::StepOptions::default().with_theta(self.options.theta);
+        for (step, (z0, w)) in states.iter().zip(unknowns).enumerate() {
+            crate::step::check_step_domain(self.system, z0, w, &options)
+                .map_err(|violation| Error::SolutionOutsideDomain { step, violation })?;
+        }
+        Ok(())
+    }
+
     fn finish(
         &self,
         v: &[f64],
@@ -817,6 +832,7 @@ where
                 clearance,
             });
         }
+        self.guard(&states, &unknowns)?;
         let mut clearance = Vec::new();
         if let Some((count, f)) = self.clearance {
             clearance = filled(count, f64::INFINITY, "obstacles")?;
