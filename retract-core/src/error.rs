@@ -101,6 +101,37 @@ fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Res
     element(f, violation)
 }
 
+impl Error {
+    /// The guard's violation of [`Error::SolutionOutsideDomain`] as a [`DomainViolation`]
+    /// (`None` for the other variants).
+    pub fn solution_violation(&self) -> Option<DomainViolation> {
+        match *self {
+            Error::SolutionOutsideDomain {
+                expression,
+                kind,
+                element,
+                ..
+            } => Some(DomainViolation {
+                expression,
+                kind,
+                element: element.map(|k| k as usize),
+            }),
+            _ => None,
+        }
+    }
+
+    /// [`Error::SolutionOutsideDomain`] at `step` for `violation`.
+    pub(crate) fn solution_outside_domain(step: usize, violation: DomainViolation) -> Self {
+        let index = |k: usize| u32::try_from(k).unwrap_or(u32::MAX);
+        Error::SolutionOutsideDomain {
+            step: index(step),
+            expression: violation.expression,
+            kind: violation.kind,
+            element: violation.element.map(index),
+        }
+    }
+}
+
 /// Why a solve or a step failed.
 ///
 /// Every variant carries the data needed to act on it; the [`Display`](fmt::Display)
@@ -166,11 +197,17 @@ pub enum Error {
     /// (the step's singularity guard, [`crate::step::check_step_domain`]: a pole at its
     /// evaluation point or between its nodes, e.g. a path through an obstacle whose barrier
     /// is a term of $L$): the solution is not a plan.
+    /// (The violation's fields are held flat, the indices as `u32`, so that an error stays
+    /// small enough to be returned by value: [`Self::solution_violation`] gives it whole.)
     SolutionOutsideDomain {
-        /// Index of the step.
-        step: usize,
-        /// The violated condition.
-        violation: DomainViolation,
+        /// Index of the step (saturated at `u32::MAX`).
+        step: u32,
+        /// The guarded expression as written in the Lagrangian.
+        expression: &'static str,
+        /// The condition it violated.
+        kind: DomainKind,
+        /// For an expression inside a loop over a slice parameter: the element's index.
+        element: Option<u32>,
     },
     /// The first guess of a boundary-value solve passes through obstacle `obstacle` (at
     /// state `step`), so Newton cannot pick a side of it.
@@ -424,11 +461,16 @@ impl fmt::Display for Error {
                  state {step}); inside an obstacle the cost is unbounded below, so this is not \
                  a plan: start from a guess that goes around it or raise the barrier weight"
             ),
-            Error::SolutionOutsideDomain { step, violation } => write!(
+            Error::SolutionOutsideDomain { step, .. } => write!(
                 f,
                 "the solution's step {step} leaves the domain of the Lagrangian ({violation}): \
                  a pole lies on it, so this is not a plan; use more steps or a guess that stays \
-                 clear of the singular set (around an obstacle, not through it)"
+                 clear of the singular set (around an obstacle, not through it)",
+                violation = self.solution_violation().unwrap_or(DomainViolation {
+                    expression: "",
+                    kind: DomainKind::Denominator,
+                    element: None,
+                })
             ),
             Error::GuessThroughObstacle {
                 obstacle,

@@ -213,6 +213,7 @@ fn every_guarded_kind_is_checked() {
 }
 
 /// `q[1] / q[1] + 0.0 * (1.0 / q[0])` is NaN where q[1] = 0 or q[0] = 0, and 1 elsewhere.
+#[allow(clippy::eq_op)]
 #[higher_order_lagrangian(order = 2)]
 fn folded_terms(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
     0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1]) + q[1] / q[1] + 0.0 * (1.0 / q[0])

@@ -447,10 +447,15 @@ fn a_solution_through_a_pole_between_its_nodes_is_refused() {
     );
     for (steps, crossing) in [(4, 2), (6, 3)] {
         match solve_scene(&[[0.7, 0.02, 0.2]], 1e-3, &start, &goal, 4.0, steps) {
-            Err(Error::SolutionOutsideDomain { step, violation }) => {
+            Err(error @ Error::SolutionOutsideDomain { step, .. }) => {
                 assert_eq!(step, crossing);
+                let violation = error.solution_violation().expect("the violation");
                 assert_eq!(violation.kind, retract::DomainKind::Denominator);
                 assert_eq!(violation.element, Some(0));
+                assert!(
+                    error.to_string().contains(&format!("step {crossing} ")),
+                    "{error}"
+                );
             }
             other => panic!("N = {steps}: {other:?}"),
         }

@@ -799,7 +799,7 @@ where
         let options = crate::StepOptions::default().with_theta(self.options.theta);
         for (step, (z0, w)) in states.iter().zip(unknowns).enumerate() {
             crate::step::check_step_domain(self.system, z0, w, &options)
-                .map_err(|violation| Error::SolutionOutsideDomain { step, violation })?;
+                .map_err(|violation| Error::solution_outside_domain(step, violation))?;
         }
         Ok(())
     }
