@@ -7,7 +7,7 @@
 //! out of range is an error naming the key, and the example exits with status 1):
 //!
 //! ```toml
-//! horizon = 4.0            # T
+//! horizon = 4.0            # T (at least 0.01)
 //! steps = 400              # N (h = T / N)
 //! barrier = 1e-2           # tau of the final solve
 //! continuation = [1.0, 0.1] # optional: barrier weights solved first, each a warm start

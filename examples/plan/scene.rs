@@ -2,7 +2,7 @@
 //! ignored) and every value checked, with messages that name the key.
 //!
 //! ```toml
-//! horizon = 4.0             # T, finite and > 0
+//! horizon = 4.0             # T, finite and >= 0.01 (MIN_HORIZON)
 //! steps = 400               # N >= 1 (h = T / N)
 //! barrier = 1e-2            # tau of the final solve, finite and > 0
 //! continuation = [1.0, 0.1] # optional: barrier weights solved first, each finite and > 0
@@ -26,8 +26,16 @@ use serde::Deserialize;
 /// first guess in memory.
 pub const MAX_STEPS: i64 = 1_000_000;
 
-/// A checked scene: every number finite, the horizon, barrier weights and radii positive,
-/// at least one step.
+/// The shortest horizon a scene may ask for. The planner's first guess is differentiated
+/// over fixed time offsets of up to about 1e-3 (the central differences of `Curve::from_fn`,
+/// eps^(1/5) = 7e-4 for the third derivative, and the guess's own pushes around the discs),
+/// so the horizon must be long against them: over a shorter one the guess is sampled far
+/// outside [0, T], where its Hermite path in t / T grows without bound (at T = 1e-300 it
+/// overflowed, and the error blamed the guess's curve instead of the horizon).
+pub const MIN_HORIZON: f64 = 0.01;
+
+/// A checked scene: every number finite, the horizon at least [`MIN_HORIZON`], barrier
+/// weights and radii positive, at least one step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// The horizon T.
@@ -247,6 +255,14 @@ impl RawBoundary {
 impl RawScene {
     fn check(&self) -> Result<Scene, Reason> {
         let horizon = positive("horizon", self.horizon)?;
+        if horizon < MIN_HORIZON {
+            return Err(invalid(
+                "horizon",
+                "at least 0.01 (MIN_HORIZON: the first guess is differentiated over time \
+                 offsets of up to 1e-3)",
+                format!("{horizon:e}"),
+            ));
+        }
         let steps = usize::try_from(self.steps)
             .ok()
             .filter(|_| (1..=MAX_STEPS).contains(&self.steps))
@@ -510,6 +526,20 @@ radius = 0.5
         for (from, to, expected) in cases {
             contains_all(&message(&edit(from, to)), &[expected]);
         }
+    }
+
+    /// A positive horizon too short for the first guess (issue 33, item 7: 1e-300 failed with
+    /// an error about the guess's `curve`) is named as the horizon.
+    #[test]
+    fn a_horizon_too_short_for_the_guess_is_named() {
+        for (value, got) in [("1e-300", "got 1e-300"), ("1e-3", "got 1e-3")] {
+            contains_all(
+                &message(&edit("horizon", &format!("horizon = {value}"))),
+                &["horizon must be at least 0.01", got],
+            );
+        }
+        let shortest = parse(&edit("horizon", "horizon = 0.01")).expect("valid");
+        assert_eq!(shortest.horizon, MIN_HORIZON);
     }
 
     #[test]

@@ -71,6 +71,8 @@ pub mod newton;
 pub mod output;
 pub mod reduced;
 pub mod se3;
+#[cfg(all(feature = "serde", feature = "std"))]
+mod serde_float;
 pub mod so3;
 pub mod special;
 pub mod sphere;

@@ -890,13 +890,13 @@ where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
     /// `steps` reduced steps of size `h` from `z0`, with the driver of [`crate::trajectory`]
-    /// (the initial state checked against the domain, step halving, domain crossing
+    /// (the parameters and the initial state checked, step halving, domain crossing
     /// location).
     ///
     /// # Errors
-    /// [`crate::Interrupted`] with the states before the failed step; a `z0` outside the
-    /// domain of the Lagrangian is [`Error::InitialStateOutsideDomain`] at step 0, as in
-    /// [`crate::trajectory`].
+    /// [`crate::Interrupted`] with the states before the failed step; a non-finite parameter
+    /// is [`Error::NonFiniteParameter`] and a `z0` outside the domain of the Lagrangian
+    /// [`Error::InitialStateOutsideDomain`] at step 0, as in [`crate::trajectory`].
     pub fn trajectory(
         &mut self,
         z0: &SVector<f64, S>,

@@ -36,6 +36,11 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// The longest jet handled here: $q, \dots, q^{(2k-1)}$ for $k \le 4$.
 const MAX_JET: usize = 8;
 
+/// How far from orthonormal a chart frame, and from the unit sphere a state's point, may be
+/// ([`SphereState::validate`]): both are exact to rounding ($\sim 10^{-16}$) for every state
+/// built here.
+const ON_SPHERE: f64 = 1e-12;
+
 /// A jet of vectors, $w^{(0)}, \dots$ (the first `len` entries are used).
 type Jet<const D: usize> = [SVector<f64, D>; MAX_JET];
 
@@ -332,6 +337,42 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
         Ok(Self { chart, z })
     }
 
+    /// Whether this is a state on the sphere (one read back from a file, or written field by
+    /// field, holds whatever numbers it was given): its chart frame $(c, e_1, e_2)$
+    /// orthonormal to $10^{-12}$, $z$ finite, and its point $\varphi(y)$ a unit vector to
+    /// $10^{-12}$. Chart coordinates $y$ so large that $|c + y_0 e_1 + y_1 e_2|$ overflows
+    /// put the point at $(0, 0, 0)$ (or NaN): such a state is refused. [`step`] and
+    /// [`Self::recentred`] run it first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `chart` for a frame that is not orthonormal, named
+    /// `state` for a point off the unit sphere; [`Error::NonFinite`] for a non-finite $z$.
+    pub fn validate(&self) -> Result<(), Error> {
+        let f = self.chart.frame();
+        let gram = f.transpose() * f - Matrix3::identity();
+        if !gram.iter().all(|g| g.abs() <= ON_SPHERE) {
+            return Err(Error::InvalidArgument {
+                name: "chart",
+                requirement: "its frame (c, e1, e2) must be orthonormal to 1e-12",
+            });
+        }
+        if !self.z.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite {
+                iteration: 0,
+                location: "state",
+            });
+        }
+        let off = (self.point().norm() - 1.0).abs();
+        if off.is_nan() || off > ON_SPHERE {
+            return Err(Error::InvalidArgument {
+                name: "state",
+                requirement: "its point phi(y) must lie on the unit sphere to 1e-12: chart \
+                              coordinates y so large that |c + y0 e1 + y1 e2| overflows do not",
+            });
+        }
+        Ok(())
+    }
+
     /// The chart jet $x$ and momenta $p$.
     fn parts(&self) -> (Blocks<2, K>, Blocks<2, K>) {
         let () = Self::SIZES;
@@ -400,8 +441,9 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
     /// The state in the chart centred at its point (the frame carried from the current one).
     ///
     /// # Errors
-    /// As [`Self::in_chart`].
+    /// As [`Self::validate`] and [`Self::in_chart`].
     pub fn recentred(&self) -> Result<Self, Error> {
+        self.validate()?;
         self.in_chart(&self.chart.carried_to(&self.point()))
     }
 
@@ -442,7 +484,9 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
 /// or [`SphereState::from_ambient`]), then written in the chart centred at the new point.
 ///
 /// # Errors
-/// Those of [`crate::map::step`] and of the chart change [`SphereState::in_chart`].
+/// Those of [`SphereState::validate`] for `state` (a chart frame that is not orthonormal, a
+/// non-finite state, a point off the unit sphere, e.g. chart coordinates that overflow it), of
+/// [`crate::map::step`] and of the chart change [`SphereState::recentred`].
 pub fn step<Sys, Map, const K: usize, const S: usize, const M: usize>(
     system: &Sys,
     map: &Map,
@@ -454,6 +498,7 @@ where
     Sys: SphereSystem + Lagrangian<2, K> + LiftedSystem<S, M>,
     Map: SphereMap<K>,
 {
+    state.validate()?;
     let params = state.chart.params();
     let (z, report) = crate::map::step(
         &system.with_chart(params),

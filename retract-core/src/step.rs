@@ -317,10 +317,13 @@ where
     system.check_domain(a, &unknowns_at::<S, M>(b, u), 1.0)
 }
 
-/// The initial state of a trajectory against the domain of the Lagrangian
-/// ([`check_point_domain`]), with its own top derivative (from the predictor; zero if the
-/// vector field cannot be evaluated there). A finite state that fails is
-/// [`Error::InitialStateOutsideDomain`]; non-finite states are left to the driver.
+/// The parameters of the system ([`LiftedSystem::check_parameters`]), then the initial state
+/// of a trajectory against the domain of the Lagrangian ([`check_point_domain`]), with its
+/// own top derivative (from the predictor; zero if the vector field cannot be evaluated
+/// there). A non-finite parameter is [`Error::NonFiniteParameter`], whatever the options (a
+/// guarded expression that holds it is not finite at any state, which is no fault of the
+/// state); a finite state that fails is [`Error::InitialStateOutsideDomain`]; non-finite
+/// states are left to the driver.
 #[cfg(feature = "std")]
 fn check_initial_state<Sys, const S: usize, const M: usize>(
     system: &Sys,
@@ -330,6 +333,7 @@ fn check_initial_state<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
+    system.check_parameters()?;
     if !options.check_domain || !z0.iter().all(|v| v.is_finite()) {
         return Ok(());
     }
@@ -677,19 +681,20 @@ impl<F, const S: usize> OneStep<S> for F where
 /// # Ok::<(), retract_core::Interrupted<8>>(())
 /// ```
 ///
-/// With [`StepOptions::check_domain`] on, `z0` itself is checked first: a state where a
-/// guarded expression of $L$ fails (a denominator vanishes, a `sqrt` argument is negative, an
-/// `ln` argument is not positive) stops the trajectory at step 0 with
-/// [`Error::InitialStateOutsideDomain`] (no state kept). Which side of a denominator's zero
+/// Before the first step the parameters are checked: a non-finite one stops the trajectory
+/// at step 0 with [`Error::NonFiniteParameter`] naming it. With [`StepOptions::check_domain`]
+/// on, `z0` itself is checked next: a state where a guarded expression of $L$ fails (a
+/// denominator vanishes, a `sqrt` argument is negative, an `ln` argument is not positive)
+/// stops the trajectory at step 0 with [`Error::InitialStateOutsideDomain`] (no state kept). Which side of a denominator's zero
 /// `z0` lies on is not known to the guard: a state inside a barrier obstacle
 /// $\tau / (|q - c|^2 - r^2)$ is reported only when a step crosses the circle
 /// ([`Error::Domain`]).
 ///
 /// # Errors
 /// [`Interrupted`], with the trajectory computed so far, at the first failed step (with no
-/// state at all for a non-finite `z0` or one outside the domain, or with
-/// [`Error::InvalidArgument`] for `steps` whose states and reports cannot be allocated, e.g.
-/// $2^{40}$ or `usize::MAX`).
+/// state at all for a non-finite parameter, a non-finite `z0` or one outside the domain, or
+/// with [`Error::InvalidArgument`] for `steps` whose states and reports cannot be allocated,
+/// e.g. $2^{40}$ or `usize::MAX`).
 pub fn trajectory<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,

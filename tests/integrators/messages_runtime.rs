@@ -496,3 +496,62 @@ fn a_nan_parameter_is_named() {
     // finite parameters pass
     assert!(OneDisc { tau: 1e-2 }.check_parameters().is_ok());
 }
+
+/// A NaN parameter inside a guarded expression is named by trajectories as by steps: the
+/// guard is NaN at every state, which is not the initial state's fault (issue 33, item 7).
+#[test]
+fn a_nan_parameter_is_named_by_trajectories() {
+    let finite = [[0.0, -5.0, 1.0]];
+    let z0 = state(
+        &DiscList {
+            tau: 1e-2,
+            discs: &finite,
+        },
+        [-2.0, 0.2, 1.0, 0.0],
+    );
+    // a NaN radius: the guard `(q - c)^2 - r^2` of the disc is NaN everywhere
+    let discs = [[0.0, -5.0, f64::NAN]];
+    let listed = DiscList {
+        tau: 1e-2,
+        discs: &discs,
+    };
+    let named = |error: &Error| {
+        matches!(
+            error,
+            Error::NonFiniteParameter {
+                name: "discs",
+                element: Some(0),
+                index: Some(2)
+            }
+        )
+    };
+    for options in [
+        StepOptions::default(),
+        StepOptions::default().with_domain_check(false),
+    ] {
+        let stop = trajectory(&listed, &z0, 0.01, 10, &options).unwrap_err();
+        assert!(named(&stop.error), "{stop}");
+        assert_eq!((stop.step, stop.trajectory.states.len()), (0, 0), "{stop}");
+        contains_all(
+            &stop.to_string(),
+            &["parameter `discs` element 0 component 2", "not finite"],
+        );
+        assert!(!stop.to_string().contains("initial state"), "{stop}");
+        let stop = ReducedStepper::new(&listed)
+            .trajectory(&z0, 0.01, 10, &options)
+            .unwrap_err();
+        assert!(named(&stop.error), "{stop}");
+        let typed = retract::State::<2, 2>::from_vector(&z0)
+            .trajectory(&listed, 0.01, 10, &options)
+            .unwrap_err();
+        assert!(named(&typed.error), "{typed}");
+    }
+    // a NaN weight outside every guard: named before the first step as well
+    let system = LogDisc { tau: f64::NAN };
+    let z0 = state(&LogDisc { tau: 1e-2 }, [-2.0, 0.2, 1.0, 0.0]);
+    let stop = trajectory(&system, &z0, 0.01, 10, &StepOptions::default()).unwrap_err();
+    assert!(
+        matches!(stop.error, Error::NonFiniteParameter { name: "tau", .. }),
+        "{stop}"
+    );
+}

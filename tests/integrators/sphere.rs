@@ -271,6 +271,67 @@ fn bad_jets_and_far_charts_are_errors() {
     ));
 }
 
+/// A state whose point is not on the unit sphere is refused by a step: chart coordinates so
+/// large that the point overflows to (0, 0, 0) (issue 33, item 8), non-finite ones, and a
+/// chart whose frame is not orthonormal.
+#[test]
+fn a_step_refuses_a_state_off_the_sphere() {
+    let options = NewtonOptions::default();
+    let s = start();
+    let step =
+        |state: &State| sphere::step(&Cubic::new(), &ProjectionMidpoint, state, 0.01, &options);
+    assert!(step(&s).is_ok());
+    // at rest there, the geodesic's step returned Ok with the state unchanged
+    let geodesic = Geodesic::new();
+    let first = SphereState::<1, 4>::from_ambient(&geodesic, &[Vector3::x(), Vector3::y()])
+        .expect("on the sphere");
+    for y in [[1e200, 0.0], [1e200, 1e200], [0.0, -1e160]] {
+        let mut far = first;
+        far.z = SVector::from([y[0], y[1], 0.0, 0.0]);
+        let result = sphere::step(&geodesic, &ProjectionMidpoint, &far, 0.1, &options);
+        assert!(
+            matches!(result, Err(Error::InvalidArgument { name: "state", .. })),
+            "{y:?}: {result:?}"
+        );
+    }
+    for y in [1e200, -1e200, 1e160, f64::MAX] {
+        let mut far = s;
+        far.z[0] = y;
+        assert!(far.point().norm() < 0.5, "{y:e}: {}", far.point());
+        let error = step(&far).expect_err("a point off the sphere");
+        assert!(
+            matches!(error, Error::InvalidArgument { name: "state", .. }),
+            "{y:e}: {error:?}"
+        );
+        assert!(error.to_string().contains("unit sphere"), "{error}");
+    }
+    for bad in [f64::NAN, f64::INFINITY] {
+        for index in [1, 5] {
+            let mut broken = s;
+            broken.z[index] = bad;
+            let error = step(&broken).expect_err("a non-finite state");
+            assert!(
+                matches!(
+                    error,
+                    Error::NonFinite { .. } | Error::InvalidArgument { .. }
+                ),
+                "{error:?}"
+            );
+        }
+    }
+    let mut skewed = s;
+    skewed.chart.centre *= 2.0;
+    let error = step(&skewed).expect_err("a frame that is not orthonormal");
+    assert!(
+        matches!(error, Error::InvalidArgument { name: "chart", .. }),
+        "{error:?}"
+    );
+    // far but representable: a point near the chart's equator is still a point of the sphere
+    let mut wide = s;
+    wide.z[0] = 1e6;
+    assert!((wide.point().norm() - 1.0).abs() < 1e-15);
+}
+
 /// The chart jet (y, y') of an ambient (q, q') as the optimizer's boundary data.
 fn boundary(chart: &Chart, jet: &[Vector3<f64>; 2]) -> [f64; 4] {
     let [y, dy] = chart.coordinates(jet).expect("in the chart");

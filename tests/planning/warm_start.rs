@@ -90,3 +90,18 @@ fn a_plan_past_the_soft_disc_warm_starts_a_nearby_start() {
         assert_warm_matches_cold(&warm, &cold, 1e-9, &format!("dy = {dy}"));
     }
 }
+
+/// A plan read back from JSON with a NaN multiplier (written as "NaN") still warm-starts:
+/// multipliers that are not finite are not used, as duals that do not fit the problem are
+/// not (issue 33, item 7: deserialised values are validated on use).
+#[test]
+fn a_plan_read_back_with_nan_multipliers_warm_starts_without_them() {
+    let first = solve_from(0.0, PlanGuess::Spline);
+    let mut value = serde_json::to_value(&first).expect("serialisable");
+    value["duals"]["equalities"][3][0] = "NaN".into();
+    let read: Plan<2, 4> = serde_json::from_value(value).expect("NaN reads back");
+    assert!(read.duals.equalities[3][0].is_nan());
+    let warm = solve_from(0.02, PlanGuess::Plan(&read));
+    let cold = solve_from(0.02, PlanGuess::Spline);
+    assert_warm_matches_cold(&warm, &cold, 1e-8, "NaN multiplier");
+}

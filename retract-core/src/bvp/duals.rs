@@ -11,21 +11,28 @@ use nalgebra::SVector;
 /// steps' evaluation points are listed step by step (the same number at every step $i < N$),
 /// those placed at the nodes node by node (every interior node $0 < i < N$). At a plan,
 /// $z s = \mu$ with $\mu$ = `barrier`, the barrier parameter per unit time at its floor.
+/// With `serde`, non-finite numbers are written as in [`super::Certificate`].
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Duals<const N: usize> {
     /// The multipliers $y_i$ of the stage equalities of step $i$ (component $j$ for
     /// equality $j$).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub equalities: Vec<SVector<f64, N>>,
     /// The slacks $s$ of the inequalities at the evaluation points (step-major).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::list"))]
     pub step_slacks: Vec<f64>,
     /// Their multipliers $z$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::list"))]
     pub step_multipliers: Vec<f64>,
     /// The slacks $s$ of the inequalities at the interior nodes (node-major).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::list"))]
     pub node_slacks: Vec<f64>,
     /// Their multipliers $z$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::list"))]
     pub node_multipliers: Vec<f64>,
     /// The barrier parameter $\mu$ per unit time.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub barrier: f64,
 }
 

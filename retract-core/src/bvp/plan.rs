@@ -11,18 +11,26 @@ use super::violations::{Infeasibility, Violations};
 use crate::{DomainViolation, Error};
 
 /// What a returned plan is certified to satisfy.
+///
+/// The residuals of a failed solve's last iterate may be NaN (not computed) or infinite; with
+/// `serde`, a non-finite field is written as the string `"NaN"`, `"inf"` or `"-inf"` and read
+/// back from it (or from `null`, as NaN), so that formats without such numbers (JSON) hold
+/// them; finite fields are plain numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Certificate {
     /// Max-norm of the gradient of the Lagrangian of the transcription, with the multipliers
     /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
     /// unit time relative to the size of the gradient of $L$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub stationarity: f64,
     /// Max-norm of the constraint violation (dynamics defects, boundary data, stage
     /// equalities).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub feasibility: f64,
     /// $\max_j z_j g_j$ over the inequalities $g_j \ge 0$ with their multipliers $z_j$ (0
     /// without inequalities): how far the interior-point iterate is from complementarity.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub complementarity: f64,
     /// Negative eigenvalues of the reduced Hessian (0 for a returned plan).
     pub negative_directions: usize,
@@ -35,42 +43,37 @@ pub struct Certificate {
     /// some direction, e.g. ends that nothing fixes).
     /// NaN if [`PlanOptions::min_eigenvalue`](super::PlanOptions::min_eigenvalue) is off or the end $x_N$ has free
     /// components (the inertia count proves positivity either way).
-    /// With `serde`, NaN is written as "none" (JSON `null`) and read back as NaN.
-    #[cfg_attr(feature = "serde", serde(with = "nan_as_none"))]
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub min_reduced_hessian_eig: f64,
 }
 
-/// An `f64` that may be NaN as an `Option<f64>` (`None` for NaN): formats without NaN, as
-/// JSON, write it as `null` and read it back.
-#[cfg(feature = "serde")]
-mod nan_as_none {
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
-    pub fn serialize<S: Serializer>(v: &f64, serializer: S) -> Result<S::Ok, S::Error> {
-        (!v.is_nan()).then_some(*v).serialize(serializer)
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::NAN))
-    }
-}
-
 /// A plan: a certified local minimum of the transcription.
+///
+/// With `serde`, NaN and infinite numbers (in the last iterate of a failed solve) are written
+/// as the strings `"NaN"`, `"inf"` and `"-inf"` and read back, as in [`Certificate`]. A plan
+/// read back holds whatever numbers it was given: its uses ([`Self::evaluate`],
+/// [`Self::try_shifted`]) check it first ([`Self::validate`]).
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Plan<const N: usize, const X: usize> {
     /// Step size $h = T/N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub h: f64,
     /// The scheme parameter.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub theta: f64,
     /// Jets $x_i = (q, \dots, q^{(k-1)})(t_i)$, $i = 0, \dots, N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub x: Vec<SVector<f64, X>>,
     /// Top derivatives $u_i$ at the evaluation points, $i < N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub u: Vec<SVector<f64, N>>,
     /// Ostrogradsky momenta $p_i$ recovered from the multipliers: $z_i = (x_i, p_i)$ is the
-    /// state of the lifted scheme.
+    /// state of the lifted scheme (empty where a failed solve did not recover them).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub momenta: Vec<SVector<f64, X>>,
     /// $J = \sum_i h\thinspace L(x_{\theta,i}, u_i)$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub cost: f64,
     /// SQP iterations.
     pub iterations: usize,
@@ -126,18 +129,15 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     /// ```
     ///
     /// # Errors
-    /// [`Error::InvalidArgument`] for $t$ outside $[0, T]$ (beyond a relative $10^{-12}$ for
-    /// rounding), not finite, or a plan without steps.
+    /// [`Error::InvalidArgument`] named `plan` for a plan that fails [`Self::validate`] or
+    /// whose interpolant is not finite at $t$ (a step $h$ too long for its jets, e.g.
+    /// $h^{2k-1}$ overflowing), named `t` for $t$ outside $[0, T]$ (beyond a relative
+    /// $10^{-12}$ for rounding) or not finite.
     pub fn evaluate(&self, t: f64) -> Result<SVector<f64, X>, Error> {
-        let steps = self.x.len().saturating_sub(1);
+        self.validate()?;
+        let steps = self.u.len();
         let t_end = self.h * steps as f64;
-        let slack = 1e-12 * t_end.abs();
-        if steps == 0 || N == 0 || !X.is_multiple_of(N) || !(self.h.is_finite() && self.h > 0.0) {
-            return Err(Error::InvalidArgument {
-                name: "plan",
-                requirement: "a plan to evaluate needs at least one step of finite h > 0",
-            });
-        }
+        let slack = 1e-12 * t_end;
         if !(t >= -slack && t <= t_end + slack) {
             return Err(Error::InvalidArgument {
                 name: "t",
@@ -154,14 +154,68 @@ impl<const N: usize, const X: usize> Plan<N, X> {
             i += 1;
         }
         let local = t - i as f64 * self.h;
+        let not_finite = Error::InvalidArgument {
+            name: "plan",
+            requirement: "its interpolant must be finite: the step h is too long for its jets",
+        };
         let piece = Hermite::new(
             self.x[i].as_slice(),
             self.x[i + 1].as_slice(),
             self.h,
             N,
             X / N,
-        )?;
-        Ok(SVector::from_fn(|r, _| piece.jet_entry(r, local)))
+        )
+        .map_err(|_| not_finite)?;
+        let x = SVector::<f64, X>::from_fn(|r, _| piece.jet_entry(r, local));
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(not_finite)
+        }
+    }
+
+    /// Whether this is a plan at all (a plan read back from a file holds whatever numbers it
+    /// was given): at least one step, $N + 1$ jets for $N$ top derivatives and $N + 1$
+    /// momenta (or none), a finite step $h > 0$ with $T = N h$ finite, $\theta \in [0, 1]$,
+    /// and every jet, top derivative and momentum finite. The certificate, the cost and the
+    /// duals describe the plan and are not checked (a failed solve's are NaN). Uses of a plan
+    /// ([`Self::evaluate`], [`Self::try_shifted`]) run it first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `plan`, its requirement saying which condition fails.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |requirement| {
+            Err(Error::InvalidArgument {
+                name: "plan",
+                requirement,
+            })
+        };
+        let steps = self.u.len();
+        if N == 0 || X == 0 || !X.is_multiple_of(N) {
+            return invalid("its jets must hold k >= 1 blocks of the N top derivatives");
+        }
+        if steps == 0
+            || self.x.len() != steps + 1
+            || !(self.momenta.is_empty() || self.momenta.len() == steps + 1)
+        {
+            return invalid(
+                "it needs N >= 1 top derivatives, N + 1 jets and N + 1 momenta (or none)",
+            );
+        }
+        if !(self.h > 0.0 && (self.h * steps as f64).is_finite()) {
+            return invalid("its step h must be finite and > 0, and T = N h finite");
+        }
+        if !(0.0..=1.0).contains(&self.theta) {
+            return invalid("its theta must lie in [0, 1]");
+        }
+        let finite = |v: &[f64]| v.iter().all(|e| e.is_finite());
+        if !(self.x.iter().all(|x| finite(x.as_slice()))
+            && self.u.iter().all(|u| finite(u.as_slice()))
+            && self.momenta.iter().all(|p| finite(p.as_slice())))
+        {
+            return invalid("its jets, top derivatives and momenta must be finite");
+        }
+        Ok(())
     }
 
     /// The plan shifted one step forward in time, for a receding-horizon warm start
@@ -169,14 +223,25 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     /// top derivative repeated and the new last jet one step of the scheme's $x$-equations
     /// from the old end with it. The momenta and the duals are shifted alike (the last ones
     /// repeated); the certificate is that of the unshifted plan.
-    pub fn shifted(&self) -> Self {
+    ///
+    /// # Errors
+    /// As [`Self::validate`]; [`Error::InvalidArgument`] named `plan` when the new last jet is
+    /// not finite (a step $h$ too long for the scheme's $x$-equations).
+    pub fn try_shifted(&self) -> Result<Self, Error> {
+        self.validate()?;
         let mut out = self.clone();
         let (Some(&last_x), Some(&last_u)) = (self.x.last(), self.u.last()) else {
-            return out;
+            return Ok(out);
         };
-        let dynamics = Dynamics::<N, X>::new(self.h, self.theta);
+        let next = Dynamics::<N, X>::new(self.h, self.theta).next(&last_x, &last_u);
+        if !next.iter().all(|v| v.is_finite()) {
+            return Err(Error::InvalidArgument {
+                name: "plan",
+                requirement: "its last jet stepped by h must be finite: h is too long for it",
+            });
+        }
         out.x.remove(0);
-        out.x.push(dynamics.next(&last_x, &last_u));
+        out.x.push(next);
         out.u.remove(0);
         out.u.push(last_u);
         if let Some(&last_p) = self.momenta.last() {
@@ -184,7 +249,15 @@ impl<const N: usize, const X: usize> Plan<N, X> {
             out.momenta.push(last_p);
         }
         out.duals.shift(self.u.len());
-        out
+        Ok(out)
+    }
+
+    /// [`Self::try_shifted`], with a plan it refuses returned unchanged (one that fails
+    /// [`Self::validate`], e.g. read back from a damaged file, or whose step $h$ is too long
+    /// for the scheme): [`Self::try_shifted`] says why, and [`Self::evaluate`] refuses such a
+    /// plan in turn.
+    pub fn shifted(&self) -> Self {
+        self.try_shifted().unwrap_or_else(|_| self.clone())
     }
 }
 
@@ -390,7 +463,10 @@ pub(super) fn unknown_certificate() -> Certificate {
 
 #[cfg(test)]
 mod tests {
-    use super::{Certificate, LONG_RUN, advice};
+    use nalgebra::SVector;
+
+    use super::{Certificate, Duals, LONG_RUN, Plan, Violations, advice};
+    use crate::Error;
 
     fn residuals(stationarity: f64, feasibility: f64) -> Certificate {
         Certificate {
@@ -415,5 +491,237 @@ mod tests {
             long.contains("unlikely to help") && !long.contains("raise"),
             "{long}"
         );
+    }
+
+    /// A plan of `steps` steps along the line $q(t) = (t, 2t)$ over $T = 1$: jets $(q, q')$,
+    /// top derivatives $q'' = 0$, zero momenta, finite residuals (so that plans compare
+    /// equal).
+    fn line(steps: usize) -> Plan<2, 4> {
+        let h = 1.0 / steps as f64;
+        Plan {
+            h,
+            theta: 0.5,
+            x: (0..=steps)
+                .map(|i| {
+                    let t = i as f64 * h;
+                    SVector::from([t, 2.0 * t, 1.0, 2.0])
+                })
+                .collect(),
+            u: vec![SVector::zeros(); steps],
+            momenta: vec![SVector::zeros(); steps + 1],
+            cost: 0.0,
+            iterations: 1,
+            certificate: Certificate {
+                min_reduced_hessian_eig: 0.5,
+                ..residuals(0.0, 0.0)
+            },
+            violations: Violations::default(),
+            duals: Duals::default(),
+        }
+    }
+
+    /// `line(4)` changed by `edit`.
+    fn edited(edit: impl FnOnce(&mut Plan<2, 4>)) -> Plan<2, 4> {
+        let mut plan = line(4);
+        edit(&mut plan);
+        plan
+    }
+
+    /// Plans whose data cannot be a plan, each with what is wrong with it.
+    fn hostile() -> Vec<(&'static str, Plan<2, 4>)> {
+        vec![
+            ("h = 1e308 (T = N h overflows)", edited(|p| p.h = 1e308)),
+            ("h NaN", edited(|p| p.h = f64::NAN)),
+            ("h infinite", edited(|p| p.h = f64::INFINITY)),
+            ("h = 0", edited(|p| p.h = 0.0)),
+            ("h < 0", edited(|p| p.h = -0.25)),
+            ("theta = 2", edited(|p| p.theta = 2.0)),
+            ("theta NaN", edited(|p| p.theta = f64::NAN)),
+            ("a NaN jet", edited(|p| p.x[2][1] = f64::NAN)),
+            ("an infinite jet", edited(|p| p.x[4][3] = f64::INFINITY)),
+            (
+                "an infinite top derivative",
+                edited(|p| p.u[1][0] = f64::INFINITY),
+            ),
+            ("a NaN momentum", edited(|p| p.momenta[3][2] = f64::NAN)),
+            ("a top derivative missing", edited(|p| p.u.truncate(3))),
+            ("a jet too many", edited(|p| p.x.push(SVector::zeros()))),
+            ("a momentum missing", edited(|p| p.momenta.truncate(4))),
+            (
+                "no steps",
+                edited(|p| {
+                    p.x.truncate(1);
+                    p.u.clear();
+                    p.momenta.truncate(1);
+                }),
+            ),
+        ]
+    }
+
+    /// Every use of a plan refuses one whose data cannot be a plan (issue 33, item 7: a plan
+    /// with h = 1e308 evaluated to `Ok(NaN)`); a valid one evaluates.
+    #[test]
+    fn a_plan_that_cannot_be_one_is_refused_on_use() {
+        let valid = line(4);
+        let x = valid.evaluate(0.3).expect("a valid plan");
+        assert!(
+            (x - SVector::from([0.3, 0.6, 1.0, 2.0])).amax() < 1e-15,
+            "{x}"
+        );
+        assert_eq!(valid.validate(), Ok(()));
+        let shifted = valid.try_shifted().expect("a valid plan");
+        assert_eq!(shifted, valid.shifted());
+        assert!((shifted.x[4] - SVector::from([1.25, 2.5, 1.0, 2.0])).amax() < 1e-15);
+        for (what, plan) in hostile() {
+            for t in [0.0, 0.1, 0.25] {
+                let result = plan.evaluate(t);
+                assert!(
+                    matches!(result, Err(Error::InvalidArgument { name: "plan", .. })),
+                    "{what}, t = {t}: {result:?}"
+                );
+            }
+            let refused = plan.validate().expect_err(what);
+            assert_eq!(plan.try_shifted().expect_err(what), refused, "{what}");
+            assert!(
+                refused.to_string().contains("invalid argument `plan`"),
+                "{refused}"
+            );
+            // shifted returns it unchanged (NaN fields compared by their Debug form)
+            assert_eq!(
+                format!("{:?}", plan.shifted()),
+                format!("{plan:?}"),
+                "{what}"
+            );
+        }
+        // a plan without momenta (a failed solve's) is a plan
+        let mut bare = line(4);
+        bare.momenta.clear();
+        assert!(bare.validate().is_ok() && bare.evaluate(0.5).is_ok());
+        // T = N h finite, but a step too long for the interpolant: not Ok(NaN) either
+        let mut long = line(1);
+        long.h = 1e308;
+        assert!(long.validate().is_ok());
+        assert!(long.try_shifted().is_err());
+        for t in [0.0, 0.5e308] {
+            let result = long.evaluate(t);
+            assert!(
+                matches!(result, Err(Error::InvalidArgument { name: "plan", .. })),
+                "t = {t}: {result:?}"
+            );
+        }
+    }
+
+    /// NaN and infinite fields of a plan (a failed solve's certificate, its cost, its iterate)
+    /// round-trip through JSON as "NaN", "inf" and "-inf"; finite ones stay plain numbers, and
+    /// `null` (what a plain `f64` field wrote) reads as NaN (issue 33, item 7).
+    #[cfg(feature = "serde")]
+    #[test]
+    fn non_finite_fields_round_trip_through_json() {
+        let mut plan = edited(|p| {
+            p.cost = f64::NAN;
+            p.certificate = super::unknown_certificate();
+            p.certificate.complementarity = f64::INFINITY;
+            p.violations = Violations {
+                nodes: f64::NAN,
+                midpoints: f64::NEG_INFINITY,
+                interpolant: 0.5,
+            };
+            p.x[2][1] = f64::NAN;
+            p.momenta[1][0] = f64::NEG_INFINITY;
+            p.duals.barrier = f64::NAN;
+            p.duals.step_slacks = vec![f64::INFINITY, 1.0];
+            p.duals.equalities = vec![SVector::from([f64::NAN, 1.0])];
+        });
+        let json = serde_json::to_string(&plan).unwrap();
+        for field in [
+            r#""cost":"NaN""#,
+            r#""stationarity":"NaN""#,
+            r#""feasibility":"NaN""#,
+            r#""complementarity":"inf""#,
+            r#""min_reduced_hessian_eig":"NaN""#,
+            r#""nodes":"NaN""#,
+            r#""midpoints":"-inf""#,
+            r#"[0.5,"NaN",1.0,2.0]"#,
+            r#"["-inf",0.0,0.0,0.0]"#,
+            r#""barrier":"NaN""#,
+            r#""step_slacks":["inf",1.0]"#,
+            r#""equalities":[["NaN",1.0]]"#,
+            // finite values stay numbers
+            r#""h":0.25"#,
+            r#""theta":0.5"#,
+            r#""interpolant":0.5"#,
+            r#""x":[[0.0,0.0,1.0,2.0],"#,
+        ] {
+            assert!(json.contains(field), "{json} lacks {field}");
+        }
+        let back: Plan<2, 4> = serde_json::from_str(&json).unwrap();
+        assert!(back.cost.is_nan() && back.certificate.stationarity.is_nan());
+        assert_eq!(back.certificate.complementarity, f64::INFINITY);
+        assert_eq!(back.violations.midpoints, f64::NEG_INFINITY);
+        assert!(back.x[2][1].is_nan() && back.duals.barrier.is_nan());
+        assert_eq!(back.momenta[1][0], f64::NEG_INFINITY);
+        assert_eq!(serde_json::to_string(&back).unwrap(), json);
+        // what a plain f64 field wrote for any non-finite value: null, read as NaN
+        let old = json.replace(r#""NaN""#, "null");
+        let read: Plan<2, 4> = serde_json::from_str(&old).unwrap();
+        assert!(read.cost.is_nan() && read.x[2][1].is_nan() && read.duals.barrier.is_nan());
+        // another string is an error that says what is accepted
+        let wrong = json.replacen(r#""cost":"NaN""#, r#""cost":"nan""#, 1);
+        let error = serde_json::from_str::<Plan<2, 4>>(&wrong).unwrap_err();
+        assert!(
+            error.to_string().contains(r#""NaN", "inf", "-inf""#),
+            "{error}"
+        );
+        // a finite plan round-trips exactly
+        plan = line(4);
+        let json = serde_json::to_string(&plan).unwrap();
+        assert_eq!(serde_json::from_str::<Plan<2, 4>>(&json).unwrap(), plan);
+        // the certificate alone
+        let json = serde_json::to_string(&super::unknown_certificate()).unwrap();
+        let read: Certificate = serde_json::from_str(&json).unwrap();
+        assert!(read.stationarity.is_nan() && read.min_reduced_hessian_eig.is_nan());
+    }
+
+    /// Hostile JSON that reads into a plan is refused by every use of it (issue 33, item 7).
+    #[cfg(feature = "serde")]
+    #[test]
+    fn a_hostile_plan_from_json_is_refused_on_use() {
+        type Edit = fn(&mut serde_json::Value);
+        let valid = serde_json::to_value(line(4)).unwrap();
+        let edits: [(&str, Edit); 8] = [
+            ("h = 1e308", |v| v["h"] = 1e308.into()),
+            ("h = \"inf\"", |v| v["h"] = "inf".into()),
+            ("h = -0.25", |v| v["h"] = (-0.25).into()),
+            ("theta = \"NaN\"", |v| v["theta"] = "NaN".into()),
+            ("a NaN jet", |v| v["x"][2][1] = "NaN".into()),
+            ("an infinite top derivative", |v| {
+                v["u"][0][0] = "inf".into()
+            }),
+            ("a top derivative missing", |v| {
+                v["u"].as_array_mut().map(Vec::pop);
+            }),
+            ("no jets", |v| v["x"] = serde_json::json!([])),
+        ];
+        for (what, edit) in edits {
+            let mut value = valid.clone();
+            edit(&mut value);
+            let plan: Plan<2, 4> = serde_json::from_value(value)
+                .unwrap_or_else(|e| panic!("{what}: the JSON reads ({e})"));
+            let result = plan.evaluate(0.1);
+            assert!(
+                matches!(result, Err(Error::InvalidArgument { name: "plan", .. })),
+                "{what}: {result:?}"
+            );
+            assert!(
+                plan.validate().is_err() && plan.try_shifted().is_err(),
+                "{what}"
+            );
+        }
+        // a jet with the wrong number of entries does not read
+        let mut value = valid;
+        value["x"][1] = serde_json::json!([0.25, 0.5, 1.0]);
+        assert!(serde_json::from_value::<Plan<2, 4>>(value.clone()).is_err());
+        value["x"][1] = serde_json::json!([0.25, 0.5, 1.0, 2.0, 3.0]);
+        assert!(serde_json::from_value::<Plan<2, 4>>(value).is_err());
     }
 }

@@ -549,10 +549,12 @@ where
             .ok_or(PlanError::without_iterate(Failure::NonFinite))?;
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        // (the stage equalities' multipliers: a warm start's, else 0)
+        // (the stage equalities' multipliers: a warm start's if they fit and are finite, else
+        // 0; a plan read back from a file may hold any numbers)
+        let finite = |y: &SVector<f64, N>| y.iter().all(|v| v.is_finite());
         let mut y = warm
             .map(|duals| duals.equalities.clone())
-            .filter(|y| y.len() == iterate.u.len())
+            .filter(|y| y.len() == iterate.u.len() && y.iter().all(finite))
             .unwrap_or_else(|| vec![SVector::zeros(); iterate.u.len()]);
         let mut full_step: Option<Direction<N, X>> = None;
         let mut kept: Option<(Riccati<N, X>, f64)> = None;

@@ -19,14 +19,17 @@ pub const INTERPOLANT_DIVISIONS: usize = 16;
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Violations {
     /// At the nodes $x_i$, over the constraints placed there ([`super::Placement`]).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub nodes: f64,
     /// At the steps' evaluation points $(x_{\theta,i}, u_i)$, over the constraints placed
     /// there.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub midpoints: f64,
     /// Along the interpolant of [`super::Plan::evaluate`] at the
     /// [`INTERPOLANT_DIVISIONS`] $- 1$ points inside every step, over the inequalities placed at
     /// the nodes (constraints of the jet alone; between the nodes nothing holds them, so a
     /// plan may cut a corner here by $O(h^2)$).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub interpolant: f64,
 }
 
