@@ -6,15 +6,15 @@
 //! $s = |\phi|^2 = |\psi|^2$ and $u = v_x / 2$, both compute
 //!
 //! $$R_{1,2}\big((y, x), (v_y, v_x)\big) = \Big(\frac{y \mp w \mp y \times w}{1 \pm y \cdot w},
-//!   \; x \mp \big(u \mp a(s)\, \psi \times u + b(s)\, \psi \times (\psi \times u)\big)\Big),
-//!   \qquad w = \rho(s)\, \phi:$$
+//!   \thickspace x \mp \big(u \mp a(s)\thinspace \psi \times u + b(s)\thinspace \psi \times (\psi \times u)\big)\Big),
+//!   \qquad w = \rho(s)\thinspace \phi:$$
 //!
 //! - [`Se3Midpoint1`] and [`Se3Midpoint2`]: the Cayley midpoint map of [`crate::so3`] on the
 //!   rotation part and the midpoint rule on the position part ($\rho = 1/2$, $a = b = 0$);
 //! - [`Se3ExpMidpoint1`] and [`Se3ExpMidpoint2`]: the group's exponential,
 //!   $R_d(g, \xi) = (g \exp(-\xi/2), g \exp(\xi/2))$ with $\rho = c_2/c_1$, $a = c_2$ and
 //!   $b = c_3$ (Stumpff functions of [`retract_core::special`]): the rotation part is
-//!   [`crate::so3::ExpMidpoint1`]'s, and the position moves by $R\, V(\pm\Omega/2)\, v/2$
+//!   [`crate::so3::ExpMidpoint1`]'s, and the position moves by $R\thinspace V(\pm\Omega/2)\thinspace v/2$
 //!   with $V(\phi) = I + c_2 \hat\phi + c_3 \hat\phi^2$, the exact flow of the constant body
 //!   velocity over half a step either way (a screw motion).
 //!

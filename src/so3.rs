@@ -7,9 +7,9 @@
 //! serve every order). Both families compute
 //!
 //! $$R_{1,2}(y, v) = \frac{y \mp w \mp y \times w}{1 \pm y \cdot w}, \qquad
-//!   w = \rho(|\phi|^2)\, \phi, \qquad \phi = \frac{v - y \times v}{1 + |y|^2} = \frac{\Omega}{2},$$
+//!   w = \rho(|\phi|^2)\thinspace \phi, \qquad \phi = \frac{v - y \times v}{1 + |y|^2} = \frac{\Omega}{2},$$
 //!
-//! the chart points of $g\,\mathrm{cay}(\mp\Omega/2)$ with $\rho = 1/2$, and of
+//! the chart points of $g\thinspace\mathrm{cay}(\mp\Omega/2)$ with $\rho = 1/2$, and of
 //! $g \exp(\mp\Omega/2)$ with $\rho(s) = c_2(s) / c_1(s)$ ($\tan(\theta/2)/\theta$ at
 //! $s = \theta^2$, through the Stumpff functions of [`retract_core::special`], so that the code
 //! has no branch at $\Omega = 0$); the tests check that they agree with the run-time lifts to

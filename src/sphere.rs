@@ -4,7 +4,7 @@
 //! ([`Chart::params`]).
 //!
 //! In the chart, $\varphi(y) = s/|s|$ with $s = c + y_0 e_1 + y_1 e_2$, a tangent vector
-//! $v \in \mathbb{R}^2$ is $\xi = D\varphi(y) v = (t - p\,(p \cdot t)) / |s|$ with
+//! $v \in \mathbb{R}^2$ is $\xi = D\varphi(y) v = (t - p\thinspace(p \cdot t)) / |s|$ with
 //! $t = v_0 e_1 + v_1 e_2$ and $p = \varphi(y)$, and the chart's inverse is
 //! $\varphi^{-1}(a) = ((e_2 \times c) \cdot a, (c \times e_1) \cdot a) / ((e_1 \times e_2)
 //! \cdot a)$, which does not see a positive factor of $a$ (so no map below normalises). Each
@@ -17,7 +17,7 @@
 //!   (symmetric, order 2). Its base point is the normalised mean of the two points, as in the
 //!   spherical midpoint method of McLachlan, Modin and Verdier.
 //! - [`ExponentialMidpoint`]: $R_d(p, \xi) = (\exp_p(-\xi/2), \exp_p(\xi/2))$,
-//!   $\exp_p(\xi) = \cos|\xi|\, p + \sin|\xi|\, \xi/|\xi|$ (paper Sec. 7; symmetric, order
+//!   $\exp_p(\xi) = \cos|\xi|\thinspace p + \sin|\xi|\thinspace \xi/|\xi|$ (paper Sec. 7; symmetric, order
 //!   2). $\cos\theta$ and $\sin\theta/\theta$ are summed as their Taylor series to
 //!   $\theta^{16}$, exact to rounding for $|\xi| \le 2$ (a step that turns the point by less
 //!   than 2 rad).

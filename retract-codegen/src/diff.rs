@@ -312,7 +312,7 @@ fn rebuild(
     out
 }
 
-/// The total time derivative $D f = \sum_{j < top} \sum_i \partial f/\partial q^{(j)}_i \, q^{(j+1)}_i$
+/// The total time derivative $D f = \sum_{j < top} \sum_i \partial f/\partial q^{(j)}_i \thinspace q^{(j+1)}_i$
 /// over jets up to q^(top).
 pub fn total_derivative(g: &mut Graph, d: &mut Differentiator, f: Id, n: usize, top: usize) -> Id {
     let mut acc = g.constant(0.0);

@@ -2,7 +2,7 @@
 //! $(C, c)$ (an [`Isometry3`]) and a chart state of dimension 6 whose point $(y, x)$ gives
 //! the pose by left translation of the chart at the identity,
 //!
-//! $$g = (C, c)\,(Q(y), x) = (C\,Q(y),\; c + C x),$$
+//! $$g = (C, c)\thinspace(Q(y), x) = (C\thinspace Q(y),\thickspace c + C x),$$
 //!
 //! with $Q$ the Gibbs chart of [`crate::so3`]. The body velocity is
 //! $\xi = (\Omega, v)$ with $\Omega = 2 (y' - y \times y') / (1 + |y|^2)$ and
@@ -163,7 +163,7 @@ pub fn recentre_system<Sys: Se3System, const K: usize, const S: usize>(
 
 /// The spatial momentum (the Noether momentum of left multiplication, in world axes) of the
 /// chart state `z` of order $k$ centred at `centre` $= (C, c)$: the linear part
-/// $P = C\,p_{x,0}$ (translations move $x$ by a constant) and the angular part about the
+/// $P = C\thinspace p_{x,0}$ (translations move $x$ by a constant) and the angular part about the
 /// world origin $L = C \big(M + \sum_j w_j \times p_{x,j}\big)$ with $M$ the Gibbs chart's
 /// ([`crate::so3::world_momentum`] in the centre's axes), $w_0 = C^T c + x$ and
 /// $w_j = x^{(j)}$ (a rotation $\omega$ moves $x$ by $C^T\omega \times (C^T c + x)$). A

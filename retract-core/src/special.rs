@@ -8,9 +8,9 @@
 //!
 //! are entire in $s$; for $s = \theta^2 > 0$, $c_0 = \cos\theta$, $c_1 = \sin\theta / \theta$,
 //! $c_2 = (1 - \cos\theta)/\theta^2$ and $c_3 = (\theta - \sin\theta)/\theta^3$. They satisfy
-//! $c_k(s) = 1/k! - s\, c_{k+2}(s)$ and are closed under differentiation:
+//! $c_k(s) = 1/k! - s\thinspace c_{k+2}(s)$ and are closed under differentiation:
 //!
-//! $$c_k'(s) = \tfrac12 \big(k\, c_{k+2}(s) - c_{k+1}(s)\big),$$
+//! $$c_k'(s) = \tfrac12 \big(k\thinspace c_{k+2}(s) - c_{k+1}(s)\big),$$
 //!
 //! which is what `#[higher_order_lagrangian]` and `#[discretization_map]` differentiate
 //! `stumpff(k, s)` by, and what [`crate::taylor::Scalar::stumpff`] lifts.

@@ -21,7 +21,7 @@
 //! Transitions between gnomonic charts are linear-fractional: in homogeneous coordinates
 //! $w = (1, y)$ and the frame matrix $F = [c\ e_1\ e_2]$, chart $b$ sees the point of chart
 //! $a$ at $\psi(w) = E_b^T F_a w / (c_b \cdot F_a w)$ (the normalisation cancels). Along a
-//! jet, $\psi^{(j)}$ follows from Leibniz' rule for $\psi\,d = n$ with $n = E_b^T F_a w$,
+//! jet, $\psi^{(j)}$ follows from Leibniz' rule for $\psi\thinspace d = n$ with $n = E_b^T F_a w$,
 //! $d = c_b \cdot F_a w$:
 //! $$\psi^{(j)} = \Big(n^{(j)} - \sum_{i=1}^{j} \tbinom{j}{i} d^{(i)} \psi^{(j-i)}\Big) / d.$$
 
@@ -225,7 +225,7 @@ impl Fractional {
 
     /// The derivative of $\psi^{(j)}$, $j <$ `len`, in the direction $(\delta N, \delta d,
     /// \delta w)$, from Leibniz' rule differentiated:
-    /// $d\,\delta\psi^{(j)} = \delta n^{(j)} - \sum_{i=0}^{j} \binom{j}{i} \delta d^{(i)}
+    /// $d\thinspace\delta\psi^{(j)} = \delta n^{(j)} - \sum_{i=0}^{j} \binom{j}{i} \delta d^{(i)}
     /// \psi^{(j-i)} - \sum_{i=1}^{j} \binom{j}{i} d^{(i)} \delta\psi^{(j-i)}$.
     fn tangent(
         &self,
@@ -253,7 +253,7 @@ impl Fractional {
 }
 
 /// The jet of $q = s / |s|$ along the jet of $s$ ($|s|$ by Leibniz' rule for $|s|^2 = s
-/// \cdot s$, then $q$ by Leibniz' rule for $q\,|s| = s$).
+/// \cdot s$, then $q$ by Leibniz' rule for $q\thinspace|s| = s$).
 fn normalised_jet(s: &Jet<3>, len: usize) -> Jet<3> {
     let mut r = [0.0; MAX_JET];
     let mut q = [Vector3::zeros(); MAX_JET];
@@ -449,7 +449,7 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
 
     /// The Noether momentum of rotations: component $a$ is $\mu_a = \sum_j p_j \cdot
     /// \delta_a x_j$, with $\delta_a x$ the chart jet's velocity under the rotation
-    /// $q \mapsto q + \epsilon\, e_a \times q$ (every ambient derivative rotates alike).
+    /// $q \mapsto q + \epsilon\thinspace e_a \times q$ (every ambient derivative rotates alike).
     /// Conserved by [`step`] for a rotation-invariant Lagrangian.
     pub fn momentum(&self) -> Vector3<f64> {
         let (x, p) = self.parts();

@@ -8,7 +8,7 @@
 //! The flow of $H_0$ is linear with a nilpotent generator $A$ ($x_j' = x_{j+1}$,
 //! $x_{k-1}' = p_{k-1}/c$, $p_0' = 0$, $p_j' = -p_{j-1}$; $A^{2k} = 0$), so
 //! $e^{tA} = \sum_{m < 2k} t^m A^m / m!$ is exact; the flow of $H_V$ is the kick
-//! $p_0 \mathrel{+}= t\, \nabla V(x_0)$. [`split_step`] is Strang's splitting
+//! $p_0 \mathrel{+}= t\thinspace \nabla V(x_0)$. [`split_step`] is Strang's splitting
 //! $e^{hA/2} \circ \mathrm{kick}_h \circ e^{hA/2}$: explicit (one gradient of $V$ per step, no
 //! Newton solve), symplectic and symmetric, of order 2; compose it with
 //! [`crate::compose::compose`] for orders 4, 6 and 8.
@@ -215,7 +215,7 @@ where
     Ok((z1, StepReport::default()))
 }
 
-/// The derivative $\partial z_1 / \partial z_0$ of [`split_step`]: $e^{hA/2} (I + h\,
+/// The derivative $\partial z_1 / \partial z_0$ of [`split_step`]: $e^{hA/2} (I + h\thinspace
 /// \partial^2 V) e^{hA/2}$, the kick's block $\partial p_0 / \partial x_0 = h \nabla^2 V$
 /// (for the symplecticity check $D^T J D = J$).
 ///

@@ -10,9 +10,9 @@
 //! half free flows fused into one, since $e^{sA} e^{tA} = e^{(s+t)A}$.
 //!
 //! # Why Runge-Kutta-Nyström methods apply
-//! With $B = H_V = -V(x_0)$, a function of $x_0$ alone, $\{B, H_0\} = -\nabla V \cdot x_1$ is a
-//! function of $x$ alone, so $\{B, \{B, H_0\}\} = 0$: a stronger identity than the
-//! $\{B, \{B, \{B, H_0\}\}\} = 0$ of $H = \tfrac12 |p|^2 + V(q)$ that Runge-Kutta-Nyström (RKN)
+//! With $B = H_V = -V(x_0)$, a function of $x_0$ alone, $\lbrace B, H_0\rbrace = -\nabla V \cdot x_1$ is a
+//! function of $x$ alone, so $\lbrace B, \lbrace B, H_0\rbrace\rbrace = 0$: a stronger identity than the
+//! $\lbrace B, \lbrace B, \lbrace B, H_0\rbrace\rbrace\rbrace = 0$ of $H = \tfrac12 |p|^2 + V(q)$ that Runge-Kutta-Nyström (RKN)
 //! splitting methods assume (kicks as their $B$, free flows as their $A$). Every order
 //! condition such a method drops is therefore also void here, and it reaches its order
 //! (`tests/integrators/splitting_methods.rs` measures it by step refinement).

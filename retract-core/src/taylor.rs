@@ -36,7 +36,7 @@ pub trait Scalar:
     /// $1 / x$.
     fn recip(self) -> Self;
     /// The Stumpff function $c_k(x)$ ([`crate::special`]), differentiated by
-    /// $c_k' = \tfrac12 (k\, c_{k+2} - c_{k+1})$. On [`Taylor`] series of up to 16 terms
+    /// $c_k' = \tfrac12 (k\thinspace c_{k+2} - c_{k+1})$. On [`Taylor`] series of up to 16 terms
     /// (a longer series does not compile).
     fn stumpff(self, k: u32) -> Self;
 }
@@ -370,7 +370,7 @@ impl<T: Scalar, const D: usize> Scalar for Taylor<T, D> {
         }
         Self { c: r }
     }
-    /// $\sum_{j < D} c_k^{(j)}(a_0)\, \delta^j / j!$ for the series $a_0 + \delta$, with
+    /// $\sum_{j < D} c_k^{(j)}(a_0)\thinspace \delta^j / j!$ for the series $a_0 + \delta$, with
     /// $c_k^{(j)} = \sum_i \alpha_{j,i} c_{k+i}$ from the derivative rule.
     fn stumpff(self, k: u32) -> Self {
         const { assert!(D <= MAX_SERIES, "series of up to 16 terms") };

@@ -135,7 +135,7 @@ pub fn dense_step(z0: &Z, jacobian: DenseJacobian) -> Result<Z, Error> {
 /// Hand-reduced midpoint step: y = q_theta solves
 /// y - (q0 + h/2 v0 + h^2/4 p1_0 - h^3/8 p0_0) + h^4/16 grad V(y) = 0; the rest is explicit.
 pub struct Core {
-    /// The force-free midpoint $q_0 + h/2\, v_0 + h^2/4\, p_{1,0} - h^3/8\, p_{0,0}$.
+    /// The force-free midpoint $q_0 + h/2\thinspace v_0 + h^2/4\thinspace p_{1,0} - h^3/8\thinspace p_{0,0}$.
     pub c0: Vector3<f64>,
 }
 

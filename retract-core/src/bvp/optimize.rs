@@ -2,7 +2,7 @@
 //!
 //! The boundary-value problem of the scheme is the KKT system of
 //!
-//! $$\min_{x, u}\ J = \sum_{i<N} h\,L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad
+//! $$\min_{x, u}\ J = \sum_{i<N} h\thinspace L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad
 //!   x_{i+1} - x_i = h A x_{\theta,i} + h B u_i, \quad x_0 = a, \quad x_N = b,$$
 //!
 //! with $x_{\theta,i} = (1-\theta) x_i + \theta x_{i+1}$, $A$ the block shift
@@ -16,7 +16,7 @@
 //! are any, adds $h \rho I$ to every stage Hessian (inertia correction as in IPOPT: $\rho$ from
 //! $10^{-4}$, times 8 until the count is 0, a third of the last value at the next iteration),
 //! so every direction descends and iterates are drawn to minima. The step length comes from a
-//! backtracking line search on the exact penalty $J + \pi \|c\|_1$ ($c$: all constraints),
+//! backtracking line search on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$: all constraints),
 //! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
 //! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
 //! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,

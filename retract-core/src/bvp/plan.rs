@@ -108,8 +108,8 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     /// The jet $x(t) = (q, \dots, q^{(k-1)})(t)$ at any $t \in [0, T]$, $T = N h$: on the step
     /// $t_i \le t \le t_{i+1}$ the Hermite interpolant of degree $2k-1$ in each coordinate
     /// that matches the plan's jets $x_i$ at $t_i$ and $x_{i+1}$ at $t_{i+1}$ (for $k = 2$,
-    /// with $s = (t - t_i)/h$: $q(t) = (2s^3 - 3s^2 + 1) q_i + (s^3 - 2s^2 + s) h q'_i +
-    /// (3s^2 - 2s^3) q_{i+1} + (s^3 - s^2) h q'_{i+1}$). It reproduces polynomials of degree
+    /// with $s = (t - t_i)/h$ and $v = q'$: $q(t) = (2s^3 - 3s^2 + 1) q_i + (s^3 - 2s^2 + s) h
+    /// v_i + (3s^2 - 2s^3) q_{i+1} + (s^3 - s^2) h v_{i+1}$). It reproduces polynomials of degree
     /// $2k-1$ exactly and is $C^{k-1}$ across the nodes, where it equals the plan's jets.
     ///
     /// ```

@@ -4,13 +4,13 @@
 //! The quadratic subproblem is, with stage variables $(\delta x_i, \delta u_i)$,
 //!
 //! $$\min \sum_i \tfrac12 \delta y_i^T H_i \delta y_i + g_i^T \delta y_i, \qquad
-//!   \delta y_i = (E\,\delta x_i + \theta \bar B\,\delta u_i + \theta c_i,\ \delta u_i),$$
-//! $$\delta x_{i+1} = \bar A\,\delta x_i + \bar B\,\delta u_i + c_i, \quad
+//!   \delta y_i = (E\thinspace\delta x_i + \theta \bar B\thinspace\delta u_i + \theta c_i,\ \delta u_i),$$
+//! $$\delta x_{i+1} = \bar A\thinspace\delta x_i + \bar B\thinspace\delta u_i + c_i, \quad
 //!   \delta x_0 = r_0, \quad \delta x_N = r_N,$$
 //!
 //! where $\delta y_i$ is the change of the stage's evaluation point $(x_{\theta,i}, u_i)$,
 //! $E = (1-\theta) I + \theta \bar A$, $H_i$ and $g_i$ the Hessian and gradient of
-//! $h\,L(x_{\theta,i}, u_i)$ and $c_i$ the dynamics defect. The terminal constraint enters
+//! $h\thinspace L(x_{\theta,i}, u_i)$ and $c_i$ the dynamics defect. The terminal constraint enters
 //! through its multiplier $\nu$: the cost-to-go is
 //! $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$ with
 //! $P_N = \nabla^2\Phi$, $s_N = \nabla\Phi$ (a terminal cost, else 0), $S_N = I$ (on the
@@ -97,7 +97,7 @@ impl<const N: usize, const X: usize> Dynamics<N, X> {
     }
 }
 
-/// One stage's quadratic model: the Hessian blocks and gradient of $h\,L$ in
+/// One stage's quadratic model: the Hessian blocks and gradient of $h\thinspace L$ in
 /// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
 /// defect $c_i$, and the stage's equality constraints $g(y) = 0$: `constraints` rows of
 /// `cx` $= \partial g/\partial x_\theta$, `cu` $= \partial g/\partial u$ and `value` $= g$.
@@ -463,7 +463,7 @@ impl<const X: usize> Terminal<X> {
     }
 }
 
-/// The largest condition number $\|D\|_{\max} \|D^{-1}\|_{\max}$ at which a tail's terminal
+/// The largest condition number $\Vert D\Vert_{\max} \Vert D^{-1}\Vert_{\max}$ at which a tail's terminal
 /// system is eliminated before the first step (a longer tail is better conditioned).
 const TAIL_CONDITION: f64 = 1e6;
 

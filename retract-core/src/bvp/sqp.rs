@@ -107,7 +107,7 @@ struct Subproblem<const N: usize, const X: usize> {
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
-    /// $\|c\|_1$ over defects, stage constraints and boundary data.
+    /// $\Vert c\Vert_1$ over defects, stage constraints and boundary data.
     fn violation_l1(&self) -> f64 {
         self.slack_violation.0
             + self
@@ -118,7 +118,7 @@ impl<const N: usize, const X: usize> Models<N, X> {
             + self.r0.lp_norm(1)
             + self.r_end.lp_norm(1)
     }
-    /// $\|c\|_\infty$.
+    /// $\Vert c\Vert_\infty$.
     fn violation_max(&self) -> f64 {
         self.stages
             .iter()

@@ -6,8 +6,8 @@
 //! $R_a$ evaluated on [`Taylor`] numbers. Its derivatives follow from those of the base map
 //! along the same curves, by Leibniz's rule on $\partial q(t) / \partial q^{(i)} = t^i / i!$:
 //!
-//! $$\frac{\partial D^j R}{\partial z^{(i)}} = \frac{j!}{i!}\, c_{j-i}[\partial R], \qquad
-//!   \frac{\partial^2 D^j R}{\partial z^{(i)} \partial z^{(l)}} = \frac{j!}{i!\, l!}\,
+//! $$\frac{\partial D^j R}{\partial z^{(i)}} = \frac{j!}{i!}\thinspace c_{j-i}[\partial R], \qquad
+//!   \frac{\partial^2 D^j R}{\partial z^{(i)} \partial z^{(l)}} = \frac{j!}{i!\thinspace l!}\thinspace
 //!   c_{j-i-l}[\partial^2 R],$$
 //!
 //! with $z$ either $q$ or $v$, $c_m[f] = \frac{1}{m!} D^m f$ the Taylor coefficients of the
@@ -93,7 +93,7 @@ macro_rules! taylor_lift {
                 (blocks(r1), blocks(r2))
             }
 
-            /// $\partial D^j R / \partial z^{(i)} = (j!/i!)\, c_{j-i}[\partial R]$.
+            /// $\partial D^j R / \partial z^{(i)} = (j!/i!)\thinspace c_{j-i}[\partial R]$.
             fn jacobians(&self, x: &Blocks<$n, K>, xi: &Blocks<$n, K>) -> MapJacobians<$n, K> {
                 // first-order duals: the Hessian is not needed here
                 let (r1, r2) = self.0.base(
@@ -121,8 +121,8 @@ macro_rules! taylor_lift {
                 }
             }
 
-            /// $\sum_{j, c} (w_{2,jc}\, \partial^2 D^j R_{2,c} - w_{1,jc}\, \partial^2 D^j R_{1,c})$
-            /// with $\partial^2 D^j R / \partial z^{(i)} \partial z^{(l)} = j!/(i!\,l!)\,
+            /// $\sum_{j, c} (w_{2,jc}\thinspace \partial^2 D^j R_{2,c} - w_{1,jc}\thinspace \partial^2 D^j R_{1,c})$
+            /// with $\partial^2 D^j R / \partial z^{(i)} \partial z^{(l)} = j!/(i!\thinspace l!)\thinspace
             /// c_{j-i-l}[\partial^2 R]$.
             fn covector_hessian(
                 &self,

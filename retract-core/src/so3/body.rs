@@ -1,12 +1,12 @@
 //! Systems written in body coordinates: `#[higher_order_lagrangian(order = k, so3)]` takes
 //! L(R, Omega, ..., Omega^(k-1)) (the rotation and the body angular velocity with its
 //! derivatives) and composes it with the Gibbs chart centred at a rotation $C$, a parameter
-//! of the generated type ([`So3System`]): $R = C\,Q(y)$ and
+//! of the generated type ([`So3System`]): $R = C\thinspace Q(y)$ and
 //! $\Omega = 2 (y' - y \times y') / (1 + |y|^2)$.
 //!
 //! Moving the centre with the chart keeps the composed Lagrangian: for the centre
-//! $C\,Q(a)$ and the translated jet $\phi_a(y)$ ([`super::transition`]), $C\,Q(a)\,
-//! Q(\phi_a(y)) = C\,Q(y)$ and the body velocity is unchanged, so [`recentre_system`] moves
+//! $C\thinspace Q(a)$ and the translated jet $\phi_a(y)$ ([`super::transition`]), $C\thinspace Q(a)\thinspace
+//! Q(\phi_a(y)) = C\thinspace Q(y)$ and the body velocity is unchanged, so [`recentre_system`] moves
 //! the state and the system's centre together, and a step in the new chart continues the
 //! step of the old one, also when L depends on R (a potential, a pointing constraint).
 
@@ -53,10 +53,10 @@ pub fn recentre_system<Sys: So3System, const K: usize, const S: usize>(
 /// The derivatives $(y', \dots, y^{(J)})$ of the chart curve through the chart point `y`
 /// whose body velocity has the derivatives `rates` $= (\Omega, \Omega', \dots,
 /// \Omega^{(J-1)})$: the Taylor coefficients $c_m = y^{(m)}/m!$ of
-/// $y' = \tfrac12 (\Omega + y \times \Omega + (y \cdot \Omega)\, y)$ (the inverse of
+/// $y' = \tfrac12 (\Omega + y \times \Omega + (y \cdot \Omega)\thinspace y)$ (the inverse of
 /// $\Omega = 2 (y' - y \times y') / (1 + |y|^2)$), solved order by order:
 /// $c_{m+1} = \tfrac{1}{2(m+1)} \big(w_m + \sum_{i+j=m} c_i \times w_j
-/// + \sum_{i+j+l=m} (c_i \cdot w_j)\, c_l\big)$ with $w_j = \Omega^{(j)}/j!$.
+/// + \sum_{i+j+l=m} (c_i \cdot w_j)\thinspace c_l\big)$ with $w_j = \Omega^{(j)}/j!$.
 pub fn chart_derivatives<const J: usize>(
     y: &Vector3<f64>,
     rates: &[Vector3<f64>; J],

@@ -8,8 +8,8 @@
 //! written in body coordinates becomes a Lagrangian of $y$ by substituting $\Omega$ (and its
 //! total derivatives): rational functions, which the macro differentiates as usual.
 //!
-//! [`CayleyMidpoint`] is the group's discretization map $R_d(g, \xi) = (g\,
-//! \mathrm{cay}(-\xi/2), g\, \mathrm{cay}(\xi/2))$ with $\xi = 2 Q^{-1} \delta Q$ the body
+//! [`CayleyMidpoint`] is the group's discretization map $R_d(g, \xi) = (g\thinspace
+//! \mathrm{cay}(-\xi/2), g\thinspace \mathrm{cay}(\xi/2))$ with $\xi = 2 Q^{-1} \delta Q$ the body
 //! vector of the tangent vector $v$ at $y$ and $\mathrm{cay}(\omega) \propto (1, \omega/2)$
 //! (the Cayley map, equal to $\exp$ to second order). In the chart, with
 //! $w = \xi/4 = (v - y \times v) / (2 (1 + |y|^2))$ and the product
@@ -23,13 +23,13 @@
 //! lifts it to every order (and [`ExpMidpoint`], through [`Scalar::stumpff`], to order 16).
 //!
 //! [`ExpMidpoint`] is the map with the group's exponential, $R_d(g, \xi) = (g \exp(-\xi/2),
-//! g \exp(\xi/2))$: the same products with $w = \tan(\theta/2)\, \phi/\theta$, $\phi = \xi/2$,
-//! $\theta = |\phi|$, written as $c_2(\theta^2)/c_1(\theta^2)\, \phi$ in Stumpff functions
+//! g \exp(\xi/2))$: the same products with $w = \tan(\theta/2)\thinspace \phi/\theta$, $\phi = \xi/2$,
+//! $\theta = |\phi|$, written as $c_2(\theta^2)/c_1(\theta^2)\thinspace \phi$ in Stumpff functions
 //! ([`crate::special`]) so that it is smooth through $\xi = 0$. It follows a one-parameter
 //! subgroup (a spherical body's motion) exactly.
 //!
 //! One chart ends at a turn by $\pi$ from its centre. Moving charts ([`recentre`] after each
-//! step, a centre quaternion $c$ and the rotation $c\,Q(y)$) follow a body through any
+//! step, a centre quaternion $c$ and the rotation $c\thinspace Q(y)$) follow a body through any
 //! number of turns; the change of chart is symplectic and commutes with the step (module
 //! `moving`).
 //!
@@ -70,7 +70,7 @@ fn dot<T: Scalar>(a: &[T; 3], b: &[T; 3]) -> T {
 }
 
 /// The chart points $y \mp w \mp y \times w$ over $1 \pm y \cdot w$ of the left
-/// translations of $y$ by the Gibbs vectors $\mp w$, with $w = \rho(|\phi|^2)\, \phi$,
+/// translations of $y$ by the Gibbs vectors $\mp w$, with $w = \rho(|\phi|^2)\thinspace \phi$,
 /// $\phi = (v - y \times v) / (1 + |y|^2) = \Omega / 2$ (module docs).
 fn gibbs_halves<T: Scalar>(y: [T; 3], v: [T; 3], rho: impl Fn(T) -> T) -> ([T; 3], [T; 3]) {
     let yv = cross(&y, &v);
@@ -98,7 +98,7 @@ impl BaseMap<3> for CayleyMidpoint {
 /// The exponential midpoint map of SO(3) in the Gibbs chart: $R_d(g, \xi) = (g
 /// \exp(-\xi/2), g \exp(\xi/2))$, the exact flow of the constant body velocity $\xi$ over
 /// half a step either way, where [`CayleyMidpoint`] takes the Cayley map. Its Gibbs vector is
-/// $w = \tan(\theta/2)\, \phi / \theta$ with $\phi = \xi/2$, $\theta = |\phi|$: the ratio
+/// $w = \tan(\theta/2)\thinspace \phi / \theta$ with $\phi = \xi/2$, $\theta = |\phi|$: the ratio
 /// $\rho(s) = c_2(s) / c_1(s)$ of Stumpff functions ([`crate::special`]), entire near
 /// $\xi = 0$, so the map and its derivatives need no branch there. It is symmetric and
 /// left-equivariant as the Cayley map is, and a step costs a few more operations.
@@ -113,9 +113,9 @@ impl BaseMap<3> for ExpMidpoint {
 
 /// The Noether momentum of left multiplication at the chart state $(y, p)$ of a
 /// first-order system ($k = 1$): component $a$ is $p \cdot \delta_a y$ with
-/// $\delta_a y = \tfrac12 (e_a + e_a \times y + (e_a \cdot y)\, y)$, the chart velocity of
+/// $\delta_a y = \tfrac12 (e_a + e_a \times y + (e_a \cdot y)\thinspace y)$, the chart velocity of
 /// $Q \mapsto (1, \epsilon e_a / 2) Q$. For a Lagrangian written in body coordinates this is
-/// the spatial angular momentum $R\, \partial L / \partial \Omega$, conserved by the
+/// the spatial angular momentum $R\thinspace \partial L / \partial \Omega$, conserved by the
 /// cotangent lift of [`CayleyMidpoint`].
 pub fn spatial_momentum(y: &Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
     let z = crate::lifted::join::<3, 1, 6>(&[*y], &[*p]);

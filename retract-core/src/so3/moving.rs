@@ -1,9 +1,9 @@
 //! Moving charts: a rotation stored as a centre $c$ (a unit quaternion) and a Gibbs chart
-//! state whose point $y$ gives the rotation $g = c\,Q(y)$. After each step the chart is
+//! state whose point $y$ gives the rotation $g = c\thinspace Q(y)$. After each step the chart is
 //! moved to the step's end ([`recentre`]), so $y$ stays near 0, where the chart is best
 //! conditioned, and a trajectory may turn through any angle.
 //!
-//! Moving the centre from $c$ to $c\,Q(a)$ changes chart points by the left translation
+//! Moving the centre from $c$ to $c\thinspace Q(a)$ changes chart points by the left translation
 //! $Q(\phi_a(y)) \propto Q(a)^{-1} Q(y)$:
 //!
 //! $$\phi_a(y) = \frac{y - a - a \times y}{1 + a \cdot y},$$
@@ -29,7 +29,7 @@ use crate::map::taylor_lift::{curve, falling};
 use crate::taylor::{Dual, Scalar, Taylor};
 
 /// $\phi_a(y) = (y - a - a \times y) / (1 + a \cdot y)$: the chart point, in the chart
-/// centred at $c\,Q(a)$, of the point $y$ of the chart centred at $c$.
+/// centred at $c\thinspace Q(a)$, of the point $y$ of the chart centred at $c$.
 pub fn translate<T: Scalar>(a: &Vector3<f64>, y: [T; 3]) -> [T; 3] {
     let ay = [
         y[2] * a[1] - y[1] * a[2],
@@ -45,7 +45,7 @@ pub fn chart_quaternion(y: &Vector3<f64>) -> UnitQuaternion<f64> {
     UnitQuaternion::new_normalize(Quaternion::new(1.0, y[0], y[1], y[2]))
 }
 
-/// The rotation $c\,Q(y)$ of the chart state `z` (of order $k$) centred at `centre`.
+/// The rotation $c\thinspace Q(y)$ of the chart state `z` (of order $k$) centred at `centre`.
 pub fn orientation<const K: usize, const S: usize>(
     centre: &UnitQuaternion<f64>,
     z: &SVector<f64, S>,
@@ -65,7 +65,7 @@ pub fn chart_point(centre: &UnitQuaternion<f64>, g: &UnitQuaternion<f64>) -> Opt
 }
 
 /// The state `z` (of order $k$: jet and momenta of $y$) in the chart centred at
-/// $c\,Q(a)$ instead of $c$ (module docs): the jet by $D^j \phi_a$, the momenta by the
+/// $c\thinspace Q(a)$ instead of $c$ (module docs): the jet by $D^j \phi_a$, the momenta by the
 /// inverse transpose of its Jacobian. An error if the rotation is a half-turn from the new
 /// centre ($|1 + a \cdot y| \le 10^{-12} (1 + |a| |y|)$, where no Gibbs chart centred there
 /// reaches) or the result is not finite.
@@ -126,7 +126,7 @@ pub(crate) fn transition_blocks<const K: usize>(
     Ok((jet, momenta))
 }
 
-/// Moves the chart of `z` to its own point: `centre` becomes $c\,Q(y)$ (renormalised) and
+/// Moves the chart of `z` to its own point: `centre` becomes $c\thinspace Q(y)$ (renormalised) and
 /// `z` the same state in that chart ([`transition`] with $a = y$), whose point is 0. An
 /// error (with nothing changed) if `z` is not finite.
 pub fn recentre<const K: usize, const S: usize>(
@@ -142,9 +142,9 @@ pub fn recentre<const K: usize, const S: usize>(
 }
 
 /// The spatial angular momentum (the Noether momentum of left multiplication, in the world
-/// frame) of the chart state `z` of order $k$ centred at `centre`: $R(c)\, M$ with
+/// frame) of the chart state `z` of order $k$ centred at `centre`: $R(c)\thinspace M$ with
 /// $M_a = \sum_j p_j \cdot D^j[\delta_a y]$, where $\delta_a y = \tfrac12 (e_a + e_a
-/// \times y + (e_a \cdot y)\, y)$ is the chart velocity of $Q \mapsto (1, \epsilon e_a / 2)
+/// \times y + (e_a \cdot y)\thinspace y)$ is the chart velocity of $Q \mapsto (1, \epsilon e_a / 2)
 /// Q$. At $k = 1$ and $c = 1$ it is [`super::spatial_momentum`]. The lifted Cayley midpoint
 /// map conserves it for a Lagrangian written in body coordinates.
 pub fn world_momentum<const K: usize, const S: usize>(

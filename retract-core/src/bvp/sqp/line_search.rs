@@ -1,5 +1,5 @@
 //! The line search of the SQP iteration: IPOPT's filter (Wächter and Biegler, Math. Program.
-//! 106, 2006) on the pair (constraint violation $\theta = \|c\|_1$, barrier cost $\varphi = J -
+//! 106, 2006) on the pair (constraint violation $\theta = \Vert c\Vert_1$, barrier cost $\varphi = J -
 //! h \mu \sum \ln s$), and where the filter finds no step, backtracking on the exact penalty
 //! $\varphi + \pi \theta$.
 //!
@@ -82,8 +82,8 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
-    /// The barrier cost $J - h \mu \sum \ln s$ and $\|c\|_1$ (with $\sum |g - s|$) at a
-    /// trial point whose slacks are $s + \alpha\,\delta s$; `None` if not finite.
+    /// The barrier cost $J - h \mu \sum \ln s$ and $\Vert c\Vert_1$ (with $\sum |g - s|$) at a
+    /// trial point whose slacks are $s + \alpha\thinspace\delta s$; `None` if not finite.
     fn merit_parts(
         &self,
         iterate: &Iterate<N, X>,
@@ -293,7 +293,7 @@ where
         Ok(None)
     }
 
-    /// Backtracking on $\varphi + \pi \|c\|_1$ along the direction (where the filter finds no
+    /// Backtracking on $\varphi + \pi \Vert c\Vert_1$ along the direction (where the filter finds no
     /// step): the accepted point, the step length and whether the decrease was at rounding
     /// level; [`Failure::LineSearch`] if no step is accepted, [`Failure::TimeLimit`] if the
     /// budget runs out between trials.
