@@ -84,8 +84,13 @@ pub mod step;
 pub mod system;
 pub mod taylor;
 
+// the optimizer at the root, beside the legacy root finder (both live in `bvp`)
 #[cfg(feature = "std")]
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
+#[cfg(feature = "std")]
+pub use bvp::{
+    OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, PlanOptions, Variable,
+};
 pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
 pub use newton::NewtonOptions;
