@@ -1,11 +1,17 @@
-//! The `#[higher_order_lagrangian]`, `#[jet_function]` and `#[discretization_map]`
-//! attributes of `retract`; the expansions live in `retract-codegen`.
+//! The attributes of `retract`: `#[higher_order_lagrangian]` (a Lagrangian into an
+//! integrator and an optimal-control cost), `#[jet_function]` (a function of the jet into a
+//! constraint), `#[discretization_map]` (a discretization map into its lift) and `#[helper]`
+//! (a function shared by them). The expansions live in `retract-codegen`.
 #![forbid(unsafe_code)]
 
 use proc_macro::TokenStream;
 
-/// Turns a higher-order Lagrangian into an integrator (a runnable example is in the docs of
-/// `retract`, which re-exports this attribute).
+/// Turns a higher-order Lagrangian L(q, q', ..., q^(k)) written as a Rust function into a
+/// type with L's gradient and Hessian, the Ostrogradsky momenta and the residual and Jacobian
+/// of the lifted midpoint scheme, all differentiated at compile time into straight-line,
+/// allocation-free code: an integrator (`retract::step`) and an optimal-control cost
+/// (`retract::OptimalControlProblem`). A runnable example is in the docs of `retract`, which
+/// re-exports this attribute.
 ///
 /// The first k + 1 arguments are the jet q, q', ..., q^(k) (`[f64; N]`, or `f64` for
 /// N = 1); later arguments are parameters (`f64`, `[f64; M]`, `&[[f64; M]]`) and become
