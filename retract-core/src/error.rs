@@ -120,7 +120,9 @@ impl Error {
         }
     }
 
-    /// [`Error::SolutionOutsideDomain`] at `step` for `violation`.
+    /// [`Error::SolutionOutsideDomain`] at `step` for `violation` (the root finder's, with
+    /// `std`).
+    #[cfg(feature = "std")]
     pub(crate) fn solution_outside_domain(step: usize, violation: DomainViolation) -> Self {
         let index = |k: usize| u32::try_from(k).unwrap_or(u32::MAX);
         Error::SolutionOutsideDomain {
