@@ -83,6 +83,22 @@ fn outside_domain(f: &mut fmt::Formatter<'_>, data: &str, error: &Error) -> fmt:
     )
 }
 
+/// [`Error::SolutionOutsideDomain`]: the step, its guard's violation and what to do.
+fn solution_outside_domain(f: &mut fmt::Formatter<'_>, step: u32, error: &Error) -> fmt::Result {
+    write!(
+        f,
+        "the solution's step {step} leaves the domain of the Lagrangian"
+    )?;
+    if let Some(violation) = error.violation() {
+        write!(f, " ({violation})")?;
+    }
+    write!(
+        f,
+        ": a pole lies on it, so this is not a plan; use more steps or a guess that stays clear \
+         of the singular set (around an obstacle, not through it)"
+    )
+}
+
 /// A violation at a single point (no step): the condition that fails there.
 fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Result {
     let expression = violation.expression;
@@ -102,24 +118,6 @@ fn at_point(f: &mut fmt::Formatter<'_>, violation: &DomainViolation) -> fmt::Res
 }
 
 impl Error {
-    /// The guard's violation of [`Error::SolutionOutsideDomain`] as a [`DomainViolation`]
-    /// (`None` for the other variants).
-    pub fn solution_violation(&self) -> Option<DomainViolation> {
-        match *self {
-            Error::SolutionOutsideDomain {
-                expression,
-                kind,
-                element,
-                ..
-            } => Some(DomainViolation {
-                expression,
-                kind,
-                element: element.map(|k| k as usize),
-            }),
-            _ => None,
-        }
-    }
-
     /// [`Error::SolutionOutsideDomain`] at `step` for `violation` (the root finder's, with
     /// `std`).
     #[cfg(feature = "std")]
@@ -200,7 +198,7 @@ pub enum Error {
     /// evaluation point or between its nodes, e.g. a path through an obstacle whose barrier
     /// is a term of $L$): the solution is not a plan.
     /// (The violation's fields are held flat, the indices as `u32`, so that an error stays
-    /// small enough to be returned by value: [`Self::solution_violation`] gives it whole.)
+    /// small enough to be returned by value: [`Self::violation`] gives it whole.)
     SolutionOutsideDomain {
         /// Index of the step (saturated at `u32::MAX`).
         step: u32,
@@ -362,7 +360,8 @@ impl Error {
     /// The guarded expression behind a domain error: the violation of a step
     /// ([`Error::Domain`]) or of given data ([`Error::InitialStateOutsideDomain`],
     /// [`Error::StartOutsideDomain`], [`Error::GoalOutsideDomain`],
-    /// [`Error::BoundariesSeparated`]); `None` for every other error.
+    /// [`Error::BoundariesSeparated`]) or of a root-finder solution
+    /// ([`Error::SolutionOutsideDomain`]); `None` for every other error.
     pub fn violation(&self) -> Option<DomainViolation> {
         match *self {
             Error::Domain(violation) => Some(violation),
@@ -385,6 +384,12 @@ impl Error {
                 expression,
                 kind,
                 element,
+            }
+            | Error::SolutionOutsideDomain {
+                expression,
+                kind,
+                element,
+                ..
             } => Some(DomainViolation {
                 expression,
                 kind,
@@ -463,17 +468,7 @@ impl fmt::Display for Error {
                  state {step}); inside an obstacle the cost is unbounded below, so this is not \
                  a plan: start from a guess that goes around it or raise the barrier weight"
             ),
-            Error::SolutionOutsideDomain { step, .. } => write!(
-                f,
-                "the solution's step {step} leaves the domain of the Lagrangian ({violation}): \
-                 a pole lies on it, so this is not a plan; use more steps or a guess that stays \
-                 clear of the singular set (around an obstacle, not through it)",
-                violation = self.solution_violation().unwrap_or(DomainViolation {
-                    expression: "",
-                    kind: DomainKind::Denominator,
-                    element: None,
-                })
-            ),
+            Error::SolutionOutsideDomain { step, .. } => solution_outside_domain(f, step, self),
             Error::GuessThroughObstacle {
                 obstacle,
                 step,

@@ -449,7 +449,7 @@ fn a_solution_through_a_pole_between_its_nodes_is_refused() {
         match solve_scene(&[[0.7, 0.02, 0.2]], 1e-3, &start, &goal, 4.0, steps) {
             Err(error @ Error::SolutionOutsideDomain { step, .. }) => {
                 assert_eq!(step, crossing);
-                let violation = error.solution_violation().expect("the violation");
+                let violation = error.violation().expect("the violation");
                 assert_eq!(violation.kind, retract::DomainKind::Denominator);
                 assert_eq!(violation.element, Some(0));
                 assert!(
