@@ -1,6 +1,7 @@
 //! The stepping path allocates nothing: a counting global allocator sees zero allocations
 //! during steps (predictor, Newton, domain check), a Newton solve, the symplecticity
-//! diagnostic and an RK4 step of a generated system.
+//! diagnostic and an RK4 step of a generated system; nor do the optimizer's warm re-solves in
+//! a workspace and the receding horizon's control periods.
 
 mod common;
 
@@ -99,4 +100,88 @@ fn jet_functions_allocate_nothing() {
     let after = allocations();
     assert_eq!(after - before, 0, "allocations in a jet function");
     assert!(acc.is_finite() && acc != 0.0);
+}
+
+// the cart-pole of the swing-up suite, shared with the examples
+#[path = "../examples/common/cart_pole.rs"]
+mod cart_pole;
+
+/// A warm re-solve in a workspace that has seen a solve of the same size allocates nothing:
+/// the bounded cart-pole (C1 of the constrained suite, T = 2, |F| <= 12, at a fifth of its
+/// steps: an equality, a two-sided inequality, the barrier, the filter and the certificate's
+/// smallest eigenvalue), re-solved from the plan of the previous start as the start moves,
+/// with the replaced plans given back to the workspace.
+#[test]
+fn a_warm_re_solve_in_a_workspace_allocates_nothing() {
+    use cart_pole::{CartForce, CartPole, PoleTorque};
+    use retract::bvp::{OptimalControlProblem, PlanGuess, Workspace};
+    let system = CartPole::new(1.0, 0.3, 0.5);
+    let unactuated = PoleTorque::new(0.3, 0.5, 9.81);
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    let upright = [0.0, std::f64::consts::PI, 0.0, 0.0];
+    let mut problem = OptimalControlProblem::new(&system, &[0.0; 4], &upright, 2.0, 40)
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -12.0, 12.0);
+    let mut workspace = Workspace::new();
+    let mut plan = problem
+        .solve_with(PlanGuess::Spline, &mut workspace)
+        .expect("cold");
+    let mut counted = Vec::new();
+    for (k, x0) in [0.01, 0.02, 0.03, 0.04].into_iter().enumerate() {
+        problem.set_start(&[x0, 0.0, 0.0, 0.0]);
+        let before = allocations();
+        let next = problem
+            .solve_with(PlanGuess::Plan(&plan), &mut workspace)
+            .unwrap_or_else(|e| panic!("x0 = {x0}: {e}"));
+        workspace.recycle(std::mem::replace(&mut plan, next));
+        // (the first warm solve sizes what a warm solve needs beyond a cold one)
+        if k > 0 {
+            counted.push((x0, allocations() - before, plan.iterations));
+        }
+    }
+    for (x0, count, iterations) in counted {
+        assert_eq!(
+            count, 0,
+            "x0 = {x0}: {count} allocations in {iterations} iterations"
+        );
+        // the work was real: iterations, the bound held, a certified minimum
+        assert!(iterations >= 1, "x0 = {x0}");
+    }
+    let eig = plan.certificate.min_reduced_hessian_eig;
+    assert!(eig > 0.0 && eig.is_finite(), "{eig}");
+    assert!(plan.violations.imposed() <= 1e-8 && (plan.x[0][0] - 0.04).abs() < 1e-12);
+}
+
+// the double pendulum's receding-horizon controller, shared with the examples
+#[path = "../examples/common/pendulum.rs"]
+mod pendulum;
+
+/// A control period of the receding horizon (the real-time re-plan from the shifted plan in
+/// one workspace, its first torque and the plant's step) allocates nothing once the workspace
+/// holds as many vectors as a re-plan needs at once: 300 periods of the swing-up of
+/// `examples/mpc.rs`, counted from period 50. (The workspace grows only when a re-plan holds
+/// more vectors at once than any before it: here a certificate that refactorises beside the
+/// iteration's own factorisations, first at period 44.)
+#[test]
+fn a_receding_horizon_period_allocates_nothing() {
+    use pendulum::{Controller, Replan, models, plant_step};
+    let (model, plant) = models();
+    let mut jet = [0.0; 4];
+    let mut z = plant.legendre(&SVector::from(jet));
+    let mut controller = Controller::new(&model, &jet);
+    let (mut counted, mut certified) = (0, 0);
+    for period in 0..300 {
+        let before = allocations();
+        let outcome = controller.replan(&jet);
+        (z, jet) = plant_step(&plant, &z, &jet, controller.torque()).expect("plant step");
+        if period >= 50 {
+            counted += allocations() - before;
+            certified += usize::from(outcome == Replan::Converged);
+        }
+        assert_ne!(outcome, Replan::Failed, "period {period}");
+    }
+    assert_eq!(counted, 0, "allocations in 250 periods");
+    // the work was real: the pendulum is upright and the re-plans were certified
+    let off = (jet[0] - std::f64::consts::PI).abs().max(jet[1].abs());
+    assert!(off < 1e-2 && certified > 200, "{jet:?} {certified}");
 }

@@ -15,7 +15,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
+use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, Workspace};
 use retract::forced::forced_step;
 use retract::nalgebra::SVector;
 use retract::{
@@ -160,19 +160,106 @@ fn first_torque(model: &TorqueCost, plan: &Plan<2, 4>) -> [f64; 2] {
     model.tau(&jet, &plan.u[0])
 }
 
+/// The receding-horizon controller: one problem, re-solved from each measured state by
+/// [`ITERATIONS`] SQP iterations from the last plan moved one period on, in one workspace
+/// (no allocation a period once the workspace has served a re-plan).
+pub struct Controller<'m> {
+    model: &'m TorqueCost,
+    problem: OptimalControlProblem<'m, TorqueCost, 2, 2, 4>,
+    workspace: Workspace<2, 4>,
+    plan: Option<Plan<2, 4>>,
+}
+
+/// How a re-plan ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Replan {
+    /// A certified plan.
+    Converged,
+    /// The iterate after [`ITERATIONS`] iterations.
+    Unfinished,
+    /// A failure: the controller goes on with its last iterate (or the shifted plan).
+    Failed,
+}
+
+impl<'m> Controller<'m> {
+    /// A controller towards the upright rest state, from the jet `jet`.
+    pub fn new(model: &'m TorqueCost, jet: &[f64; 4]) -> Self {
+        let goal = [PI, 0.0, 0.0, 0.0];
+        Self {
+            model,
+            problem: OptimalControlProblem::new(model, jet, &goal, HORIZON, STEPS),
+            workspace: Workspace::new(),
+            plan: None,
+        }
+    }
+
+    /// Re-plans from the measured jet `jet`.
+    pub fn replan(&mut self, jet: &[f64; 4]) -> Replan {
+        self.problem.set_start(jet);
+        // the last plan moved one period on (one it cannot shift is kept as it is)
+        if let Some(plan) = self.plan.as_mut() {
+            let _ = plan.try_shift();
+        }
+        let guess = self
+            .plan
+            .as_ref()
+            .map_or(PlanGuess::Spline, PlanGuess::Plan);
+        let result = (self.problem).solve_real_time_with(guess, ITERATIONS, &mut self.workspace);
+        let (next, outcome) = match result {
+            Ok(real_time) if real_time.converged => (Some(real_time.plan), Replan::Converged),
+            Ok(real_time) => (Some(real_time.plan), Replan::Unfinished),
+            // keep going on the last iterate (or the previous plan, shifted)
+            Err(error) => (error.last.map(|p| *p), Replan::Failed),
+        };
+        if let Some(next) = next
+            && let Some(old) = self.plan.replace(next)
+        {
+            self.workspace.recycle(old);
+        }
+        outcome
+    }
+
+    /// The torque of the plan's first step (zero without any plan).
+    pub fn torque(&self) -> [f64; 2] {
+        (self.plan.as_ref()).map_or([0.0; 2], |plan| first_torque(self.model, plan))
+    }
+}
+
+/// The plant: one forced-midpoint step of `h` under the torque `tau` from the canonical state
+/// `z`, returning the new state and its jet.
+///
+/// # Errors
+/// A step that fails.
+pub fn plant_step(
+    pendulum: &Plant,
+    z: &SVector<f64, 4>,
+    jet: &[f64; 4],
+    tau: [f64; 2],
+) -> Result<(SVector<f64, 4>, [f64; 4]), retract::Error> {
+    let h = HORIZON / STEPS as f64;
+    let (z, _) = forced_step(pendulum, z, &SVector::from(tau), h, &StepOptions::default())?;
+    let q = SVector::<f64, 2>::from([z[0], z[1]]);
+    let p = SVector::<f64, 2>::from([z[2], z[3]]);
+    let dq = pendulum.top_derivative(&[q], &p, &SVector::from([jet[2], jet[3]]))?;
+    Ok((z, [q[0], q[1], dq[0], dq[1]]))
+}
+
+/// The planner's model and the plant of the double pendulum.
+pub fn models() -> (TorqueCost, Plant) {
+    (
+        TorqueCost::new(M1, M2, L1, L2, G),
+        Plant::new(M1, M2, L1, L2, G),
+    )
+}
+
 /// Runs `replans` control periods from the hanging rest state.
 ///
 /// # Errors
 /// A plant step that fails (the plant itself, not a re-plan: those are counted).
 pub fn run(replans: usize) -> Result<Summary, retract::Error> {
-    let model = TorqueCost::new(M1, M2, L1, L2, G);
-    let pendulum = Plant::new(M1, M2, L1, L2, G);
-    let h = HORIZON / STEPS as f64;
-    let goal = [PI, 0.0, 0.0, 0.0];
-    let options = StepOptions::default();
+    let (model, pendulum) = models();
     let mut jet = [0.0; 4];
     let mut z = pendulum.legendre(&SVector::from(jet));
-    let mut plan: Option<Plan<2, 4>> = None;
     let mut summary = Summary {
         replans,
         failures: 0,
@@ -181,35 +268,16 @@ pub fn run(replans: usize) -> Result<Summary, retract::Error> {
         last: jet,
         max_torque: 0.0,
     };
+    let mut controller = Controller::new(&model, &jet);
     for _ in 0..replans {
-        let problem = OptimalControlProblem::new(&model, &jet, &goal, HORIZON, STEPS);
-        let shifted = plan.as_ref().map(Plan::shifted);
-        let guess = shifted.as_ref().map_or(PlanGuess::Spline, PlanGuess::Plan);
         let started = Instant::now();
-        let result = problem.solve_real_time(guess, ITERATIONS);
+        let outcome = controller.replan(&jet);
         summary.times_us.push(started.elapsed().as_secs_f64() * 1e6);
-        match result {
-            Ok(real_time) => {
-                summary.converged += usize::from(real_time.converged);
-                plan = Some(real_time.plan);
-            }
-            Err(error) => {
-                summary.failures += 1;
-                // keep going on the last iterate (or the previous plan, shifted)
-                plan = error.last.map(|p| *p).or(shifted);
-            }
-        }
-        // the plant: one forced-midpoint step under the plan's first torque (zero without
-        // any plan)
-        let tau = plan
-            .as_ref()
-            .map_or([0.0; 2], |plan| first_torque(&model, plan));
+        summary.converged += usize::from(outcome == Replan::Converged);
+        summary.failures += usize::from(outcome == Replan::Failed);
+        let tau = controller.torque();
         summary.max_torque = summary.max_torque.max(tau[0].abs()).max(tau[1].abs());
-        (z, _) = forced_step(&pendulum, &z, &SVector::from(tau), h, &options)?;
-        let q = SVector::<f64, 2>::from([z[0], z[1]]);
-        let p = SVector::<f64, 2>::from([z[2], z[3]]);
-        let dq = pendulum.top_derivative(&[q], &p, &SVector::from([jet[2], jet[3]]))?;
-        jet = [q[0], q[1], dq[0], dq[1]];
+        (z, jet) = plant_step(&pendulum, &z, &jet, tau)?;
     }
     summary.last = jet;
     Ok(summary)

@@ -11,10 +11,6 @@ use crate::common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 /// A warm-started plan `warm` ends at the cold start's cost (to `relative` of it) in no more
 /// iterations.
 pub fn assert_warm_matches_cold(warm: &Plan<2, 4>, cold: &Plan<2, 4>, relative: f64, case: &str) {
-    eprintln!(
-        "WARMTRACE {case}: warm {} cold {}",
-        warm.iterations, cold.iterations
-    );
     assert!(
         (warm.cost - cold.cost).abs() <= relative * cold.cost,
         "{case}: warm {} cold {}",

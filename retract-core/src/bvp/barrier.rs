@@ -63,29 +63,34 @@ impl Barrier {
     /// at the first iterate (IPOPT's `bound_mult_init_val` 1 in the transcribed problem's
     /// units, where the multiplier is $h z$), for `count` inequalities per step and `nodes` per
     /// interior node over `steps` steps of length `h`.
+    /// (`vectors`: three empty vectors for $s$, $z$, $y$.)
     pub fn new(
         (mu, h): (f64, f64),
         (count, nodes, steps): (usize, usize, usize),
         values: &[f64],
         push: impl Fn(usize) -> (f64, f64),
+        [mut s, mut z, mut y]: [Vec<f64>; 3],
     ) -> Self {
-        let s: Vec<f64> = values
-            .iter()
-            .enumerate()
-            .map(|(k, g)| {
-                let (low, high) = push(k);
-                g.max(low).min(high)
-            })
-            .collect();
+        s.extend(values.iter().enumerate().map(|(k, g)| {
+            let (low, high) = push(k);
+            g.max(low).min(high)
+        }));
+        z.resize(s.len(), 1.0 / h);
+        y.resize(s.len(), 1.0 / h);
         Self {
             mu,
-            z: vec![1.0 / h; s.len()],
-            y: vec![1.0 / h; s.len()],
             s,
+            z,
+            y,
             count,
             nodes,
             steps,
         }
+    }
+
+    /// Its vectors $s$, $z$, $y$ (to keep for a later [`Self::new`] or [`Self::warm`]).
+    pub fn into_vectors(self) -> [Vec<f64>; 3] {
+        [self.s, self.z, self.y]
     }
 
     /// The barrier of a primal-dual warm start from `duals` (which fit the layout `(count,
@@ -100,17 +105,17 @@ impl Barrier {
         duals: &super::duals::Duals<N>,
         (count, nodes, steps): (usize, usize, usize),
         floor: f64,
+        [mut s, mut z, mut y]: [Vec<f64>; 3],
     ) -> Self {
-        let s = (duals.step_slacks.iter().chain(&duals.node_slacks))
-            .map(|s| s.max(WARM_SLACK_PUSH))
-            .collect();
-        let z: Vec<f64> = (duals.step_multipliers.iter().chain(&duals.node_multipliers))
-            .copied()
-            .collect();
+        s.extend(
+            (duals.step_slacks.iter().chain(&duals.node_slacks)).map(|s| s.max(WARM_SLACK_PUSH)),
+        );
+        z.extend(duals.step_multipliers.iter().chain(&duals.node_multipliers));
+        y.extend_from_slice(&z);
         Self {
             mu: duals.barrier.max(floor),
             s,
-            y: z.clone(),
+            y,
             z,
             count,
             nodes,
@@ -150,8 +155,8 @@ impl Barrier {
     ) {
         let node = stage
             .node
-            .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
-        let (hessian, gradient) = &mut **node;
+            .get_or_insert_with(|| (SMatrix::zeros(), SVector::zeros()));
+        let (hessian, gradient) = node;
         for (j, c) in lin.iter().enumerate() {
             let k = self.node_index(i, j);
             let (s, z) = (self.s[k], self.z[k]);
@@ -162,20 +167,24 @@ impl Barrier {
 
     /// $-h z \nabla g$ summed over the inequalities of every node ($i = 0, \dots, N$; zero at
     /// the ends and where there are none), with the multipliers `z`: the node terms of the
-    /// gradient of the Lagrangian.
+    /// gradient of the Lagrangian (in `out`, emptied first).
     pub fn node_gradients<const N: usize, const X: usize>(
         &self,
         lin: &[Linearized<N, X>],
         z: &[f64],
         h: f64,
-    ) -> Vec<SVector<f64, X>> {
-        let mut out = vec![SVector::zeros(); if self.nodes > 0 { self.steps + 1 } else { 0 }];
+        out: &mut Vec<SVector<f64, X>>,
+    ) {
+        out.clear();
+        out.resize(
+            if self.nodes > 0 { self.steps + 1 } else { 0 },
+            SVector::zeros(),
+        );
         for (k, c) in lin.iter().enumerate().skip(self.at_steps()) {
             if let Slot::Node(i) = self.slot(k) {
                 out[i] -= c.gx * (h * z[k]);
             }
         }
-        out
     }
 
     /// The barrier's share $\sum_k h (z_k / s_k) (\nabla g_k^T \delta y)^2$ of the model's
@@ -200,35 +209,26 @@ impl Barrier {
     /// The multipliers after a primal-dual step with slack steps `ds`:
     /// $z + \alpha_z \delta z$, $\delta z = (\mu - z s - z\thinspace\delta s) / s$ and
     /// $\alpha_z$ the dual fraction-to-the-boundary step of [`Self::update`] (1 near a
-    /// solution, where this is $(\mu - z\thinspace\delta s) / s$).
-    pub fn predicted(&self, ds: &[f64]) -> Vec<f64> {
-        let dz = self.dual_steps(ds);
-        let alpha_z = self.dual_step_length(&dz);
-        self.z
-            .iter()
-            .zip(&dz)
-            .map(|(z, d)| z + alpha_z * d)
-            .collect()
+    /// solution, where this is $(\mu - z\thinspace\delta s) / s$), in `out` (emptied first).
+    pub fn predicted(&self, ds: &[f64], out: &mut Vec<f64>) {
+        let alpha_z = self.dual_step_length(ds);
+        out.clear();
+        out.extend((0..self.z.len()).map(|k| self.z[k] + alpha_z * self.dual_step(k, ds)));
     }
 
-    /// $\delta z = (\mu - z s - z\thinspace\delta s) / s$.
-    fn dual_steps(&self, ds: &[f64]) -> Vec<f64> {
-        self.z
-            .iter()
-            .zip(&self.s)
-            .zip(ds)
-            .map(|((z, s), d)| (self.mu - z * s - z * d) / s)
-            .collect()
+    /// $\delta z_k = (\mu - z_k s_k - z_k\thinspace\delta s_k) / s_k$.
+    fn dual_step(&self, k: usize, ds: &[f64]) -> f64 {
+        let (z, s) = (self.z[k], self.s[k]);
+        (self.mu - z * s - z * ds[k]) / s
     }
 
-    /// The largest step in $(0, 1]$ along `dz` that keeps every multiplier above
-    /// $(1 - \tau)$ times its value.
-    fn dual_step_length(&self, dz: &[f64]) -> f64 {
+    /// The largest step in $(0, 1]$ along $\delta z$ ([`Self::dual_step`]) that keeps every
+    /// multiplier above $(1 - \tau)$ times its value.
+    fn dual_step_length(&self, ds: &[f64]) -> f64 {
         let tau = self.tau();
-        self.z
-            .iter()
-            .zip(dz)
-            .filter(|(_, d)| **d < 0.0)
+        (0..self.z.len())
+            .map(|k| (self.z[k], self.dual_step(k, ds)))
+            .filter(|(_, d)| *d < 0.0)
             .fold(1.0_f64, |a, (z, d)| a.min(-tau * z / d))
     }
 
@@ -296,7 +296,7 @@ impl Barrier {
             Slot::Node(i) => {
                 let node = stages[i]
                     .node
-                    .get_or_insert_with(|| Box::new((SMatrix::zeros(), SVector::zeros())));
+                    .get_or_insert_with(|| (SMatrix::zeros(), SVector::zeros()));
                 node.0 += c.gx * c.gx.transpose() * weight;
             }
         }
@@ -324,20 +324,20 @@ impl Barrier {
         lin: &[Linearized<N, X>],
         direction: &Direction<N, X>,
         theta: f64,
+        mut out: Vec<f64>,
     ) -> Vec<f64> {
-        lin.iter()
-            .enumerate()
-            .map(|(k, c)| {
-                let change = match self.slot(k) {
-                    Slot::Step(i) => {
-                        let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
-                        c.gx.dot(&dx) + c.gu.dot(&direction.du[i])
-                    }
-                    Slot::Node(i) => c.gx.dot(&direction.dx[i]),
-                };
-                change + c.value - self.s[k]
-            })
-            .collect()
+        out.clear();
+        out.extend(lin.iter().enumerate().map(|(k, c)| {
+            let change = match self.slot(k) {
+                Slot::Step(i) => {
+                    let dx = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+                    c.gx.dot(&dx) + c.gu.dot(&direction.du[i])
+                }
+                Slot::Node(i) => c.gx.dot(&direction.dx[i]),
+            };
+            change + c.value - self.s[k]
+        }));
+        out
     }
 
     /// The largest step length in $(0, 1]$ that keeps every slack above $(1 - \tau)$ times
@@ -416,14 +416,13 @@ impl Barrier {
     /// Takes the step: slacks by `alpha` along `ds`, the multipliers $z$ by their own
     /// length, the multipliers $y$ by `alpha` towards $z + \delta z$.
     pub fn update(&mut self, ds: &[f64], alpha: f64) {
-        let dz = self.dual_steps(ds);
-        let alpha_z = self.dual_step_length(&dz);
-        for ((y, z), dzk) in self.y.iter_mut().zip(&self.z).zip(&dz) {
-            *y += alpha * (z + dzk - *y);
-        }
-        for (((z, s), d), dzk) in self.z.iter_mut().zip(self.s.iter_mut()).zip(ds).zip(&dz) {
-            *s += alpha * d;
-            *z = (*z + alpha_z * dzk).clamp(self.mu / (1e10 * *s), 1e10 * self.mu / *s);
+        let alpha_z = self.dual_step_length(ds);
+        for k in 0..self.z.len() {
+            let dzk = self.dual_step(k, ds);
+            self.y[k] += alpha * (self.z[k] + dzk - self.y[k]);
+            self.s[k] += alpha * ds[k];
+            let s = self.s[k];
+            self.z[k] = (self.z[k] + alpha_z * dzk).clamp(self.mu / (1e10 * s), 1e10 * self.mu / s);
         }
     }
 
@@ -443,7 +442,14 @@ mod tests {
     /// its value to the Newton value $z + \delta z$.
     #[test]
     fn the_curvature_multiplier_follows_the_primal_step() {
-        let mut barrier = Barrier::new((0.1, 1.0), (1, 0, 1), &[0.5], |_| (0.01, f64::INFINITY));
+        let empty = [Vec::new(), Vec::new(), Vec::new()];
+        let mut barrier = Barrier::new(
+            (0.1, 1.0),
+            (1, 0, 1),
+            &[0.5],
+            |_| (0.01, f64::INFINITY),
+            empty,
+        );
         barrier.y = vec![3.0];
         let (s, z) = (barrier.s[0], barrier.z[0]);
         let ds = -0.45;

@@ -1,9 +1,10 @@
 //! What a plan is certified by: the KKT residuals with the momenta recovered from the
 //! multipliers, and the smallest eigenvalue of the reduced Hessian.
 
-use nalgebra::{DMatrix, SVector, SymmetricEigen};
+use nalgebra::SVector;
 
 use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
+use super::workspace::Pool;
 use crate::newton::max_abs;
 
 /// The multipliers $\mu_i$ of the scheme's $x$-equations
@@ -23,7 +24,7 @@ use crate::newton::max_abs;
 /// gradient $n_i$ in $x_i$ from the inequalities at the nodes; empty without them) add to
 /// $r_{x,i}$: where such a constraint is active the momentum jumps at the node, $p_{i+1} - p_i
 /// = d_i + n_{i+1}$, and $p_{i+1}$ above is the value after the jump.
-/// Returns the momenta, the
+/// Returns the momenta (in `momenta`, emptied first), the
 /// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \sigma)$ (the terminal
 /// residual without the $h$) and its scale $\sigma = \max(1, |\nabla L|_\infty)$.
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
@@ -33,6 +34,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     direction: &Direction<N, X>,
     node_gradients: &[SVector<f64, X>],
     (terminal_gradient, fixed, start_fixed): (&SVector<f64, X>, &SVector<f64, X>, &SVector<f64, X>),
+    mut momenta: Vec<SVector<f64, X>>,
 ) -> (Vec<SVector<f64, X>>, f64, f64) {
     let (h, theta) = (dynamics.h, dynamics.theta);
     let wt = &dynamics.poly_w;
@@ -41,7 +43,7 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         SVector::<f64, X>::from_fn(|r, _| if r >= N { mu[r - N] } else { 0.0 })
     };
     let steps = stages.len();
-    let mut momenta = Vec::with_capacity(steps + 1);
+    momenta.clear();
     let mut worst: f64 = 0.0;
     // max |grad (h L)|_inf over the steps (divided by h once, at the end)
     let mut largest: f64 = 0.0;
@@ -106,90 +108,155 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
     steps: usize,
+    pool: &mut Pool<N, X>,
 ) -> f64 {
-    let inner = (steps - 1) * X;
-    let dim = inner + steps * N;
-    let apply = |v: &[f64]| -> Vec<f64> {
-        let linear = |i: usize| {
-            let lx = if i >= 1 && i < steps {
-                SVector::<f64, X>::from_fn(|r, _| -v[(i - 1) * X + r])
-            } else {
-                SVector::zeros()
-            };
-            let lu = SVector::<f64, N>::from_fn(|a, _| -v[inner + i * N + a]);
-            StageLinear {
-                lx,
-                lu,
-                defect: SVector::zeros(),
-                constraint: SVector::zeros(),
-            }
-        };
-        let zero = SVector::<f64, X>::zeros();
-        let d = riccati.solve_linear(dynamics, &linear, &zero, (&zero, &zero));
-        let mut out = Vec::with_capacity(dim);
-        for dx in &d.dx[1..steps] {
-            out.extend_from_slice(dx.as_slice());
-        }
-        for du in &d.du {
-            out.extend_from_slice(du.as_slice());
-        }
-        out
-    };
+    let dim = (steps - 1) * X + steps * N;
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector
-    let seed: Vec<f64> = (0..dim)
-        .map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5)
-        .collect();
-    let mut q = apply(&seed);
+    let mut seed = pool.lanczos.take(dim);
+    seed.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
+    let mut q = pool.lanczos.take(dim);
+    apply_inverse(riccati, dynamics, &seed, &mut q, pool);
+    let (mut q_prev, mut w) = (seed, pool.lanczos.take(dim));
+    q_prev.iter_mut().for_each(|x| *x = 0.0);
+    let (mut alphas, mut betas) = (
+        pool.lanczos.take(LANCZOS_STEPS),
+        pool.lanczos.take(LANCZOS_STEPS),
+    );
     let norm = dot(&q, &q).sqrt();
-    if !(norm > 0.0 && norm.is_finite()) {
-        return f64::NAN;
-    }
-    q.iter_mut().for_each(|x| *x /= norm);
-    let mut q_prev = vec![0.0; dim];
-    let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut largest = f64::NAN;
-    let mut beta = 0.0;
-    for m in 0..dim.min(150) {
-        let mut w = apply(&q);
-        for (wi, pi) in w.iter_mut().zip(&q_prev) {
-            *wi -= beta * pi;
-        }
-        let alpha = dot(&w, &q);
-        for (wi, qi) in w.iter_mut().zip(&q) {
-            *wi -= alpha * qi;
-        }
-        beta = dot(&w, &w).sqrt();
-        alphas.push(alpha);
-        betas.push(beta);
-        if m >= 2 || beta <= 1e-14 * alpha.abs() {
-            let size = alphas.len();
-            let t = DMatrix::<f64>::from_fn(size, size, |r, c| {
-                if r == c {
-                    alphas[r]
-                } else if r + 1 == c || c + 1 == r {
-                    betas[r.min(c)]
-                } else {
-                    0.0
-                }
-            });
-            let eig = SymmetricEigen::new(t);
-            let Some((index, &top)) = eig
-                .eigenvalues
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.total_cmp(b.1))
-            else {
-                return f64::NAN;
-            };
-            let bound = beta * eig.eigenvectors[(size - 1, index)].abs();
-            largest = top;
-            if bound <= 1e-3 * top.abs() || beta <= 1e-14 * alpha.abs() {
-                return 1.0 / largest;
+    if norm > 0.0 && norm.is_finite() {
+        q.iter_mut().for_each(|x| *x /= norm);
+        let mut beta = 0.0;
+        for m in 0..dim.min(LANCZOS_STEPS) {
+            apply_inverse(riccati, dynamics, &q, &mut w, pool);
+            for (wi, pi) in w.iter_mut().zip(&q_prev) {
+                *wi -= beta * pi;
             }
+            let alpha = dot(&w, &q);
+            for (wi, qi) in w.iter_mut().zip(&q) {
+                *wi -= alpha * qi;
+            }
+            beta = dot(&w, &w).sqrt();
+            alphas.push(alpha);
+            betas.push(beta);
+            if m >= 2 || beta <= 1e-14 * alpha.abs() {
+                let (top, last) = tridiagonal_top(&alphas, &betas[..m]);
+                largest = top;
+                if beta * last <= 1e-3 * top.abs() || beta <= 1e-14 * alpha.abs() || top.is_nan() {
+                    break;
+                }
+            }
+            core::mem::swap(&mut q_prev, &mut q);
+            core::mem::swap(&mut q, &mut w);
+            q.iter_mut().for_each(|x| *x /= beta);
         }
-        q_prev = std::mem::replace(&mut q, w);
-        q.iter_mut().for_each(|x| *x /= beta);
+    }
+    for v in [q, q_prev, w, alphas, betas] {
+        pool.lanczos.give(v);
     }
     1.0 / largest
+}
+
+/// The most Lanczos steps of [`min_reduced_eigenvalue`].
+const LANCZOS_STEPS: usize = 150;
+
+/// `out` $= Z (Z^T \nabla^2 J Z)^{-1} Z^T v$: the subproblem's solution for the linear terms
+/// $-v$ on the interior nodes and the top derivatives, with homogeneous constraints.
+fn apply_inverse<const N: usize, const X: usize>(
+    riccati: &Riccati<N, X>,
+    dynamics: &Dynamics<N, X>,
+    v: &[f64],
+    out: &mut Vec<f64>,
+    pool: &mut Pool<N, X>,
+) {
+    let steps = riccati.steps();
+    let inner = (steps - 1) * X;
+    let linear = |i: usize| {
+        let lx = if i >= 1 && i < steps {
+            SVector::<f64, X>::from_fn(|r, _| -v[(i - 1) * X + r])
+        } else {
+            SVector::zeros()
+        };
+        let lu = SVector::<f64, N>::from_fn(|a, _| -v[inner + i * N + a]);
+        StageLinear {
+            lx,
+            lu,
+            defect: SVector::zeros(),
+            constraint: SVector::zeros(),
+        }
+    };
+    let zero = SVector::<f64, X>::zeros();
+    let d = riccati.solve_linear(dynamics, &linear, &zero, (&zero, &zero), pool);
+    out.clear();
+    for dx in &d.dx[1..steps] {
+        out.extend_from_slice(dx.as_slice());
+    }
+    for du in &d.du {
+        out.extend_from_slice(du.as_slice());
+    }
+    d.recycle(pool);
+}
+
+/// The largest eigenvalue $\vartheta$ of the symmetric tridiagonal matrix $T$ with diagonal
+/// `alpha` and off-diagonal `beta` ($T_{j,j+1} = \beta_j$; at most [`LANCZOS_STEPS`] rows),
+/// and $|v_m|$, the last component of its unit eigenvector: $\vartheta$ by bisection on the
+/// Sturm count (the negative pivots of $T - x I$ are the eigenvalues below $x$), $v$ by two
+/// steps of inverse iteration with the shift just above $\vartheta$, where
+/// $\sigma I - T$ is positive definite and its tridiagonal elimination needs no pivoting.
+fn tridiagonal_top(alpha: &[f64], beta: &[f64]) -> (f64, f64) {
+    let m = alpha.len().min(LANCZOS_STEPS);
+    let coupling = |j: usize| beta.get(j).copied().unwrap_or(0.0);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (j, a) in alpha.iter().enumerate().take(m) {
+        let radius = coupling(j).abs() + if j > 0 { coupling(j - 1).abs() } else { 0.0 };
+        (lo, hi) = (lo.min(a - radius), hi.max(a + radius));
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (f64::NAN, f64::NAN);
+    }
+    let below = |x: f64| {
+        let (mut count, mut d) = (0, 1.0);
+        for (j, a) in alpha.iter().enumerate().take(m) {
+            let off = if j > 0 { coupling(j - 1) } else { 0.0 };
+            d = a - x - off * off / d;
+            if d == 0.0 {
+                d = -f64::MIN_POSITIVE;
+            }
+            count += usize::from(d < 0.0);
+        }
+        count
+    };
+    // the largest eigenvalue: the least x with all m eigenvalues below it
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if below(mid) == m { hi = mid } else { lo = mid }
+    }
+    let top = hi;
+    let scale = alpha
+        .iter()
+        .take(m)
+        .fold(0.0_f64, |s, a| s.max(a.abs()))
+        .max(f64::MIN_POSITIVE);
+    let sigma = top + 1e-10 * scale;
+    let (mut v, mut upper) = ([1.0; LANCZOS_STEPS], [0.0; LANCZOS_STEPS]);
+    for _ in 0..2 {
+        // (sigma I - T) y = v by elimination from the top (diagonal pivots stay positive)
+        let mut pivot = sigma - alpha[0];
+        v[0] /= pivot;
+        for j in 1..m {
+            upper[j - 1] = -coupling(j - 1) / pivot;
+            pivot = sigma - alpha[j] + coupling(j - 1) * upper[j - 1];
+            v[j] = (v[j] + coupling(j - 1) * v[j - 1]) / pivot;
+        }
+        for j in (0..m - 1).rev() {
+            v[j] -= upper[j] * v[j + 1];
+        }
+        let norm = v[..m].iter().map(|x| x * x).sum::<f64>().sqrt();
+        v[..m].iter_mut().for_each(|x| *x /= norm);
+    }
+    (top, v[m - 1].abs())
 }

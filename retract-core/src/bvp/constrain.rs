@@ -165,6 +165,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         placement: Placement,
         index: usize,
     ) {
+        self.placed = std::sync::OnceLock::new();
         for (value, sign, absent) in [
             (lower, 1.0, f64::NEG_INFINITY),
             (upper, -1.0, f64::INFINITY),

@@ -17,7 +17,9 @@
 //!   multipliers, for warm starts), `sqp` (the iteration; `sqp::line_search` its filter), `riccati` (the KKT solve and its inertia),
 //!   `constraints` and `barrier` (stage constraints), `certificate` (residuals, momenta,
 //!   curvature), `guess` (the spline guess), `curve` (guesses from a path $q(t)$,
-//!   [`Curve`]), `extrapolate` (Richardson extrapolation).
+//!   [`Curve`]), `extrapolate` (Richardson extrapolation), `workspace` (the vectors a solve
+//!   keeps for the next: [`Workspace`], [`OptimalControlProblem::solve_with`], a warm
+//!   re-solve that allocates nothing).
 //! - [`BoundaryValueProblem`] solves the same conditions by Newton's method on their residual
 //!   (`root_finder`): fast where the answer is known to be a minimum, but blind to the cost.
 //!
@@ -43,7 +45,9 @@
 //! # Receding horizon
 //! Each control period the system moves one step along the plan, and the problem is solved
 //! again from there, warm-started from [`Plan::shifted`] with a budget of SQP iterations
-//! ([`OptimalControlProblem::solve_real_time`]). Without the barrier ($\tau = 0$) the cost is
+//! ([`OptimalControlProblem::solve_real_time`]); a loop that must not allocate re-solves one
+//! problem ([`OptimalControlProblem::set_start`]) in a [`Workspace`]
+//! ([`OptimalControlProblem::solve_with`]). Without the barrier ($\tau = 0$) the cost is
 //! quadratic and the dynamics linear, so one SQP step from any guess reaches the minimum. By
 //! the principle of optimality, the rest of an optimal plan is the optimal plan from its
 //! second state over the remaining $N - 1$ steps:
@@ -86,6 +90,7 @@ mod refine;
 mod riccati;
 mod sqp;
 mod violations;
+mod workspace;
 
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
@@ -94,6 +99,7 @@ pub use extrapolate::Extrapolated;
 pub use optimize::{MAX_INTERIOR_SAMPLES, OptimalControlProblem, PlanGuess, PlanOptions};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
+pub use workspace::Workspace;
 
 mod root_finder;
 mod shift;

@@ -25,6 +25,7 @@
 //! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
 //! the reduced Hessian (Lanczos on the inverse, [`super::certificate`]).
 
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use nalgebra::SVector;
@@ -35,6 +36,7 @@ use super::guess::Hermite;
 use super::plan::{Failure, Plan, PlanError, RealTime};
 use super::riccati::Dynamics;
 use super::sqp::Sqp;
+use super::workspace::Workspace;
 use crate::{DomainViolation, Error, JetFunction, Lagrangian, LiftedSystem};
 
 /// Options of [`OptimalControlProblem::solve`].
@@ -210,6 +212,20 @@ pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize
     pub(super) t_end: f64,
     pub(super) steps: usize,
     pub(super) options: PlanOptions,
+    /// The inequalities by where they are imposed, made at the first solve (a builder that
+    /// adds an inequality or sets the options empties it; a clone starts without).
+    pub(super) placed: OnceLock<Placed<'a, N, K>>,
+}
+
+/// The inequalities of a problem by where the solve imposes them.
+pub(super) struct Placed<'a, const N: usize, const K: usize> {
+    /// At the steps' evaluation points, then at the interior samples.
+    pub at_steps: Vec<Inequality<'a, N, K>>,
+    /// At the interior nodes.
+    pub at_nodes: Vec<Inequality<'a, N, K>>,
+    /// The weights of the interpolant inside a step
+    /// ([`super::violations::interpolant_weights`]).
+    pub interpolant: Option<Vec<f64>>,
 }
 
 impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
@@ -232,6 +248,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
             t_end: self.t_end,
             steps: self.steps,
             options: self.options,
+            placed: OnceLock::new(),
         }
     }
 }
@@ -261,7 +278,14 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             t_end,
             steps,
             options: PlanOptions::default(),
+            placed: OnceLock::new(),
         }
+    }
+
+    /// Moves the start to `start` (the same jets as [`Self::new`]'s): for a receding horizon
+    /// that re-solves one problem from each new measured state ([`Self::solve_with`]).
+    pub fn set_start(&mut self, start: &[f64; X]) {
+        self.start = SVector::from_column_slice(start);
     }
 
     /// A Lagrangian per step: step $i$ costs $h L_i(x_{\theta,i}, u_i)$ with $L_i$ =
@@ -311,7 +335,32 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// Sets the options.
     pub fn with_options(mut self, options: PlanOptions) -> Self {
         self.options = options;
+        self.placed = OnceLock::new();
         self
+    }
+
+    /// The inequalities by where they are imposed ([`Placed`]), made once.
+    pub(super) fn placed(&self) -> &Placed<'a, N, K> {
+        self.placed.get_or_init(|| {
+            let placed = |at: fn(Placement) -> bool| {
+                let list = self.inequalities.iter().filter(|c| at(c.placement));
+                list.copied().collect::<Vec<_>>()
+            };
+            let mut at_steps = placed(Placement::at_midpoints);
+            at_steps.extend(self.interior_samples(K));
+            // (at theta = 0 or 1 the evaluation points are nodes: no second copy there)
+            let at_nodes = if self.options.theta == 0.0 || self.options.theta == 1.0 {
+                placed(|p| p == Placement::Nodes)
+            } else {
+                placed(Placement::at_nodes)
+            };
+            let interpolant = super::violations::interpolant_weights(self.h(), K);
+            Placed {
+                at_steps,
+                at_nodes,
+                interpolant,
+            }
+        })
     }
 
     fn h(&self) -> f64 {
@@ -469,6 +518,59 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
+        self.solve_with(guess, &mut Workspace::new())
+    }
+
+    /// [`Self::solve`] in `workspace`: the solve takes its vectors from there and leaves them
+    /// there for the next one. The workspace grows until it holds as many vectors as a solve
+    /// of the problem needs at once (a path that holds more, e.g. a refactorisation in the
+    /// certificate beside the iteration's own, grows it once); from then on a solve allocates
+    /// nothing, the plan it returns included, when the plans it replaces are given back
+    /// ([`Workspace::recycle`]) and the problem is reused ([`Self::set_start`]). A failure
+    /// allocates its report ([`PlanError::last`]):
+    ///
+    /// ```
+    /// # use retract::bvp::{OptimalControlProblem, PlanGuess, Workspace};
+    /// # #[retract::higher_order_lagrangian(order = 2)]
+    /// # fn bend(q: [f64; 1], _dq: [f64; 1], ddq: [f64; 1]) -> f64 { 0.5 * ddq[0] * ddq[0] }
+    /// let system = Bend::new();
+    /// let mut problem = OptimalControlProblem::new(&system, &[0.0, 0.0], &[1.0, 0.0], 1.0, 20);
+    /// let mut workspace = Workspace::new();
+    /// let mut plan = problem.solve_with(PlanGuess::Spline, &mut workspace)?;
+    /// for start in [0.01, 0.02, 0.03] {
+    ///     problem.set_start(&[start, 0.0]);
+    ///     let next = problem.solve_with(PlanGuess::Plan(&plan), &mut workspace)?;
+    ///     workspace.recycle(std::mem::replace(&mut plan, next));
+    /// }
+    /// # Ok::<(), retract::bvp::PlanError<1, 2>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Self::solve`].
+    pub fn solve_with<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        workspace: &mut Workspace<N, X>,
+    ) -> Result<Plan<N, X>, PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
+        let solved = self.solve_under(guess, workspace, (self.options, false));
+        solved.map(|(plan, _)| plan)
+    }
+
+    /// [`Self::solve_with`] under `options` (the problem's but for the iteration limit and
+    /// the eigenvalue of a real-time iteration, `real_time`): the plan and whether it is
+    /// certified (if not, a real-time iteration's iterate at its iteration limit).
+    fn solve_under<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        workspace: &mut Workspace<N, X>,
+        (options, real_time): (PlanOptions, bool),
+    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
         let started = Instant::now();
         let invalid = |e| PlanError {
             failure: Failure::Invalid(e),
@@ -510,7 +612,14 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             PlanGuess::Plan(plan) => Some(&plan.duals),
             _ => None,
         };
-        let iterate = self.initial(guess).map_err(invalid)?;
+        let mut iterate = {
+            let pool = workspace.pool.get_mut();
+            Iterate {
+                x: pool.jets.take(self.steps + 1),
+                u: pool.tops.take(self.steps),
+            }
+        };
+        self.initial(guess, &mut iterate).map_err(invalid)?;
         self.check_terminal_cost(&iterate).map_err(invalid)?;
         self.check_ends::<S, M>(&iterate).map_err(invalid)?;
         if let Err((step, violation)) = self.guard::<S, M>(&iterate) {
@@ -519,23 +628,16 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
-        let placed = |at: fn(Placement) -> bool| {
-            let list = self.inequalities.iter().filter(|c| at(c.placement));
-            list.copied().collect::<Vec<_>>()
-        };
-        let mut at_steps = placed(Placement::at_midpoints);
-        at_steps.extend(self.interior_samples(K));
+        let placed = self.placed();
         Sqp::<Sys, N, K, X, S, M> {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started,
-            at_steps,
-            // (at theta = 0 or 1 the evaluation points are nodes: no second copy there)
-            at_nodes: if self.options.theta == 0.0 || self.options.theta == 1.0 {
-                placed(|p| p == Placement::Nodes)
-            } else {
-                placed(Placement::at_nodes)
-            },
+            at_steps: &placed.at_steps,
+            at_nodes: &placed.at_nodes,
+            pool: &workspace.pool,
+            options,
+            real_time,
         }
         .run(iterate, warm)
     }
@@ -556,24 +658,29 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
-        let mut capped = self.clone();
-        capped.options.max_iterations = iterations.max(1);
+        self.solve_real_time_with(guess, iterations, &mut Workspace::new())
+    }
+
+    /// [`Self::solve_real_time`] in `workspace` (as [`Self::solve_with`]: a re-solve of the
+    /// same problem allocates nothing once the workspace has served one).
+    ///
+    /// # Errors
+    /// As [`Self::solve_real_time`].
+    pub fn solve_real_time_with<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        iterations: usize,
+        workspace: &mut Workspace<N, X>,
+    ) -> Result<RealTime<N, X>, PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
+        let mut capped = self.options;
+        capped.max_iterations = iterations.max(1);
         // (a receding horizon needs the plan now, not its curvature)
-        capped.options.min_eigenvalue = false;
-        match capped.solve(guess) {
-            Ok(plan) => Ok(RealTime {
-                plan,
-                converged: true,
-            }),
-            Err(PlanError {
-                failure: Failure::IterationLimit,
-                last: Some(plan),
-            }) => Ok(RealTime {
-                plan: *plan,
-                converged: false,
-            }),
-            Err(e) => Err(e),
-        }
+        capped.min_eigenvalue = false;
+        let (plan, converged) = self.solve_under(guess, workspace, (capped, true))?;
+        Ok(RealTime { plan, converged })
     }
 
     /// The bytes the solve will hold at once, about: per step, three stage models (the
@@ -611,13 +718,18 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             })
     }
 
-    fn initial(&self, guess: PlanGuess<'_, N, X>) -> Result<Iterate<N, X>, Error> {
+    /// The first iterate from `guess`, into `iterate` (empty vectors).
+    fn initial(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        iterate: &mut Iterate<N, X>,
+    ) -> Result<(), Error> {
         let (h, theta, steps) = (self.h(), self.options.theta, self.steps);
         let wrong = |requirement| Error::InvalidArgument {
             name: "guess",
             requirement,
         };
-        let iterate = match guess {
+        match guess {
             PlanGuess::Spline => {
                 let spline = Hermite::new(
                     self.start.as_slice(),
@@ -626,16 +738,13 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     N,
                     K,
                 )?;
-                let x = (0..=steps)
-                    .map(|i| SVector::from_fn(|r, _| spline.jet_entry(r, i as f64 * h)))
-                    .collect();
-                let u = (0..steps)
-                    .map(|i| {
-                        let t = (i as f64 + theta) * h;
-                        SVector::from_fn(|a, _| spline.derivative(a, K, t))
-                    })
-                    .collect();
-                Iterate { x, u }
+                (iterate.x).extend(
+                    (0..=steps).map(|i| SVector::from_fn(|r, _| spline.jet_entry(r, i as f64 * h))),
+                );
+                iterate.u.extend((0..steps).map(|i| {
+                    let t = (i as f64 + theta) * h;
+                    SVector::from_fn(|a, _| spline.derivative(a, K, t))
+                }));
             }
             PlanGuess::Plan(plan) => {
                 if plan.x.len() != steps + 1 || plan.u.len() != steps {
@@ -643,29 +752,25 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                         "a warm start needs a plan with the same number of steps",
                     ));
                 }
-                Iterate {
-                    x: plan.x.clone(),
-                    u: plan.u.clone(),
-                }
+                iterate.x.extend_from_slice(&plan.x);
+                iterate.u.extend_from_slice(&plan.u);
             }
-            PlanGuess::Curve(curve) => curve.sample::<K, X>(self.t_end, steps, theta)?,
+            PlanGuess::Curve(curve) => *iterate = curve.sample::<K, X>(self.t_end, steps, theta)?,
             PlanGuess::Path { x, u } => {
                 if x.len() != steps + 1 || u.len() != steps {
                     return Err(wrong("a path guess needs N + 1 jets and N top derivatives"));
                 }
-                Iterate {
-                    x: x.to_vec(),
-                    u: u.to_vec(),
-                }
+                iterate.x.extend_from_slice(x);
+                iterate.u.extend_from_slice(u);
             }
-        };
+        }
         let finite = |v: &[f64]| v.iter().all(|e| e.is_finite());
         if !iterate.x.iter().all(|v| finite(v.as_slice()))
             || !iterate.u.iter().all(|v| finite(v.as_slice()))
         {
             return Err(wrong("the guess must be finite"));
         }
-        Ok(iterate)
+        Ok(())
     }
 
     /// The boundary jets against the domain of the Lagrangian

@@ -230,8 +230,18 @@ impl<const N: usize, const X: usize> Plan<N, X> {
     pub fn try_shifted(&self) -> Result<Self, Error> {
         self.validate()?;
         let mut out = self.clone();
+        out.try_shift()?;
+        Ok(out)
+    }
+
+    /// [`Self::try_shifted`] in place (no allocation); on an error the plan is unchanged.
+    ///
+    /// # Errors
+    /// As [`Self::try_shifted`].
+    pub fn try_shift(&mut self) -> Result<(), Error> {
+        self.validate()?;
         let (Some(&last_x), Some(&last_u)) = (self.x.last(), self.u.last()) else {
-            return Ok(out);
+            return Ok(());
         };
         let next = Dynamics::<N, X>::new(self.h, self.theta).next(&last_x, &last_u);
         if !next.iter().all(|v| v.is_finite()) {
@@ -240,16 +250,16 @@ impl<const N: usize, const X: usize> Plan<N, X> {
                 requirement: "its last jet stepped by h must be finite: h is too long for it",
             });
         }
-        out.x.remove(0);
-        out.x.push(next);
-        out.u.remove(0);
-        out.u.push(last_u);
+        self.x.remove(0);
+        self.x.push(next);
+        self.u.remove(0);
+        self.u.push(last_u);
         if let Some(&last_p) = self.momenta.last() {
-            out.momenta.remove(0);
-            out.momenta.push(last_p);
+            self.momenta.remove(0);
+            self.momenta.push(last_p);
         }
-        out.duals.shift(self.u.len());
-        Ok(out)
+        self.duals.shift(self.u.len());
+        Ok(())
     }
 
     /// [`Self::try_shifted`], with a plan it refuses returned unchanged (one that fails

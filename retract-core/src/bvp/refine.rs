@@ -11,6 +11,7 @@
 use nalgebra::SVector;
 
 use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel, Terminal};
+use super::workspace::Pool;
 
 /// The gradient in $(\delta x_i, \delta u_i)$ of the Lagrangian of stage $i$'s model
 /// $\ell_i + y^T (G_x \delta y_x + G_u \delta u + g)$ at `(dx, du)`, with $\rho$ on the
@@ -47,7 +48,8 @@ fn stage_gradient<const N: usize, const X: usize>(
 /// One step of iterative refinement of `d`, the solution by `riccati` of the subproblem of
 /// `stages` (with `rho`, the start `r0`, the end `r_end` and the terminal gradient `s_end`):
 /// the residuals of stationarity in $\delta u_i$ and $\delta x_i$, of the dynamics, of the
-/// stage constraints and of the ends, then their correction added to `d`.
+/// stage constraints and of the ends, then their correction added to `d` (its vectors from
+/// `pool`).
 pub(crate) fn refine<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
@@ -55,7 +57,7 @@ pub(crate) fn refine<const N: usize, const X: usize>(
     rho: f64,
     r0: &SVector<f64, X>,
     (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
-    d: &mut Direction<N, X>,
+    (d, pool): (&mut Direction<N, X>, &mut Pool<N, X>),
 ) {
     let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
     let steps = stages.len();
@@ -84,7 +86,8 @@ pub(crate) fn refine<const N: usize, const X: usize>(
     let free = terminal.fixed.map(|f| 1.0 - f);
     let terminal_residual =
         (terminal.hessian * last + last * rho + s_end - d.costate[steps - 1]).component_mul(&free);
-    let correction = riccati.solve_linear(dynamics, &residual, &start, (&end, &terminal_residual));
+    let ends = (&end, &terminal_residual);
+    let correction = riccati.solve_linear(dynamics, &residual, &start, ends, pool);
     for (x, c) in d.dx.iter_mut().zip(&correction.dx) {
         *x += c;
     }
@@ -97,4 +100,5 @@ pub(crate) fn refine<const N: usize, const X: usize>(
     for (y, c) in d.multipliers.iter_mut().zip(&correction.multipliers) {
         *y += c;
     }
+    correction.recycle(pool);
 }

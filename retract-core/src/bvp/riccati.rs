@@ -31,9 +31,10 @@
 
 use std::time::Instant;
 
-use nalgebra::{DMatrix, SMatrix, SVector, SymmetricEigen};
+use nalgebra::{SMatrix, SVector};
 
 use super::shift::{BlockColumn, BlockPoly};
+use super::workspace::Pool;
 
 /// The constant linear dynamics of the lifted scheme's $x$-equations for one $(h, \theta)$:
 /// $x_{i+1} = \bar A x_i + \bar B u_i$ with $\bar A = W (I + h(1-\theta) A)$, $\bar B = W h B$,
@@ -116,8 +117,7 @@ pub(crate) struct StageModel<const N: usize, const X: usize> {
     pub value: SVector<f64, N>,
     /// Terms of the node $x_i$ itself (the barrier of the inequalities placed at the node):
     /// their Hessian and gradient in $\delta x_i$, added to $Q_{xx}$ and $q_x$.
-    /// (Boxed: most stages of most problems have none, and the model stays small.)
-    pub node: Option<Box<NodeTerms<X>>>,
+    pub node: Option<NodeTerms<X>>,
 }
 
 /// The Hessian and gradient in $\delta x_i$ of terms of a node $x_i$ itself.
@@ -172,7 +172,7 @@ fn constraint_projection<const N: usize, const X: usize>(
 
 /// What the backward pass keeps of a stage.
 #[derive(Clone, Copy, Debug)]
-struct StageFactor<const N: usize, const X: usize> {
+pub(crate) struct StageFactor<const N: usize, const X: usize> {
     /// $\tilde Q^{-1} = (\Pi Q_{uu} \Pi + w (I - \Pi))^{-1}$ ($Q_{uu}^{-1}$ without constraints).
     quu_inv: SMatrix<f64, N, N>,
     quu: SMatrix<f64, N, N>,
@@ -204,7 +204,7 @@ impl<const N: usize, const X: usize> StageFactor<N, X> {
 /// What the backward pass keeps of a step of the tail, the steps where the terminal
 /// multiplier $\nu$ is still a parameter.
 #[derive(Clone, Copy, Debug)]
-struct TailFactor<const N: usize, const X: usize> {
+pub(crate) struct TailFactor<const N: usize, const X: usize> {
     /// $K_\nu$ of $\delta u = K \delta x + k + K_\nu \nu$.
     gain_nu: SMatrix<f64, N, X>,
     /// $S_{i+1}$ of the next stage.
@@ -260,6 +260,16 @@ pub(crate) struct Direction<const N: usize, const X: usize> {
     pub multipliers: Vec<SVector<f64, N>>,
 }
 
+impl<const N: usize, const X: usize> Direction<N, X> {
+    /// Gives the direction's vectors back to `pool`.
+    pub fn recycle(self, pool: &mut Pool<N, X>) {
+        pool.jets.give(self.dx);
+        pool.jets.give(self.costate);
+        pool.tops.give(self.du);
+        pool.tops.give(self.multipliers);
+    }
+}
+
 /// The linear data of one stage of a subproblem: the gradient $(l_x, l_u)$ in
 /// $(\delta x_i, \delta u_i)$, the defect $c_i$ and the constraint offset $c_0$.
 pub(crate) struct StageLinear<const N: usize, const X: usize> {
@@ -287,16 +297,56 @@ fn invert_by_eigen<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f6
     if !m.iter().all(|v| v.is_finite()) {
         return None;
     }
-    // the indefinite case is rare: a dynamic eigendecomposition
-    let eig = SymmetricEigen::new(DMatrix::from_column_slice(D, D, m.as_slice()));
-    let scale = eig.eigenvalues.amax().max(f64::MIN_POSITIVE);
-    if eig.eigenvalues.iter().any(|l| l.abs() <= 1e-13 * scale) {
+    let (eigenvalues, vectors) = jacobi_eigen(m);
+    let scale = eigenvalues.amax().max(f64::MIN_POSITIVE);
+    if eigenvalues
+        .iter()
+        .any(|l| l.abs() <= 1e-13 * scale || !l.is_finite())
+    {
         return None;
     }
-    let negative = eig.eigenvalues.iter().filter(|l| **l < 0.0).count();
-    let inv_diag = DMatrix::from_diagonal(&eig.eigenvalues.map(|l| 1.0 / l));
-    let inv = &eig.eigenvectors * inv_diag * eig.eigenvectors.transpose();
-    Some((SMatrix::from_column_slice(inv.as_slice()), negative))
+    let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
+    let inv_diag = SMatrix::<f64, D, D>::from_diagonal(&eigenvalues.map(|l| 1.0 / l));
+    Some((vectors * inv_diag * vectors.transpose(), negative))
+}
+
+/// The eigenvalues and eigenvectors (columns) of the symmetric matrix `m` by cyclic Jacobi
+/// rotations ($A \leftarrow P^T A P$ with $\tan\phi = \mathrm{sgn}(\vartheta) / (|\vartheta| +
+/// \sqrt{\vartheta^2 + 1})$, $\vartheta = (a_{qq} - a_{pp}) / 2 a_{pq}$, zeroing $a_{pq}$), until
+/// the off-diagonal part is below $10^{-15}$ of the whole (at most 64 sweeps).
+fn jacobi_eigen<const D: usize>(m: &SMatrix<f64, D, D>) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
+    let mut a = (m + m.transpose()) * 0.5;
+    let mut v = SMatrix::<f64, D, D>::identity();
+    let total = a.norm_squared();
+    for _ in 0..64 {
+        let diagonal: f64 = (0..D).map(|i| a[(i, i)] * a[(i, i)]).sum();
+        if total - diagonal <= 1e-30 * total {
+            break;
+        }
+        for p in 0..D {
+            for q in p + 1..D {
+                let apq = a[(p, q)];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (a[(q, q)] - a[(p, p)]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                let rotate = |x: f64, y: f64| (c * x - s * y, s * x + c * y);
+                for k in 0..D {
+                    (a[(k, p)], a[(k, q)]) = rotate(a[(k, p)], a[(k, q)]);
+                }
+                for k in 0..D {
+                    (a[(p, k)], a[(q, k)]) = rotate(a[(p, k)], a[(q, k)]);
+                }
+                for k in 0..D {
+                    (v[(k, p)], v[(k, q)]) = rotate(v[(k, p)], v[(k, q)]);
+                }
+            }
+        }
+    }
+    (a.diagonal(), v)
 }
 
 /// $M^{-1}$ and the number of negative pivots of $M = L D L^T$ ($L$ unit lower triangular),
@@ -486,8 +536,9 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         stages: &[StageModel<N, X>],
         rho: f64,
         terminal: &Terminal<X>,
+        pool: &mut Pool<N, X>,
     ) -> Self {
-        Self::factor_until(dynamics, stages, rho, terminal, None)
+        Self::factor_until(dynamics, stages, rho, terminal, (None, pool))
     }
 
     /// [`Self::factor_with`], stopped (`interrupted`) once `deadline` has passed: the clock is
@@ -497,7 +548,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         stages: &[StageModel<N, X>],
         rho: f64,
         terminal: &Terminal<X>,
-        deadline: Option<Instant>,
+        (deadline, pool): (Option<Instant>, &mut Pool<N, X>),
     ) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = stages.len();
@@ -507,8 +558,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         }
         let mut sens = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed);
         let free = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed.map(|f| 1.0 - f));
-        let mut factors = Vec::with_capacity(steps);
-        let mut tail = Vec::with_capacity(X / N);
+        let mut factors = pool.factors.take(steps);
+        let mut tail = pool.tails.take(steps);
         let mut negative = 0;
         let mut singular = false;
         let mut d = SMatrix::<f64, X, X>::zeros();
@@ -613,6 +664,17 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         }
     }
 
+    /// The number of steps $N$ factorised.
+    pub fn steps(&self) -> usize {
+        self.stages.len()
+    }
+
+    /// Gives the factorisation's vectors back to `pool`.
+    pub fn recycle(self, pool: &mut Pool<N, X>) {
+        pool.factors.give(self.stages);
+        pool.tails.give(self.tail);
+    }
+
     /// The factor of step `i`.
     fn step_factor(&self, i: usize) -> &StageFactor<N, X> {
         &self.stages[self.stages.len() - 1 - i]
@@ -648,6 +710,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         rho: f64,
         r0: &SVector<f64, X>,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
+        pool: &mut Pool<N, X>,
     ) -> Direction<N, X> {
         let theta = dynamics.theta;
         let linear = |i: usize| {
@@ -666,7 +729,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 constraint: stage.value + stage.cx * offset,
             }
         };
-        self.solve_linear(dynamics, &linear, r0, (r_end, s_end))
+        self.solve_linear(dynamics, &linear, r0, (r_end, s_end), pool)
     }
 
     /// The subproblem's solution for the stage linear terms, defects and constraint offsets
@@ -681,16 +744,18 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         linear: &impl Fn(usize) -> StageLinear<N, X>,
         r0: &SVector<f64, X>,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
+        pool: &mut Pool<N, X>,
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let (backward, s_start) = self.backward(dynamics, linear, r_end, s_end);
+        let mut backward = pool.backward.take(steps);
+        let s_start = self.backward(dynamics, linear, (r_end, s_end), &mut backward);
         let mut d = Direction {
-            dx: Vec::with_capacity(steps + 1),
-            du: Vec::with_capacity(steps),
-            costate: Vec::with_capacity(steps),
-            multipliers: Vec::with_capacity(steps),
+            dx: pool.jets.take(steps + 1),
+            du: pool.tops.take(steps),
+            costate: pool.jets.take(steps),
+            multipliers: pool.tops.take(steps),
         };
         // fixed start components from r0, free ones minimise V_0
         let mut x = r0.component_mul(&self.start_free.map(|f| 1.0 - f));
@@ -739,10 +804,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             d.du.push(u);
             d.dx.push(x);
         }
+        pool.backward.give(backward);
         d
     }
 
-    /// The backward pass of a solve: per step (last step first) the feed-forward term, $q_u$,
+    /// The backward pass of a solve into `out`: per step (last step first) the feed-forward term, $q_u$,
     /// $s_{i+1}$ and the defect for the linear terms `linear(i)`. At the tail's first state
     /// (if not step 0) $\nu$ is eliminated: $s_b \leftarrow s_b + S_b D^{-1} (r_N - e)$ with
     /// $e = \delta x_N$ of the tail from $\delta x_b = 0$, $\nu = 0$.
@@ -750,13 +816,12 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         &self,
         dynamics: &Dynamics<N, X>,
         linear: &impl Fn(usize) -> StageLinear<N, X>,
-        r_end: &SVector<f64, X>,
-        s_end: &SVector<f64, X>,
-    ) -> (Vec<Backward<N, X>>, SVector<f64, X>) {
+        (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
+        out: &mut Vec<Backward<N, X>>,
+    ) -> SVector<f64, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let mut out = Vec::with_capacity(steps);
         let mut s = *s_end;
         for i in (0..steps).rev() {
             let f = self.step_factor(i);
@@ -788,7 +853,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 s += self.sens_boundary * (self.d_inv * gap);
             }
         }
-        (out, s)
+        s
     }
 
     /// $\delta x_N$ of the closed tail loop from $\delta x_b = 0$ with $\nu = 0$, for the
@@ -836,7 +901,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
 }
 
 /// What the backward pass of a solve keeps of a step.
-struct Backward<const N: usize, const X: usize> {
+pub(crate) struct Backward<const N: usize, const X: usize> {
     feedforward: SVector<f64, N>,
     qu: SVector<f64, N>,
     s_next: SVector<f64, X>,
@@ -846,6 +911,26 @@ struct Backward<const N: usize, const X: usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{DMatrix, SymmetricEigen};
+
+    /// The Jacobi eigendecomposition of an indefinite symmetric matrix rebuilds it, with
+    /// orthonormal vectors, and the fallback inverse counts its negative eigenvalues.
+    #[test]
+    fn jacobi_rebuilds_an_indefinite_matrix_and_counts_its_negative_eigenvalues() {
+        let mut seed = 11;
+        let b = SMatrix::<f64, 5, 5>::from_fn(|_, _| noise(&mut seed));
+        let m = b + b.transpose() - SMatrix::<f64, 5, 5>::identity() * 0.7;
+        let (values, vectors) = jacobi_eigen(&m);
+        let rebuilt = vectors * SMatrix::from_diagonal(&values) * vectors.transpose();
+        assert!((rebuilt - m).amax() < 1e-13, "{}", (rebuilt - m).amax());
+        let gram = vectors.transpose() * vectors - SMatrix::<f64, 5, 5>::identity();
+        assert!(gram.amax() < 1e-14);
+        let reference = SymmetricEigen::new(DMatrix::from_column_slice(5, 5, m.as_slice()));
+        let negative = reference.eigenvalues.iter().filter(|l| **l < 0.0).count();
+        let (inverse, counted) = invert_by_eigen(&m).expect("regular");
+        assert!(negative > 0 && negative < 5 && counted == negative);
+        assert!((inverse * m - SMatrix::<f64, 5, 5>::identity()).amax() < 1e-10);
+    }
 
     /// A deterministic pseudo-random number in [-1, 1).
     fn noise(seed: &mut u64) -> f64 {
@@ -899,7 +984,7 @@ mod tests {
             top -= t.transpose() * g;
             // the node terms of x_i
             if let Some(node) = &s.node {
-                let (hn, gn) = &**node;
+                let (hn, gn) = node;
                 for r in 0..X {
                     for c in 0..X {
                         kkt[(xc(i) + r, xc(i) + c)] += hn[(r, c)];
@@ -981,7 +1066,7 @@ mod tests {
                 }
                 let node = (i > 0).then(|| {
                     let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
-                    Box::new((m * m.transpose(), SVector::from_fn(|_, _| noise(&mut seed))))
+                    (m * m.transpose(), SVector::from_fn(|_, _| noise(&mut seed)))
                 });
                 StageModel {
                     hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
@@ -1008,12 +1093,17 @@ mod tests {
         let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
         let s_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
         let rho = 0.25;
-        let riccati = Riccati::factor_with(&dynamics, &stages, rho, &terminal);
+        let riccati =
+            Riccati::factor_with(&dynamics, &stages, rho, &terminal, &mut Pool::default());
         assert!(riccati.positive_definite());
-        let exact = riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end));
+        let solve = || {
+            let pool = &mut Pool::default();
+            riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end), pool)
+        };
+        let exact = solve();
         let model = (&stages[..], &terminal);
         for perturbation in [0.0, 0.1] {
-            let mut d = riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end));
+            let mut d = solve();
             for v in d.dx.iter_mut().skip(1).chain(d.costate.iter_mut()) {
                 *v += SVector::<f64, X>::from_fn(|_, _| perturbation * noise(&mut seed));
             }
@@ -1027,7 +1117,7 @@ mod tests {
                 rho,
                 &r0,
                 (&r_end, &s_end),
-                &mut d,
+                (&mut d, &mut Pool::default()),
             );
             for (i, stage) in stages.iter().enumerate() {
                 let off = (d.dx[i + 1] - exact.dx[i + 1])
@@ -1068,7 +1158,7 @@ mod tests {
                     let node = (i % 2 == 1).then(|| {
                         let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
                         let g = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
-                        Box::new((m * m.transpose() * 0.5, g))
+                        (m * m.transpose() * 0.5, g)
                     });
                     StageModel {
                         hxx: h.fixed_view::<4, 4>(0, 0).into_owned(),
@@ -1106,10 +1196,15 @@ mod tests {
                 };
                 let free = X - terminal.rows();
                 let free_start = terminal.start_fixed.iter().filter(|f| **f == 0.0).count();
-                let riccati = Riccati::factor_with(&dynamics, &stages, 0.0, &terminal);
+                let riccati =
+                    Riccati::factor_with(&dynamics, &stages, 0.0, &terminal, &mut Pool::default());
                 assert!(!riccati.singular);
                 assert_eq!(riccati.boundary() > 0, steps > 2);
-                let d = riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end));
+                let solve = || {
+                    let pool = &mut Pool::default();
+                    riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end), pool)
+                };
+                let d = solve();
                 let (kkt, rhs) = dense_kkt(&dynamics, &stages, &terminal, (&r0, &r_end), &s_end);
                 let nc = (steps + 2) * X;
                 let xc = |i: usize| i * X;
@@ -1138,7 +1233,7 @@ mod tests {
                 }
                 // one step of iterative refinement from a wrong solution gives the right one
                 // (the system is linear), costates included
-                let mut wrong = riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end));
+                let mut wrong = solve();
                 for v in wrong.dx.iter_mut().chain(wrong.costate.iter_mut()) {
                     *v += SVector::<f64, X>::from_fn(|_, _| 0.1 * noise(&mut seed));
                 }
@@ -1147,7 +1242,16 @@ mod tests {
                 }
                 let model = (&stages[..], &terminal);
                 let end = (&r_end, &s_end);
-                crate::bvp::refine::refine(&riccati, &dynamics, model, 0.0, &r0, end, &mut wrong);
+                let pool = &mut Pool::default();
+                crate::bvp::refine::refine(
+                    &riccati,
+                    &dynamics,
+                    model,
+                    0.0,
+                    &r0,
+                    end,
+                    (&mut wrong, pool),
+                );
                 for i in 0..=steps {
                     assert!((wrong.dx[i] - d.dx[i]).amax() < 1e-9, "refined dx[{i}]");
                 }

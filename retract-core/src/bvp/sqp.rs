@@ -2,6 +2,7 @@
 //! Riccati solve, the convergence test and the second-order check; the filter line search in
 //! its own module (`line_search`).
 
+use std::cell::RefCell;
 use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
@@ -10,10 +11,11 @@ use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
 use super::duals::Duals;
-use super::optimize::{Iterate, OptimalControlProblem, blocks};
+use super::optimize::{Iterate, OptimalControlProblem, PlanOptions, blocks};
 use super::plan::{Certificate, Failure, Plan, PlanError};
 use super::refine::refine;
 use super::riccati::{Direction, Dynamics, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
+use super::workspace::Pool;
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
 
@@ -63,9 +65,15 @@ pub(super) struct Sqp<
     pub dynamics: Dynamics<N, X>,
     pub started: Instant,
     /// The inequalities placed at the steps' evaluation points.
-    pub at_steps: Vec<Inequality<'a, N, K>>,
+    pub at_steps: &'p [Inequality<'a, N, K>],
     /// The inequalities placed at the nodes (imposed at the interior ones).
-    pub at_nodes: Vec<Inequality<'a, N, K>>,
+    pub at_nodes: &'p [Inequality<'a, N, K>],
+    /// The vectors kept between iterations and solves.
+    pub pool: &'p RefCell<Pool<N, X>>,
+    /// The options of this run (the problem's, or those of a real-time iteration).
+    pub options: PlanOptions,
+    /// A real-time iteration: the iterate at the iteration limit is a result, not a failure.
+    pub real_time: bool,
 }
 
 /// The models of all stages at one iterate.
@@ -106,6 +114,29 @@ struct Subproblem<const N: usize, const X: usize> {
     barrier_error: f64,
 }
 
+/// What the iteration carries from one iterate to the next.
+struct State<const N: usize, const X: usize> {
+    iterate: Iterate<N, X>,
+    /// The stage equalities' multipliers.
+    y: Vec<SVector<f64, N>>,
+    barrier: Barrier,
+    filter: Option<Filter>,
+    /// The last direction, after a full step (its multipliers are the Newton estimates at the
+    /// new iterate).
+    full_step: Option<Direction<N, X>>,
+    /// A factorisation kept for a simplified Newton step, with the error where it was made.
+    kept: Option<(Riccati<N, X>, f64)>,
+}
+
+/// How [`Sqp::finish`] ended: a certified plan, a failed second-order check, or not yet (a
+/// constraint violated beyond the tolerance where it is imposed).
+#[allow(clippy::large_enum_variant)] // (made once per solve, and moved at once)
+enum Finished<const N: usize, const X: usize> {
+    Plan(Plan<N, X>),
+    Failed(Failure, Certificate, Subproblem<N, X>),
+    Not(Subproblem<N, X>),
+}
+
 impl<const N: usize, const X: usize> Models<N, X> {
     /// $\Vert c\Vert_1$ over defects, stage constraints and boundary data.
     fn violation_l1(&self) -> f64 {
@@ -133,6 +164,43 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
+    /// An empty iterate of `steps` steps, from the pool.
+    fn take_iterate(&self, steps: usize) -> Iterate<N, X> {
+        let mut pool = self.pool.borrow_mut();
+        Iterate {
+            x: pool.jets.take(steps + 1),
+            u: pool.tops.take(steps),
+        }
+    }
+
+    /// Gives an iterate's vectors back to the pool.
+    fn give_iterate(&self, iterate: Iterate<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(iterate.x);
+        pool.tops.give(iterate.u);
+    }
+
+    /// Gives a plan's vectors back to the pool.
+    fn give_plan(&self, plan: Plan<N, X>) {
+        self.pool.borrow_mut().give_plan(plan);
+    }
+
+    /// Gives the models' vectors back to the pool.
+    fn give_models(&self, models: Models<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.stages.give(models.stages);
+        pool.linearized.give(models.inequalities);
+        pool.gradients.give(models.cost_gradient);
+    }
+
+    /// Gives a subproblem's vectors back to the pool.
+    fn give_subproblem(&self, sub: Subproblem<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        sub.riccati.recycle(&mut pool);
+        sub.direction.recycle(&mut pool);
+        pool.jets.give(sub.momenta);
+    }
+
     fn x_theta(&self, iterate: &Iterate<N, X>, i: usize) -> SVector<f64, X> {
         let theta = self.dynamics.theta;
         iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
@@ -194,7 +262,7 @@ where
             }
         }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
-        stage.node = self.node_curvature(iterate, i, barrier).map(Box::new);
+        stage.node = self.node_curvature(iterate, i, barrier);
         stage
     }
 
@@ -239,9 +307,12 @@ where
         barrier: &Barrier,
     ) -> Result<Models<N, X>, Failure> {
         let h = self.dynamics.h;
-        let mut stages = Vec::with_capacity(iterate.u.len());
+        let steps = iterate.u.len();
         let inequalities = self.inequalities(iterate);
-        let mut cost_gradient = Vec::with_capacity(iterate.u.len());
+        let (mut stages, mut cost_gradient) = {
+            let mut pool = self.pool.borrow_mut();
+            (pool.stages.take(steps), pool.gradients.take(steps))
+        };
         let mut cost = 0.0;
         for (i, u) in iterate.u.iter().enumerate() {
             if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
@@ -335,7 +406,7 @@ where
     pub fn inequalities(&self, iterate: &Iterate<N, X>) -> Vec<Linearized<N, X>> {
         let steps = iterate.u.len();
         let count = steps * self.at_steps.len() + steps.saturating_sub(1) * self.at_nodes.len();
-        let mut out = Vec::with_capacity(count);
+        let mut out = self.pool.borrow_mut().linearized.take(count);
         if !self.at_steps.is_empty() {
             for (i, u) in iterate.u.iter().enumerate() {
                 let xt = self.x_theta(iterate, i);
@@ -370,37 +441,49 @@ where
         // unshifted stages are kept from the first correction on, to shift each trial afresh)
         let mut base: Option<Vec<StageModel<N, X>>> = None;
         let mut factor = |rho: f64| {
+            let mut pool = self.pool.borrow_mut();
             if rho > 0.0 && !barrier.s.is_empty() {
-                let base = base.get_or_insert_with(|| models.stages.clone());
+                let base = base.get_or_insert_with(|| {
+                    let mut base = pool.stages.take(models.stages.len());
+                    base.extend_from_slice(&models.stages);
+                    base
+                });
                 models.stages.clone_from_slice(base);
                 barrier.shift_slacks(&mut models.stages, &models.inequalities, rho);
             }
             let (stages, end) = (&models.stages, &models.terminal);
-            let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, self.deadline());
+            let clock = (self.deadline(), &mut *pool);
+            let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, clock);
             if riccati.interrupted {
+                riccati.recycle(&mut pool);
                 return Err(Failure::TimeLimit);
             }
-            Ok(riccati.positive_definite().then_some(riccati))
+            if riccati.positive_definite() {
+                return Ok(Some(riccati));
+            }
+            riccati.recycle(&mut pool);
+            Ok(None)
         };
-        if last < 1e-8
-            && let Some(riccati) = factor(0.0)?
-        {
-            return Ok((riccati, 0.0));
+        let mut found = Err(Failure::Regularization);
+        if last < 1e-8 {
+            found = factor(0.0).and_then(|r| r.map(|r| (r, 0.0)).ok_or(Failure::Regularization));
         }
         let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
-        while rho < 1e40 {
-            if let Some(riccati) = factor(h * rho)? {
-                return Ok((riccati, rho));
-            }
+        while matches!(found, Err(Failure::Regularization)) && rho < 1e40 {
+            found =
+                factor(h * rho).and_then(|r| r.map(|r| (r, rho)).ok_or(Failure::Regularization));
             rho *= if last > 0.0 { 8.0 } else { 100.0 };
         }
-        Err(Failure::Regularization)
+        if let Some(base) = base {
+            self.pool.borrow_mut().stages.give(base);
+        }
+        found
     }
 
     /// When the wall-time budget runs out: the start of the solve plus
     /// [`super::PlanOptions::max_time`].
     fn deadline(&self) -> Option<Instant> {
-        let budget = self.problem.options.max_time?;
+        let budget = self.options.max_time?;
         self.started.checked_add(budget)
     }
 
@@ -424,11 +507,11 @@ where
     ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
         let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
-        let with_inequalities;
+        let mut pool = self.pool.borrow_mut();
+        let mut with_inequalities = pool.gradients.take(models.cost_gradient.len());
         let gradients = if barrier.at_steps() > 0 {
-            let mut g = models.cost_gradient.clone();
-            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, h);
-            with_inequalities = g;
+            with_inequalities.extend_from_slice(&models.cost_gradient);
+            barrier.lagrangian_gradients(&mut with_inequalities, &models.inequalities, z, h);
             &with_inequalities
         } else {
             &models.cost_gradient
@@ -438,15 +521,21 @@ where
             &models.terminal.fixed,
             &models.terminal.start_fixed,
         );
-        let nodes = barrier.node_gradients(&models.inequalities, z, h);
+        let mut nodes = pool.jets.take(barrier.steps + 1);
+        barrier.node_gradients(&models.inequalities, z, h, &mut nodes);
+        let momenta = pool.jets.take(models.stages.len() + 1);
+        let stages = &models.stages;
         let (momenta, stationarity, scale) = kkt_residuals(
             &self.dynamics,
-            &models.stages,
+            stages,
             gradients,
             direction,
             &nodes,
             end,
+            momenta,
         );
+        pool.gradients.give(with_inequalities);
+        pool.jets.give(nodes);
         let complementarity = z
             .iter()
             .zip(&barrier.s)
@@ -474,19 +563,36 @@ where
         let (h, theta) = (self.dynamics.h, self.dynamics.theta);
         let (step_slacks, node_slacks) = barrier.s.split_at(barrier.at_steps());
         let (step_multipliers, node_multipliers) = barrier.z.split_at(barrier.at_steps());
+        let mut pool = self.pool.borrow_mut();
+        let mut copy = |v: &[f64]| {
+            let mut out = pool.reals.take(v.len());
+            out.extend_from_slice(v);
+            out
+        };
+        let (step_slacks, step_multipliers) = (copy(step_slacks), copy(step_multipliers));
+        let (node_slacks, node_multipliers) = (copy(node_slacks), copy(node_multipliers));
+        let (mut equalities, mut x, mut u) = (
+            pool.tops.take(y.len()),
+            pool.jets.take(iterate.x.len()),
+            pool.tops.take(iterate.u.len()),
+        );
+        drop(pool);
+        equalities.extend_from_slice(y);
+        x.extend_from_slice(&iterate.x);
+        u.extend_from_slice(&iterate.u);
         let duals = Duals {
-            equalities: y.to_vec(),
-            step_slacks: step_slacks.to_vec(),
-            step_multipliers: step_multipliers.to_vec(),
-            node_slacks: node_slacks.to_vec(),
-            node_multipliers: node_multipliers.to_vec(),
+            equalities,
+            step_slacks,
+            step_multipliers,
+            node_slacks,
+            node_multipliers,
             barrier: barrier.mu,
         };
         Plan {
             h,
             theta,
-            x: iterate.x.clone(),
-            u: iterate.u.clone(),
+            x,
+            u,
             momenta,
             cost,
             iterations,
@@ -501,22 +607,40 @@ where
     /// per unit time, $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without
     /// inequalities; `None` if an inequality is not finite there.
     fn initial_barrier(&self, iterate: &Iterate<N, X>, warm: Option<&Duals<N>>) -> Option<Barrier> {
-        let values: Vec<f64> = self.inequalities(iterate).iter().map(|c| c.value).collect();
-        if !values.iter().all(|v| v.is_finite()) {
-            return None;
-        }
+        let lin = self.inequalities(iterate);
+        let mut pool = self.pool.borrow_mut();
+        let mut values = pool.reals.take(lin.len());
+        values.extend(lin.iter().map(|c| c.value));
+        pool.linearized.give(lin);
+        let vectors = [0; 3].map(|_| pool.reals.take(values.len()));
+        drop(pool);
         let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
         let fits = |d: &&Duals<N>| layout.0 + layout.1 > 0 && d.fit(layout.2, layout.0, layout.1);
-        if let Some(duals) = warm.filter(fits) {
-            let floor = barrier_floor(self.problem.options.tolerance);
-            return Some(Barrier::warm(duals, layout, floor));
-        }
+        let barrier = if !values.iter().all(|v| v.is_finite()) {
+            None
+        } else if let Some(duals) = warm.filter(fits) {
+            let floor = barrier_floor(self.options.tolerance);
+            Some(Barrier::warm(duals, layout, floor, vectors))
+        } else {
+            Some(self.cold_barrier(&values, layout, vectors))
+        };
+        self.pool.borrow_mut().reals.give(values);
+        barrier
+    }
+
+    /// [`Barrier::new`] for the inequalities' `values` at the first iterate.
+    fn cold_barrier(
+        &self,
+        values: &[f64],
+        layout: (usize, usize, usize),
+        vectors: [Vec<f64>; 3],
+    ) -> Barrier {
         let mu = if layout.0 + layout.1 > 0 {
-            self.problem.options.initial_barrier / self.dynamics.h
+            self.options.initial_barrier / self.dynamics.h
         } else {
             0.0
         };
-        let (steps, nodes) = (slack_push(&self.at_steps), slack_push(&self.at_nodes));
+        let (steps, nodes) = (slack_push(self.at_steps), slack_push(self.at_nodes));
         let at_steps = layout.0 * layout.2;
         let push = |k: usize| {
             if k < at_steps {
@@ -525,7 +649,7 @@ where
                 nodes[(k - at_steps) % layout.1]
             }
         };
-        Some(Barrier::new((mu, self.dynamics.h), layout, &values, push))
+        Barrier::new((mu, self.dynamics.h), layout, values, push, vectors)
     }
 
     /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
@@ -539,49 +663,85 @@ where
     /// Newton step, [`Self::subproblem`]); a point is never certified with a kept one.
     pub fn run(
         &self,
-        mut iterate: Iterate<N, X>,
+        iterate: Iterate<N, X>,
         warm: Option<&Duals<N>>,
-    ) -> Result<Plan<N, X>, PlanError<N, X>> {
-        let options = &self.problem.options;
-        let theta = self.dynamics.theta;
-        let count = self.at_steps.len() + self.at_nodes.len();
-        let mut barrier = (self.initial_barrier(&iterate, warm))
-            .ok_or(PlanError::without_iterate(Failure::NonFinite))?;
-        let floor = barrier_floor(options.tolerance);
-        let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let Some(barrier) = self.initial_barrier(&iterate, warm) else {
+            self.give_iterate(iterate);
+            return Err(PlanError::without_iterate(Failure::NonFinite));
+        };
         // (the stage equalities' multipliers: a warm start's if they fit and are finite, else
         // 0; a plan read back from a file may hold any numbers)
         let finite = |y: &SVector<f64, N>| y.iter().all(|v| v.is_finite());
-        let mut y = warm
-            .map(|duals| duals.equalities.clone())
-            .filter(|y| y.len() == iterate.u.len() && y.iter().all(finite))
-            .unwrap_or_else(|| vec![SVector::zeros(); iterate.u.len()]);
-        let mut full_step: Option<Direction<N, X>> = None;
-        let mut kept: Option<(Riccati<N, X>, f64)> = None;
-        let mut filter: Option<Filter> = None;
+        let steps = iterate.u.len();
+        let mut y = self.pool.borrow_mut().tops.take(steps);
+        match warm.map(|duals| &duals.equalities) {
+            Some(given) if given.len() == steps && given.iter().all(finite) => {
+                y.extend_from_slice(given);
+            }
+            _ => y.resize(steps, SVector::zeros()),
+        }
+        let mut state = State {
+            iterate,
+            y,
+            barrier,
+            filter: None,
+            full_step: None,
+            kept: None,
+        };
+        let result = self.iterate_from(&mut state);
+        self.release(state);
+        result
+    }
+
+    /// Gives the vectors of the iteration's `state` back to the pool.
+    fn release(&self, state: State<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(state.iterate.x);
+        pool.tops.give(state.iterate.u);
+        pool.tops.give(state.y);
+        for v in state.barrier.into_vectors() {
+            pool.reals.give(v);
+        }
+        if let Some(filter) = state.filter {
+            pool.pairs.give(filter.into_entries());
+        }
+        if let Some(direction) = state.full_step {
+            direction.recycle(&mut pool);
+        }
+        if let Some((riccati, _)) = state.kept {
+            riccati.recycle(&mut pool);
+        }
+    }
+
+    /// The iteration of [`Self::run`] from `st`: the plan and whether it is certified (if
+    /// not, the iterate of a real-time iteration at its iteration limit).
+    fn iterate_from(&self, st: &mut State<N, X>) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let options = &self.options;
+        let count = self.at_steps.len() + self.at_nodes.len();
+        let floor = barrier_floor(options.tolerance);
+        let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
         // (the stage constraints' projections change with the iterate: no simplified steps)
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
+            let point = (&st.iterate, &st.y[..], &st.barrier);
             let fail = |failure, cost, certificate, momenta| PlanError {
                 failure,
-                last: Some(Box::new(self.plan(
-                    (&iterate, &y, &barrier),
-                    cost,
-                    done,
-                    momenta,
-                    certificate,
-                ))),
+                last: Some(Box::new(self.plan(point, cost, done, momenta, certificate))),
             };
             // after a full step the last subproblem's multipliers are the Newton estimates
             // here: if they already certify this point, no subproblem is solved at it
-            if let Some(last) = full_step.take().filter(|_| rho_last == 0.0) {
-                let state = (&iterate, &y[..], &barrier);
-                if let Some(plan) = self.certify_without_solve(state, &last, iterations) {
-                    return Ok(plan);
+            if let Some(last) = st.full_step.take() {
+                let plan = (rho_last == 0.0)
+                    .then(|| self.certify_without_solve(point, &last, iterations))
+                    .flatten();
+                last.recycle(&mut self.pool.borrow_mut());
+                if let Some(plan) = plan {
+                    return Ok((plan, true));
                 }
             }
-            let mut models = match self.models(&iterate, &y, &barrier) {
+            let mut models = match self.models(&st.iterate, &st.y, &st.barrier) {
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
                     let unknown = super::plan::unknown_certificate();
@@ -589,101 +749,138 @@ where
                 }
                 Err(failure) => return Err(PlanError::without_iterate(failure)),
             };
-            let sub = match self.subproblem(&mut models, &barrier, kept.take(), rho_last) {
+            let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
                     let mut partial = super::plan::unknown_certificate();
                     partial.feasibility = models.violation_max();
-                    let failure = self.name_infeasibility(failure, &iterate);
+                    let failure = self.name_infeasibility(failure, &st.iterate);
                     return Err(fail(failure, models.cost, partial, vec![]));
                 }
             };
-            let Subproblem {
-                riccati,
-                rho,
-                stale,
-                direction,
-                mut momenta,
-                certificate,
-                error,
-                barrier_error,
-            } = sub;
-            rho_last = rho;
+            rho_last = sub.rho;
             // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
-            if barrier.mu > floor && barrier_error <= 10.0 * barrier.mu {
-                barrier.decrease(floor, self.dynamics.h);
-                if let Some(filter) = &mut filter {
+            if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
+                st.barrier.decrease(floor, self.dynamics.h);
+                if let Some(filter) = &mut st.filter {
                     filter.reset();
                 }
+                self.give_models(models);
+                self.give_subproblem(sub);
                 continue;
             }
-            let complementarity = barrier.complementarity().0;
+            let complementarity = st.barrier.complementarity().0;
             // converged, or at the acceptable level with no progress left but rounding
-            let acceptable = stalled >= 3 && error.max(complementarity) <= options.acceptable;
-            if (error <= options.tolerance || acceptable) && barrier.mu <= floor {
-                let certified = self.certify(
-                    (&iterate, &y, &barrier),
-                    &models,
-                    (rho == 0.0 && !stale).then_some(&riccati),
-                    certificate,
-                );
-                match certified {
-                    Ok(certificate) => {
-                        let plan = self.plan(
-                            (&iterate, &y, &barrier),
-                            models.cost,
-                            iterations,
-                            momenta,
-                            certificate,
-                        );
-                        // (no plan with a constraint violated beyond the tolerance where it is
-                        // imposed: iterate on)
-                        if plan.violations.imposed() <= options.tolerance {
-                            return Ok(plan);
-                        }
-                        momenta = plan.momenta;
+            let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
+            let sub = if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
+                match self.finish(point, &models, sub, iterations) {
+                    Finished::Plan(plan) => {
+                        self.give_models(models);
+                        return Ok((plan, true));
                     }
-                    Err((failure, certificate)) => {
-                        return Err(fail(failure, models.cost, certificate, momenta));
+                    Finished::Failed(failure, certificate, sub) => {
+                        return Err(fail(failure, models.cost, certificate, sub.momenta));
                     }
+                    Finished::Not(sub) => sub,
                 }
-            }
+            } else {
+                sub
+            };
             let out_of_time = self.out_of_time();
+            if iterations == options.max_iterations && self.real_time && !out_of_time {
+                let point = (&st.iterate, &st.y[..], &st.barrier);
+                let plan = self.plan(point, models.cost, done, sub.momenta, sub.certificate);
+                self.give_models(models);
+                let mut pool = self.pool.borrow_mut();
+                sub.riccati.recycle(&mut pool);
+                sub.direction.recycle(&mut pool);
+                return Ok((plan, false));
+            }
             if iterations == options.max_iterations || out_of_time {
                 let failure = if out_of_time {
                     Failure::TimeLimit
                 } else {
                     Failure::IterationLimit
                 };
-                return Err(fail(failure, models.cost, certificate, momenta));
+                return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
             }
             iterations += 1;
-            let ds = barrier.slack_steps(&models.inequalities, &direction, theta);
-            let (slacks, globals) = ((&barrier, &ds[..]), (&mut filter, &mut penalty));
-            let searched = (&iterate, &models, &direction);
-            let searched = self.line_search(searched, slacks, globals);
-            let accepted = match searched {
+            let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
+            let theta = self.dynamics.theta;
+            let ds = (st.barrier).slack_steps(&models.inequalities, &sub.direction, theta, ds);
+            let (slacks, globals) = ((&st.barrier, &ds[..]), (&mut st.filter, &mut penalty));
+            let searched = (&st.iterate, &models, &sub.direction);
+            let accepted = match self.line_search(searched, slacks, globals) {
                 Ok(accepted) => accepted,
-                Err(Failure::LineSearch) if stale => {
+                Err(Failure::LineSearch) if sub.stale => {
                     // the simplified direction failed: solve this iterate's own subproblem
                     iterations -= 1;
+                    self.pool.borrow_mut().reals.give(ds);
+                    self.give_models(models);
+                    self.give_subproblem(sub);
                     continue;
                 }
                 Err(failure) => {
-                    let failure = self.name_infeasibility(failure, &iterate);
-                    return Err(fail(failure, models.cost, certificate, momenta));
+                    let failure = self.name_infeasibility(failure, &st.iterate);
+                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
                 }
             };
-            let state = (&mut iterate, &mut barrier, &mut y[..]);
-            let (alpha, at_rounding) = Self::advance(accepted, (&direction, &ds), state);
+            let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
+            let (alpha, at_rounding) = self.advance(accepted, (&sub.direction, &ds), state);
+            self.pool.borrow_mut().reals.give(ds);
+            self.give_models(models);
             stalled = if at_rounding { stalled + 1 } else { 0 };
+            let Subproblem {
+                riccati,
+                rho,
+                stale,
+                direction,
+                momenta,
+                error,
+                ..
+            } = sub;
+            self.pool.borrow_mut().jets.give(momenta);
             // (worth trying when Newton's quadratic convergence will take the error from here
             // to below the tolerance)
-            full_step = (alpha == 1.0 && error <= options.tolerance.sqrt()).then_some(direction);
+            if alpha == 1.0 && error <= options.tolerance.sqrt() {
+                st.full_step = Some(direction);
+            } else {
+                direction.recycle(&mut self.pool.borrow_mut());
+            }
             // near a solution, one step with this factorisation at the next iterate
             if alpha == 1.0 && rho == 0.0 && !stale && unconstrained && error <= CHORD_ERROR {
-                kept = Some((riccati, error));
+                st.kept = Some((riccati, error));
+            } else {
+                riccati.recycle(&mut self.pool.borrow_mut());
             }
+        }
+    }
+
+    /// The end of the iteration at a point whose residuals are below the tolerance (or at the
+    /// acceptable level) with the barrier at its floor: the second-order check
+    /// ([`Self::certify`]) and the plan, unless a constraint is violated beyond the tolerance
+    /// where it is imposed (then the iteration goes on with the subproblem `sub`).
+    fn finish(
+        &self,
+        point: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        models: &Models<N, X>,
+        mut sub: Subproblem<N, X>,
+        iterations: usize,
+    ) -> Finished<N, X> {
+        let factored = (sub.rho == 0.0 && !sub.stale).then_some(&sub.riccati);
+        match self.certify(point, models, factored, sub.certificate) {
+            Ok(certificate) => {
+                let momenta = core::mem::take(&mut sub.momenta);
+                let mut plan = self.plan(point, models.cost, iterations, momenta, certificate);
+                if plan.violations.imposed() <= self.options.tolerance {
+                    self.give_subproblem(sub);
+                    return Finished::Plan(plan);
+                }
+                sub.momenta = core::mem::take(&mut plan.momenta);
+                self.give_plan(plan);
+                Finished::Not(sub)
+            }
+            Err((failure, certificate)) => Finished::Failed(failure, certificate, sub),
         }
     }
 
@@ -698,7 +895,7 @@ where
         match self.problem.violations(iterate, h, theta) {
             (violations, Some(worst))
                 if violations.imposed().is_nan()
-                    || violations.imposed() > self.problem.options.tolerance =>
+                    || violations.imposed() > self.options.tolerance =>
             {
                 Failure::StalledInfeasible(worst)
             }
@@ -722,10 +919,11 @@ where
     ) -> Result<Subproblem<N, X>, Failure> {
         if let Some((riccati, e_prev)) = kept {
             let sub = self.solved((models, barrier), riccati, 0.0, true);
-            let tolerance = self.problem.options.tolerance;
+            let tolerance = self.options.tolerance;
             if sub.error <= tolerance || sub.error * sub.error <= tolerance * e_prev {
                 return Ok(sub);
             }
+            self.give_subproblem(sub);
         }
         let (riccati, rho) = self.factor_corrected(models, barrier, rho_last)?;
         Ok(self.solved((models, barrier), riccati, rho, false))
@@ -747,29 +945,32 @@ where
             (barrier.z.iter().zip(&barrier.s)).any(|(z, s)| *z > REFINE_RATIO * s);
         let (r0, end) = (&models.r0, (&models.r_end, &models.terminal_gradient));
         let rho_h = self.dynamics.h * rho;
-        let mut direction = riccati.solve(&self.dynamics, &models.stages, rho_h, r0, end);
+        let mut pool = self.pool.borrow_mut();
+        let stages = &models.stages;
+        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut pool);
         if ill_conditioned {
             let model = (&models.stages[..], &models.terminal);
             for _ in 0..REFINEMENTS {
-                refine(
-                    &riccati,
-                    &self.dynamics,
-                    model,
-                    rho_h,
-                    r0,
-                    end,
-                    &mut direction,
-                );
+                let d = (&mut direction, &mut *pool);
+                refine(&riccati, &self.dynamics, model, rho_h, r0, end, d);
             }
         }
         // the multipliers of the inequalities that go with the subproblem's solution: the
         // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
         // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
-        let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta);
-        let z = barrier.predicted(&ds);
+        let (ds, mut z) = (
+            pool.reals.take(barrier.s.len()),
+            pool.reals.take(barrier.s.len()),
+        );
+        drop(pool);
+        let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta, ds);
+        barrier.predicted(&ds, &mut z);
         let (momenta, certificate, _) =
             self.residuals(models, barrier, riccati.negative, &direction, &z);
         let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
+        let mut pool = self.pool.borrow_mut();
+        pool.reals.give(ds);
+        pool.reals.give(z);
         let error = certificate.stationarity.max(certificate.feasibility);
         Subproblem {
             riccati,
@@ -796,7 +997,7 @@ where
         direction: &Direction<N, X>,
         (z, momenta): (&[f64], &[SVector<f64, X>]),
     ) -> f64 {
-        if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.problem.options.tolerance) {
+        if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.options.tolerance) {
             return f64::INFINITY;
         }
         let h = self.dynamics.h;
@@ -809,7 +1010,8 @@ where
         let count = direction.multipliers.len() * N + momenta.len() * X;
         let compl = barrier.complementarity().1;
         let error = |z: &[f64]| {
-            let (_, certificate, scale) = self.residuals(models, barrier, 0, direction, z);
+            let (momenta, certificate, scale) = self.residuals(models, barrier, 0, direction, z);
+            self.pool.borrow_mut().jets.give(momenta);
             let (s_d, s_c) = barrier.error_scales(z, h, (others, count));
             (scale * certificate.stationarity / s_d)
                 .max(certificate.feasibility)
@@ -829,18 +1031,28 @@ where
         iterations: usize,
     ) -> Option<Plan<N, X>> {
         let (iterate, y, barrier) = state;
-        let options = &self.problem.options;
+        let options = &self.options;
         if barrier.mu > barrier_floor(options.tolerance) {
             return None;
         }
         let models = self.models(iterate, y, barrier).ok()?;
         let (momenta, certificate, _) = self.residuals(&models, barrier, 0, last, &barrier.z);
-        if certificate.stationarity.max(certificate.feasibility) > options.tolerance {
+        let certified = (certificate.stationarity.max(certificate.feasibility)
+            <= options.tolerance)
+            .then(|| self.certify(state, &models, None, certificate).ok())
+            .flatten();
+        let cost = models.cost;
+        self.give_models(models);
+        let Some(certificate) = certified else {
+            self.pool.borrow_mut().jets.give(momenta);
             return None;
+        };
+        let plan = self.plan(state, cost, iterations, momenta, certificate);
+        if plan.violations.imposed() <= options.tolerance {
+            return Some(plan);
         }
-        let certificate = self.certify(state, &models, None, certificate).ok()?;
-        let plan = self.plan(state, models.cost, iterations, momenta, certificate);
-        (plan.violations.imposed() <= options.tolerance).then_some(plan)
+        self.give_plan(plan);
+        None
     }
 
     /// The second-order check at a KKT point: the Hessian of the Lagrangian must be positive
@@ -862,30 +1074,50 @@ where
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         models: &Models<N, X>,
         factored: Option<&Riccati<N, X>>,
-        mut certificate: Certificate,
+        certificate: Certificate,
     ) -> Result<Certificate, (Failure, Certificate)> {
         let barrier = state.2;
-        let refactored;
+        let mut refactored = None;
         let exact = if !barrier.s.is_empty() {
-            refactored = self.penalized_factor(state, models, 0.0);
-            &refactored
+            refactored.insert(self.penalized_factor(state, models, 0.0))
         } else if let Some(riccati) = factored {
             riccati
         } else {
-            refactored =
-                Riccati::factor_with(&self.dynamics, &models.stages, 0.0, &models.terminal);
-            &refactored
+            let pool = &mut *self.pool.borrow_mut();
+            let (stages, end) = (&models.stages, &models.terminal);
+            refactored.insert(Riccati::factor_with(&self.dynamics, stages, 0.0, end, pool))
         };
+        let result = self.second_order(state, models, exact, certificate);
+        if let Some(riccati) = refactored {
+            riccati.recycle(&mut self.pool.borrow_mut());
+        }
+        result
+    }
+
+    /// The rest of [`Self::certify`] with the factorisation `exact` of its second-order check:
+    /// its inertia, the shifted factorisation of a singular one, the smallest eigenvalue.
+    fn second_order(
+        &self,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        models: &Models<N, X>,
+        exact: &Riccati<N, X>,
+        mut certificate: Certificate,
+    ) -> Result<Certificate, (Failure, Certificate)> {
         certificate.negative_directions = exact.negative;
         if !exact.positive_definite() {
             // singular without a negative pivot: semidefinite if a shift of the rounding's
             // size makes it definite (a minimum, flat along some direction: not strict)
             let shifted = (exact.negative == 0).then(|| self.shifted_factor(state, models));
-            if shifted.as_ref().is_some_and(|f| f.positive_definite()) {
+            let definite = shifted.as_ref().is_some_and(|f| f.positive_definite());
+            let negative = shifted.map_or(exact.negative, |f| {
+                let negative = f.negative;
+                f.recycle(&mut self.pool.borrow_mut());
+                negative
+            });
+            if definite {
                 certificate.min_reduced_hessian_eig = 0.0;
                 return Ok(certificate);
             }
-            let negative = shifted.map_or(exact.negative, |f| f.negative);
             certificate.negative_directions = negative;
             let failure = Failure::NotAMinimum {
                 negative_directions: negative,
@@ -893,9 +1125,10 @@ where
             return Err((failure, certificate));
         }
         // (the Lanczos operator takes x_N as fixed)
-        if self.problem.options.min_eigenvalue && models.terminal.fixed.iter().all(|f| *f != 0.0) {
+        if self.options.min_eigenvalue && models.terminal.fixed.iter().all(|f| *f != 0.0) {
+            let pool = &mut *self.pool.borrow_mut();
             certificate.min_reduced_hessian_eig =
-                min_reduced_eigenvalue(exact, &self.dynamics, self.problem.steps);
+                min_reduced_eigenvalue(exact, &self.dynamics, self.problem.steps, pool);
         }
         Ok(certificate)
     }
@@ -914,7 +1147,14 @@ where
             return self.penalized_factor(state, models, SEMIDEFINITE_SHIFT);
         }
         let shift = SEMIDEFINITE_SHIFT * self.hessian_scale(&models.stages);
-        Riccati::factor_with(&self.dynamics, &models.stages, shift, &models.terminal)
+        let pool = &mut *self.pool.borrow_mut();
+        Riccati::factor_with(
+            &self.dynamics,
+            &models.stages,
+            shift,
+            &models.terminal,
+            pool,
+        )
     }
 
     /// The largest entry of the stage Hessians $H_{xx}$, $H_{uu}$, and $h$ at least.
@@ -935,13 +1175,17 @@ where
         models: &Models<N, X>,
         shift: f64,
     ) -> Riccati<N, X> {
-        let base: Vec<StageModel<N, X>> = (0..iterate.u.len())
-            .map(|i| self.stage(iterate, i, &y[i], barrier))
-            .collect();
+        let steps = iterate.u.len();
+        let (mut base, mut stages) = {
+            let mut pool = self.pool.borrow_mut();
+            (pool.stages.take(steps), pool.stages.take(steps))
+        };
+        base.extend((0..steps).map(|i| self.stage(iterate, i, &y[i], barrier)));
+        stages.extend_from_slice(&base);
         let scale = self.hessian_scale(&base);
         let lin = &models.inequalities;
-        let mut stages = base.clone();
-        let mut riccati = None;
+        let mut riccati: Option<Riccati<N, X>> = None;
+        let pool = &mut *self.pool.borrow_mut();
         for weight in FINSLER_WEIGHTS {
             stages.clone_from_slice(&base);
             for (k, c) in lin.iter().enumerate() {
@@ -952,16 +1196,22 @@ where
                     weight * scale / c.gx.norm_squared().max(c.gu.norm_squared()).max(1e-300);
                 barrier.add_outer(&mut stages, k, c, sigma);
             }
-            let factor =
-                Riccati::factor_with(&self.dynamics, &stages, shift * scale, &models.terminal);
+            if let Some(last) = riccati.take() {
+                last.recycle(pool);
+            }
+            let end = &models.terminal;
+            let factor = Riccati::factor_with(&self.dynamics, &stages, shift * scale, end, pool);
             let done = factor.positive_definite();
             riccati = Some(factor);
             if done {
                 break;
             }
         }
-        riccati.unwrap_or_else(|| {
-            Riccati::factor_with(&self.dynamics, &base, shift * scale, &models.terminal)
-        })
+        let riccati = riccati.unwrap_or_else(|| {
+            Riccati::factor_with(&self.dynamics, &base, shift * scale, &models.terminal, pool)
+        });
+        pool.stages.give(base);
+        pool.stages.give(stages);
+        riccati
     }
 }

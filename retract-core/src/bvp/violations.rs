@@ -179,7 +179,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         (report, worst)
     }
 
-    /// The node inequalities on the interpolant inside step `i`.
+    /// The node inequalities on the interpolant inside step `i` (the Hermite polynomial
+    /// between its end jets, [`interpolant_weights`]).
     fn between(&self, iterate: &Iterate<N, X>, i: usize, h: f64, worst: &mut Worst) {
         let mut at_nodes = self
             .inequalities
@@ -189,26 +190,57 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         if at_nodes.peek().is_none() {
             return;
         }
-        let Ok(piece) = Hermite::new(
-            iterate.x[i].as_slice(),
-            iterate.x[i + 1].as_slice(),
-            h,
-            N,
-            K,
-        ) else {
+        // (the problem's own step, the usual case, has its weights made once)
+        let own = h == self.t_end / self.steps as f64;
+        let other = (!own).then(|| interpolant_weights(h, K)).flatten();
+        let Some(weights) = (if own {
+            self.placed().interpolant.as_ref()
+        } else {
+            other.as_ref()
+        }) else {
             return;
         };
+        let (x0, x1) = (&iterate.x[i], &iterate.x[i + 1]);
         let zero = SVector::<f64, N>::zeros();
-        let points: Vec<SVector<f64, X>> = (1..INTERPOLANT_DIVISIONS)
-            .map(|j| {
-                let t = h * j as f64 / INTERPOLANT_DIVISIONS as f64;
-                SVector::from_fn(|r, _| piece.jet_entry(r, t))
-            })
-            .collect();
+        let mut points = [SVector::<f64, X>::zeros(); INTERPOLANT_DIVISIONS - 1];
+        for (p, point) in points.iter_mut().enumerate() {
+            let w = &weights[p * 2 * K * K..(p + 1) * 2 * K * K];
+            *point = SVector::from_fn(|r, _| {
+                let (j, a) = (r / N, r % N);
+                let row = &w[j * 2 * K..(j + 1) * 2 * K];
+                (0..K)
+                    .map(|m| row[m] * x0[m * N + a] + row[K + m] * x1[m * N + a])
+                    .sum()
+            });
+        }
         for c in at_nodes {
             for x in &points {
                 worst.see(-c.value(x, &zero), c.reference(), Location::Between(i));
             }
         }
     }
+}
+
+/// The weights of the Hermite interpolant inside a step of length `h` between jets of order
+/// `k`: at the point $t_p = p h / D$ ($p = 1, \dots, D - 1$, $D$ =
+/// [`INTERPOLANT_DIVISIONS`]), $q^{(j)}(t_p) = \sum_{m < k} (a_{pjm} q^{(m)}(0) + b_{pjm}
+/// q^{(m)}(h))$ coordinate by coordinate, with $a_{pjm}$ at index $((p - 1) k + j) 2k + m$
+/// and $b_{pjm}$ $k$ after it. `None` where the interpolation is singular.
+pub(super) fn interpolant_weights(h: f64, k: usize) -> Option<Vec<f64>> {
+    // the polynomials of the unit jets: q^(m)(0) = 1 (side 0) or q^(m)(h) = 1 (side 1)
+    let unit = |side: usize, m: usize| {
+        let mut ends = vec![0.0; 2 * k];
+        ends[side * k + m] = 1.0;
+        Hermite::new(&ends[..k], &ends[k..], h, 1, k).ok()
+    };
+    let basis: Option<Vec<Hermite>> = (0..2 * k).map(|b| unit(b / k, b % k)).collect();
+    let basis = basis?;
+    let mut weights = Vec::with_capacity((INTERPOLANT_DIVISIONS - 1) * 2 * k * k);
+    for p in 1..INTERPOLANT_DIVISIONS {
+        let t = h * p as f64 / INTERPOLANT_DIVISIONS as f64;
+        for j in 0..k {
+            weights.extend(basis.iter().map(|b| b.derivative(0, j, t)));
+        }
+    }
+    Some(weights)
 }

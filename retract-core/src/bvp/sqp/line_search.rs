@@ -41,14 +41,20 @@ pub(in crate::bvp) struct Filter {
 }
 
 impl Filter {
-    /// An empty filter for a first violation `theta0`.
-    pub fn new(theta0: f64) -> Self {
+    /// An empty filter for a first violation `theta0` (its pairs kept in `entries`).
+    pub fn new(theta0: f64, mut entries: Vec<(f64, f64)>) -> Self {
         let scale = theta0.max(1.0);
+        entries.clear();
         Self {
-            entries: Vec::new(),
+            entries,
             theta_max: 1e4 * scale,
             theta_min: 1e-4 * scale,
         }
+    }
+
+    /// Its vector of pairs (to keep for a later filter).
+    pub fn into_entries(self) -> Vec<(f64, f64)> {
+        self.entries
     }
 
     /// Empties the filter (when $\mu$ changes, the barrier cost changes with it).
@@ -93,7 +99,7 @@ where
     ) -> Option<(f64, f64)> {
         let h = self.dynamics.h;
         let (mut cost, mut violation) = (0.0, 0.0);
-        let mut values = Vec::with_capacity(ds.len());
+        let mut values = self.pool.borrow_mut().reals.take(ds.len());
         for (i, u) in iterate.u.iter().enumerate() {
             let system = self.problem.system_at(i);
             let xt = self.x_theta(iterate, i);
@@ -107,6 +113,7 @@ where
         }
         self.node_values(iterate, &mut values);
         let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
+        self.pool.borrow_mut().reals.give(values);
         let last = &iterate.x[iterate.x.len() - 1];
         violation += slack
             + (self.problem.start - iterate.x[0])
@@ -171,20 +178,21 @@ where
         (barrier, ds): (&Barrier, &[f64]),
         alpha: f64,
     ) -> (Iterate<N, X>, Option<(f64, f64)>) {
-        let trial = Iterate {
-            x: iterate
+        let mut trial = self.take_iterate(iterate.u.len());
+        (trial.x).extend(
+            iterate
                 .x
                 .iter()
                 .zip(&direction.dx)
-                .map(|(x, d)| x + d * alpha)
-                .collect(),
-            u: iterate
+                .map(|(x, d)| x + d * alpha),
+        );
+        (trial.u).extend(
+            iterate
                 .u
                 .iter()
                 .zip(&direction.du)
-                .map(|(u, d)| u + d * alpha)
-                .collect(),
-        };
+                .map(|(u, d)| u + d * alpha),
+        );
         let parts = self
             .problem
             .guard::<S, M>(&trial)
@@ -198,12 +206,14 @@ where
     /// multipliers `y` toward the direction's by the same primal step length. Returns the
     /// step length and whether the decrease was at rounding level.
     pub(super) fn advance(
+        &self,
         accepted: Accepted<N, X>,
         (direction, ds): (&Direction<N, X>, &[f64]),
         (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
     ) -> (f64, bool) {
         let alpha = accepted.alpha;
-        *iterate = accepted.trial;
+        let left = core::mem::replace(iterate, accepted.trial);
+        self.give_iterate(left);
         barrier.update(ds, alpha);
         for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
             *yi += (target - *yi) * alpha;
@@ -220,7 +230,9 @@ where
         slacks: (&Barrier, &[f64]),
         (filter, penalty): (&mut Option<Filter>, &mut f64),
     ) -> Result<Accepted<N, X>, Failure> {
-        let filter = filter.get_or_insert_with(|| Filter::new(models.violation_l1()));
+        let filter = filter.get_or_insert_with(|| {
+            Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
+        });
         let searched = (iterate, models, direction);
         match self.filter_search(searched, slacks, filter)? {
             Some(accepted) => Ok(accepted),
@@ -240,7 +252,7 @@ where
         (barrier, ds): (&Barrier, &[f64]),
         filter: &mut Filter,
     ) -> Result<Option<Accepted<N, X>>, Failure> {
-        let options = &self.problem.options;
+        let options = &self.options;
         let slope = self.slope(models, direction, barrier, ds);
         let (theta, phi) = (models.violation_l1(), models.barrier_cost);
         if !slope.is_finite() {
@@ -267,27 +279,32 @@ where
                 return Err(Failure::TimeLimit);
             }
             let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
-            if let Some((phi_t, theta_t)) = parts
-                && !filter.rejects(theta_t, phi_t)
+            let Some((phi_t, theta_t)) = parts.filter(|(p, t)| !filter.rejects(*t, *p)) else {
+                self.give_iterate(trial);
+                alpha *= 0.5;
+                continue;
+            };
+            let switching =
+                slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
+            let accept = if theta <= filter.theta_min && switching {
+                phi_t <= phi + options.armijo * alpha * slope + noise
+            } else if theta_t <= (1.0 - GAMMA_THETA) * theta
+                || phi_t <= phi - GAMMA_PHI * theta + noise
             {
+                filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
+                true
+            } else {
+                false
+            };
+            if accept {
                 let accepted = Accepted {
                     trial,
                     alpha,
                     at_rounding,
                 };
-                let switching =
-                    slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
-                if theta <= filter.theta_min && switching {
-                    if phi_t <= phi + options.armijo * alpha * slope + noise {
-                        return Ok(Some(accepted));
-                    }
-                } else if theta_t <= (1.0 - GAMMA_THETA) * theta
-                    || phi_t <= phi - GAMMA_PHI * theta + noise
-                {
-                    filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
-                    return Ok(Some(accepted));
-                }
+                return Ok(Some(accepted));
             }
+            self.give_iterate(trial);
             alpha *= 0.5;
         }
         Ok(None)
@@ -305,7 +322,7 @@ where
         (barrier, ds): (&Barrier, &[f64]),
         penalty: &mut f64,
     ) -> Result<Accepted<N, X>, Failure> {
-        let options = &self.problem.options;
+        let options = &self.options;
         let slope = self.slope(models, direction, barrier, ds);
         let violation = models.violation_l1();
         if violation > 0.0 {
@@ -352,6 +369,7 @@ where
                     at_rounding: -descent <= noise,
                 });
             }
+            self.give_iterate(trial);
             alpha *= 0.5;
         }
         Err(Failure::LineSearch)
