@@ -27,10 +27,10 @@
 
 use nalgebra::{Matrix2x3, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 
-use crate::lifted::{Blocks, join, split};
-use crate::map::DiscretizationMap;
-use crate::newton::NewtonOptions;
-use crate::step::StepReport;
+use crate::numeric::newton::NewtonOptions;
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::map::DiscretizationMap;
+use crate::scheme::step::StepReport;
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// The longest jet handled here: $q, \dots, q^{(2k-1)}$ for $k \le 4$.
@@ -423,8 +423,8 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
         for (j, pj) in p.iter().enumerate() {
             rhs.fixed_rows_mut::<2>(2 * j).copy_from(pj);
         }
-        let solved =
-            crate::linalg::solve(&tt, &rhs).ok_or(Error::SingularJacobian { iteration: 0 })?;
+        let solved = crate::numeric::linalg::solve(&tt, &rhs)
+            .ok_or(Error::SingularJacobian { iteration: 0 })?;
         let x_b: Blocks<2, K> = core::array::from_fn(|j| values.0[j]);
         let p_b: Blocks<2, K> = core::array::from_fn(|j| solved.fixed_rows::<2>(2 * j).into());
         let z = join::<2, K, S>(&x_b, &p_b);
@@ -486,7 +486,7 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
 /// # Errors
 /// Those of [`SphereState::validate`] for `state` (a chart frame that is not orthonormal, a
 /// non-finite state, a point off the unit sphere, e.g. chart coordinates that overflow it), of
-/// [`crate::map::step`] and of the chart change [`SphereState::recentred`].
+/// [`crate::scheme::map::step`] and of the chart change [`SphereState::recentred`].
 pub fn step<Sys, Map, const K: usize, const S: usize, const M: usize>(
     system: &Sys,
     map: &Map,
@@ -500,7 +500,7 @@ where
 {
     state.validate()?;
     let params = state.chart.params();
-    let (z, report) = crate::map::step(
+    let (z, report) = crate::scheme::map::step(
         &system.with_chart(params),
         &map.in_chart(params),
         &state.z,

@@ -13,7 +13,7 @@
 use nalgebra::{SVector, UnitQuaternion, Vector3};
 
 use super::moving::recentre;
-use crate::lifted::join;
+use crate::scheme::lifted::join;
 use crate::{Error, Lagrangian};
 
 /// A generated Lagrangian or jet function on SO(3) (`so3`): a system on $\mathbb{R}^3$,

@@ -4,7 +4,7 @@
 //!
 //! $$g = (C, c)\thinspace(Q(y), x) = (C\thinspace Q(y),\thickspace c + C x),$$
 //!
-//! with $Q$ the Gibbs chart of [`crate::so3`]. The body velocity is
+//! with $Q$ the Gibbs chart of [`crate::manifold::so3`]. The body velocity is
 //! $\xi = (\Omega, v)$ with $\Omega = 2 (y' - y \times y') / (1 + |y|^2)$ and
 //! $v = R^T p' = Q(y)^T x'$, the same in every chart.
 //!
@@ -12,15 +12,15 @@
 //! with this chart, centred at a parameter of the generated type ([`Se3System`]). Moving the
 //! centre from $(C, c)$ to $(C, c)(Q(a), b)$ changes chart points by
 //! $(y, x) \mapsto (\phi_a(y), Q(a)^T (x - b))$: the Gibbs chart's transition
-//! ([`crate::so3::translate`]) and a rigid motion of the position, so the jet and the momenta
+//! ([`crate::manifold::so3::translate`]) and a rigid motion of the position, so the jet and the momenta
 //! change block by block ([`transition`]), and a step of a left-invariant discretization map
 //! (the Cayley map on $y$ with the midpoint rule on $x$) commutes with the change.
 
 use nalgebra::{Isometry3, Matrix3, SVector, Translation3, UnitQuaternion, Vector3};
 
 use crate::Error;
-use crate::lifted::{Blocks, join, split};
-use crate::so3::{chart_momentum, chart_quaternion, transition_blocks};
+use crate::manifold::so3::{chart_momentum, chart_quaternion, transition_blocks};
+use crate::scheme::lifted::{Blocks, join, split};
 
 /// A generated Lagrangian or jet function on SE(3) (`se3`): a system on $\mathbb{R}^6$, the
 /// product chart, whose centre $(C, c)$ is a parameter.
@@ -63,7 +63,7 @@ pub fn pose<const K: usize, const S: usize>(
 }
 
 /// The chart point $(y, x)$ of the pose `g` in the chart centred at `centre`:
-/// $y$ of [`crate::so3::chart_point`] and $x = C^T (p - c)$; `None` for a rotation a
+/// $y$ of [`crate::manifold::so3::chart_point`] and $x = C^T (p - c)$; `None` for a rotation a
 /// half-turn from the centre's.
 pub fn chart_point(centre: &Isometry3<f64>, g: &Isometry3<f64>) -> Option<SVector<f64, 6>> {
     let relative = centre.inverse() * g;
@@ -98,7 +98,7 @@ fn join_blocks<const K: usize>(y: &Blocks<3, K>, x: &Blocks<3, K>) -> Blocks<6, 
 }
 
 /// The state `z` (of order $k$) in the chart centred at $(C, c)(Q(a), b)$ instead of
-/// $(C, c)$ (module docs): the rotation part by [`crate::so3::transition`], the position's
+/// $(C, c)$ (module docs): the rotation part by [`crate::manifold::so3::transition`], the position's
 /// jet $x \mapsto Q(a)^T (x - b)$ and $x^{(j)} \mapsto Q(a)^T x^{(j)}$, its momenta
 /// $p \mapsto Q(a)^T p$ (the inverse transpose of an orthogonal map). An error if the
 /// rotation is a half-turn from the new centre's or the result is not finite.
@@ -165,7 +165,7 @@ pub fn recentre_system<Sys: Se3System, const K: usize, const S: usize>(
 /// chart state `z` of order $k$ centred at `centre` $= (C, c)$: the linear part
 /// $P = C\thinspace p_{x,0}$ (translations move $x$ by a constant) and the angular part about the
 /// world origin $L = C \big(M + \sum_j w_j \times p_{x,j}\big)$ with $M$ the Gibbs chart's
-/// ([`crate::so3::world_momentum`] in the centre's axes), $w_0 = C^T c + x$ and
+/// ([`crate::manifold::so3::world_momentum`] in the centre's axes), $w_0 = C^T c + x$ and
 /// $w_j = x^{(j)}$ (a rotation $\omega$ moves $x$ by $C^T\omega \times (C^T c + x)$). A
 /// Lagrangian written in body coordinates conserves both, and so do the steps of the
 /// left-invariant map. Returns $(L, P)$.

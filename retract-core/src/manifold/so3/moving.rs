@@ -15,7 +15,7 @@
 //! point transformation, $p_{\rm new} = (\partial Y_{\rm new} / \partial Y)^{-T} p$: a
 //! symplectic change of coordinates. The Jacobian is block lower triangular with blocks
 //! $\partial y^{(j)}_{\rm new} / \partial y^{(i)} = \frac{j!}{i!} c_{j-i}[D\phi_a]$ (the
-//! Taylor coefficients of $D\phi_a$ along the curve, as in [`crate::map::TaylorLift`]).
+//! Taylor coefficients of $D\phi_a$ along the curve, as in [`crate::scheme::map::TaylorLift`]).
 //! The Cayley midpoint map and a Lagrangian written in body coordinates are both invariant
 //! under left translations, so a step commutes with the change of chart: stepping and
 //! recentring give the same rotations as stepping in one chart, wherever that chart is
@@ -24,9 +24,9 @@
 use nalgebra::{Matrix3, Quaternion, SVector, UnitQuaternion, Vector3};
 
 use crate::Error;
-use crate::lifted::{Blocks, join, split};
-use crate::map::taylor_lift::{curve, falling};
-use crate::taylor::{Dual, Scalar, Taylor};
+use crate::numeric::taylor::{Dual, Scalar, Taylor};
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::map::taylor_lift::{curve, falling};
 
 /// $\phi_a(y) = (y - a - a \times y) / (1 + a \cdot y)$: the chart point, in the chart
 /// centred at $c\thinspace Q(a)$, of the point $y$ of the chart centred at $c$.
