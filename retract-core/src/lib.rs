@@ -89,6 +89,29 @@ pub use scheme::{
     compose, diagnostics, forced, lifted, map, reduced, split, split_methods, split_stepper, step,
 };
 
+/// What generated code names and a user does not: the traits it implements, the functions
+/// its impls call and the types they return, in one flat module that the macro's output can
+/// reach by one path (as `::thiserror::__private`). Not a public API: it follows the macros
+/// of the same version.
+#[doc(hidden)]
+pub mod __private {
+    pub use crate::manifold::se3::Se3System;
+    pub use crate::manifold::so3::So3System;
+    pub use crate::manifold::sphere::SphereSystem;
+    pub use crate::numeric::linalg::solve;
+    pub use crate::numeric::special::stumpff;
+    pub use crate::scheme::lifted::{hamiltonian, legendre, predictor, step_cost, vector_field};
+    pub use crate::scheme::map::{CovectorHessian, DiscretizationMap, MapJacobians};
+    pub use crate::scheme::reduced::{
+        ClosedForm, ReducedFactors, ReducedScheme, two_product, two_sum,
+    };
+    pub use crate::scheme::split::Separable;
+    pub use crate::system::{
+        Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction,
+    };
+    pub use crate::{DomainKind, DomainViolation, Error, Float, nalgebra};
+}
+
 // the optimizer at the root, beside the legacy root finder (both live in `bvp`)
 #[cfg(feature = "std")]
 pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
