@@ -20,6 +20,7 @@ use nalgebra::{Isometry3, Matrix3, SVector, Translation3, UnitQuaternion, Vector
 
 use crate::Error;
 use crate::manifold::so3::{chart_momentum, chart_quaternion, transition_blocks};
+use crate::manifold::{CentredSystem, MovingChart};
 use crate::scheme::lifted::{Blocks, join, split};
 
 /// A generated Lagrangian or jet function on SE(3) (`se3`): a system on $\mathbb{R}^6$, the
@@ -40,9 +41,54 @@ pub fn centre_pose(centre: &Isometry3<f64>) -> [f64; 12] {
     core::array::from_fn(|e| if e < 9 { r[(e / 3, e % 3)] } else { c[e - 9] })
 }
 
-/// `system` with its chart centred at `centre`.
+/// `system` with its chart centred at `centre` ([`CentredSystem::centred`]).
 pub fn centred<Sys: Se3System>(system: &Sys, centre: &Isometry3<f64>) -> Sys {
-    system.with_centre(centre_pose(centre))
+    CentredSystem::<Se3, 6>::centred(system, centre)
+}
+
+/// A system on SE(3) is written in the chart centred at any pose: its centre parameter is
+/// the pose laid out by [`centre_pose`].
+impl<Sys: Se3System> CentredSystem<Se3, 6> for Sys {
+    fn centred(&self, chart: &Isometry3<f64>) -> Self {
+        self.with_centre(centre_pose(chart))
+    }
+}
+
+/// The rigid motions in moving product charts: a chart is its centre $(C, c)$ (an
+/// [`Isometry3`]), the point of the chart coordinates $(y, x)$ is the pose
+/// $(C, c)(Q(y), x)$, and the transition to the chart centred at $(C, c)(Q(a), b)$ is
+/// [`transition`] (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Se3;
+
+impl MovingChart<6> for Se3 {
+    type Chart = Isometry3<f64>;
+    type Point = Isometry3<f64>;
+
+    /// The pose $(C, c)(Q(y), x)$.
+    fn point(chart: &Isometry3<f64>, point: &SVector<f64, 6>) -> Isometry3<f64> {
+        let (y, position) = halves(point);
+        chart * chart_pose(&y, &position)
+    }
+
+    /// [`chart_point`]: `None` for a rotation a half-turn from the centre's.
+    fn chart_point(chart: &Isometry3<f64>, g: &Isometry3<f64>) -> Option<SVector<f64, 6>> {
+        chart_point(chart, g)
+    }
+
+    /// The centre $(C, c)(Q(a), b)$ (its quaternion renormalised) and [`transition`] of `z`,
+    /// with `a` $= (a, b)$.
+    fn transition<const K: usize, const S: usize>(
+        chart: &Isometry3<f64>,
+        a: &SVector<f64, 6>,
+        z: &SVector<f64, S>,
+    ) -> Result<(Isometry3<f64>, SVector<f64, S>), Error> {
+        let (a, b) = halves(a);
+        let moved = transition::<K, S>(&a, &b, z)?;
+        let mut next = chart * chart_pose(&a, &b);
+        next.rotation = UnitQuaternion::new_normalize(next.rotation.into_inner());
+        Ok((next, moved))
+    }
 }
 
 /// The chart point $(y, x)$ of the pose $(Q(y), x)$ relative to the chart's centre.
@@ -58,8 +104,7 @@ pub fn pose<const K: usize, const S: usize>(
 ) -> Isometry3<f64> {
     const { assert!(K >= 1, "the order k is at least 1") };
     let (x, _) = split::<6, K, S>(z);
-    let (y, position) = halves(&x[0]);
-    centre * chart_pose(&y, &position)
+    Se3::point(centre, &x[0])
 }
 
 /// The chart point $(y, x)$ of the pose `g` in the chart centred at `centre`:
@@ -133,32 +178,24 @@ pub fn transition<const K: usize, const S: usize>(
 
 /// Moves the chart of `z` to its own point: `centre` becomes $(C, c)(Q(y), x)$ (its
 /// quaternion renormalised) and `z` the same state in that chart ([`transition`] with
-/// $(a, b) = (y, x)$), whose point is 0. An error (with nothing changed) as for
-/// [`transition`].
+/// $(a, b) = (y, x)$), whose point is 0 ([`Se3`]'s [`MovingChart::recentre`]). An error
+/// (with nothing changed) as for [`transition`].
 pub fn recentre<const K: usize, const S: usize>(
     centre: &mut Isometry3<f64>,
     z: &mut SVector<f64, S>,
 ) -> Result<(), Error> {
-    let (x, _) = split::<6, K, S>(z);
-    let (y, position) = halves(&x[0]);
-    let moved = transition::<K, S>(&y, &position, z)?;
-    let mut next = *centre * chart_pose(&y, &position);
-    next.rotation = UnitQuaternion::new_normalize(next.rotation.into_inner());
-    *centre = next;
-    *z = moved;
-    Ok(())
+    Se3::recentre::<K, S>(centre, z)
 }
 
 /// Moves the chart of `z` to its own point, as [`recentre`], and the centre of `system` with
-/// it. An error (nothing changed) as for [`recentre`].
+/// it ([`crate::manifold::recentre_system`]). An error (nothing changed) as for
+/// [`recentre`].
 pub fn recentre_system<Sys: Se3System, const K: usize, const S: usize>(
     system: &mut Sys,
     centre: &mut Isometry3<f64>,
     z: &mut SVector<f64, S>,
 ) -> Result<(), Error> {
-    recentre::<K, S>(centre, z)?;
-    *system = centred(system, centre);
-    Ok(())
+    crate::manifold::recentre_system::<Se3, Sys, 6, K, S>(system, centre, z)
 }
 
 /// The spatial momentum (the Noether momentum of left multiplication, in world axes) of the
@@ -186,4 +223,49 @@ pub fn spatial_momentum<const K: usize, const S: usize>(
         angular += w.cross(&px[j]);
     }
     (centre.rotation * angular, centre.rotation * px[0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::manifold::testing::{there_and_back, vector};
+
+    /// A pose from a seeded axis-angle vector and translation.
+    fn pose_at(seed: &mut u64) -> Isometry3<f64> {
+        let rotation = UnitQuaternion::from_scaled_axis(vector::<3>(seed, 1.8));
+        Isometry3::from_parts(Translation3::from(vector::<3>(seed, 3.0)), rotation)
+    }
+
+    #[test]
+    fn a_transition_there_and_back_is_the_identity() {
+        let mut seed = 5;
+        for _ in 0..50 {
+            let centre = pose_at(&mut seed);
+            let z: SVector<f64, 24> = vector(&mut seed, 1.0);
+            let a: SVector<f64, 6> = vector(&mut seed, 0.5);
+            let (back, z_back) = there_and_back::<Se3, 6, 2, 24>(&centre, &a, &z);
+            assert!(back.rotation.angle_to(&centre.rotation) < 1e-12);
+            assert!((back.translation.vector - centre.translation.vector).amax() < 1e-12);
+            assert!((z_back - z).amax() < 1e-12, "{z_back} {z}");
+        }
+    }
+
+    #[test]
+    fn recentring_puts_the_point_at_the_origin_and_keeps_the_pose() {
+        let mut seed = 13;
+        for _ in 0..50 {
+            let mut centre = pose_at(&mut seed);
+            let mut z: SVector<f64, 24> = vector(&mut seed, 1.0);
+            let before = pose::<2, 24>(&centre, &z);
+            let (angular, linear) = spatial_momentum::<2, 24>(&centre, &z);
+            Se3::recentre::<2, 24>(&mut centre, &mut z).unwrap();
+            assert!(z.fixed_rows::<6>(0).amax() < 1e-15, "{z}");
+            assert!(centre.rotation.angle_to(&before.rotation) < 1e-12);
+            assert!((centre.translation.vector - before.translation.vector).amax() < 1e-12);
+            let (angular_after, linear_after) = spatial_momentum::<2, 24>(&centre, &z);
+            let scale = 1.0 + angular.amax() + linear.amax();
+            assert!((angular_after - angular).amax() < 1e-12 * scale);
+            assert!((linear_after - linear).amax() < 1e-12 * scale);
+        }
+    }
 }

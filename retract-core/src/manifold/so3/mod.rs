@@ -43,10 +43,11 @@ use nalgebra::{SVector, Vector3};
 mod body;
 mod moving;
 pub use body::{So3System, body_state, centre_matrix, centred, chart_derivatives, recentre_system};
-pub(crate) use moving::{chart_momentum, transition_blocks};
 pub use moving::{
-    chart_point, chart_quaternion, orientation, recentre, transition, translate, world_momentum,
+    So3, chart_point, chart_quaternion, orientation, recentre, transition, translate,
+    world_momentum,
 };
+pub(crate) use moving::{chart_momentum, transition_blocks};
 
 use crate::numeric::taylor::Scalar;
 use crate::scheme::map::BaseMap;
