@@ -232,6 +232,16 @@ impl<const N: usize, const K: usize> State<N, K> {
     }
 }
 
+// (here rather than beside `Trajectory`, so that the schemes do not import the states)
+#[cfg(feature = "std")]
+impl<const S: usize> crate::Trajectory<S> {
+    /// State $z_i$ by blocks ([`State`]: $q^{(j)}$, $p_j$ by name), or `None` past the end;
+    /// `S` $= 2nk$ is checked at compile time.
+    pub fn state<const N: usize, const K: usize>(&self, i: usize) -> Option<State<N, K>> {
+        self.states.get(i).map(State::from_vector)
+    }
+}
+
 /// [`Blocks`] as a list of $K$ blocks (serde implements arrays only up to a fixed length, not
 /// for a const-generic one); deserializing needs no allocation.
 #[cfg(feature = "serde")]

@@ -538,12 +538,6 @@ impl<const S: usize> Trajectory<S> {
         (0..self.states.len()).map(|i| i as f64 * self.h).collect()
     }
 
-    /// State $z_i$ by blocks ([`crate::State`]: $q^{(j)}$, $p_j$ by name), or `None` past the
-    /// end; `S` $= 2nk$ is checked at compile time.
-    pub fn state<const N: usize, const K: usize>(&self, i: usize) -> Option<crate::State<N, K>> {
-        self.states.get(i).map(crate::State::from_vector)
-    }
-
     /// The largest number of Newton iterations of any step (0 for no step).
     pub fn max_iterations(&self) -> usize {
         self.reports.iter().map(|r| r.iterations).max().unwrap_or(0)
