@@ -194,7 +194,7 @@ pub enum Error {
         clearance: f64,
     },
     /// A converged boundary-value solution's step `step` leaves the domain of the Lagrangian
-    /// (the step's singularity guard, [`crate::step::check_step_domain`]: a pole at its
+    /// (the step's singularity guard, [`crate::scheme::step::check_step_domain`]: a pole at its
     /// evaluation point or between its nodes, e.g. a path through an obstacle whose barrier
     /// is a term of $L$): the solution is not a plan.
     /// (The violation's fields are held flat, the indices as `u32`, so that an error stays

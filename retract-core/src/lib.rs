@@ -13,27 +13,35 @@
 //! It is solved without inverting the Legendre map, with the top derivative $u = q^{(k)}$
 //! as an extra unknown ([`LiftedSystem`]).
 //!
-//! - [`Lagrangian`] and [`LiftedSystem`]: what a system provides ([`system`]);
-//!   [`lifted`] assembles the scheme from a [`Lagrangian`].
-//! - [`newton`]: the solver; [`step`](mod@step): one step and trajectories; [`forced`]: a
-//!   step under an external force (plant simulation);
-//!   [`diagnostics`]: energy, symplecticity, drift, RK4.
-//! - [`map`]: the integrator of any discretization map (paper Prop. 5.1), the theta map
-//!   among them; [`map::TaylorLift`] lifts a map written over a [`taylor::Scalar`] at any
-//!   order by Taylor arithmetic ([`taylor`]).
-//! - [`so3`]: the rotation group in Gibbs charts and its Cayley midpoint map.
-//! - [`se3`]: the rigid motions in moving product charts (Gibbs chart and position).
-//! - [`split`]: an explicit symplectic splitting for $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$
-//!   (one gradient of $V$ per step), which the macro detects.
-//!   [`split_methods`]: splitting methods for it (fused compositions, Blanes-Moan RKN
-//!   methods of order 4 and 6); [`split_stepper`]: their stepper.
-//! - [`sphere`]: systems on the unit sphere $S^2$ in moving gnomonic charts, stepped by a
-//!   discretization map of $S^2$.
-//! - [`state`](mod@state): typed derivative data ([`Jet`]) and states ([`State`]), built by
-//!   the Legendre map and read by name ($q^{(j)}$, $p_j$, $u$).
-//! - [`models`]: a system written by hand.
-//! - [`output`]: CSV export of trajectories, plans and solutions, with a header naming
-//!   every column.
+//! The crate is in layers. [`numeric`] imports none of the others, [`scheme`] imports
+//! [`numeric`], [`manifold`] imports both, and the planner ([`bvp`]) all three; the interface
+//! at the root ([`system`], [`state`](mod@state), [`Error`]) is shared by all of them:
+//!
+//! - the interface: [`Lagrangian`] and [`LiftedSystem`], what a system provides
+//!   ([`system`]); [`state`](mod@state): typed derivative data ([`Jet`]) and states
+//!   ([`State`]), built by the Legendre map and read by name ($q^{(j)}$, $p_j$, $u$); the
+//!   [`Error`] of every failure;
+//! - [`numeric`]: the kernels, [`numeric::newton`] (damped Newton), [`numeric::linalg`] (dense
+//!   LU), the banded LU, [`numeric::taylor`] (Taylor and dual numbers) and
+//!   [`numeric::special`] (Stumpff functions);
+//! - [`scheme`]: [`scheme::step`](mod@scheme::step) (one step with its singularity guard, and
+//!   trajectories), [`scheme::lifted`] (the scheme assembled from a [`Lagrangian`]),
+//!   [`scheme::reduced`] (the reduced step), [`scheme::compose`] (symmetric compositions),
+//!   [`scheme::forced`] (a step under an external force), [`scheme::diagnostics`] (energy,
+//!   symplecticity, drift, RK4), [`scheme::split`] with [`scheme::split_methods`] and
+//!   [`scheme::split_stepper`] (the explicit splitting for
+//!   $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$), and [`scheme::map`] (the integrator of any
+//!   discretization map, paper Prop. 5.1, lifted at any order by
+//!   [`scheme::map::TaylorLift`]);
+//! - [`manifold`]: moving charts of [`manifold::sphere`] ($S^2$, gnomonic charts),
+//!   [`manifold::so3`] (the rotation group, Gibbs charts) and [`manifold::se3`] (the rigid
+//!   motions, product charts);
+//! - the planner, [`bvp`] (with `std`): the optimal-control solver and the root finder;
+//! - [`models`]: a system written by hand; [`output`] (with `std`): CSV export of
+//!   trajectories, plans and solutions, with a header naming every column.
+//!
+//! The paths of these modules before the layers (`retract_core::step`, `retract_core::so3`,
+//! `retract_core::newton`, ...) still name them, for one release.
 //!
 //! # References
 //! A. Anahory Simoes, M. Barbero Liñán, L. Colombo, D. Martín de Diego,
@@ -47,7 +55,7 @@
 //!
 //! `serde` (off by default): `Serialize` and `Deserialize` for the results and options
 //! ([`Trajectory`], [`StepReport`], [`bvp::Plan`], [`bvp::Certificate`], [`BvpSolution`],
-//! [`State`], [`Jet`], [`sphere::SphereState`], the option structs), `Serialize` for the
+//! [`State`], [`Jet`], [`manifold::sphere::SphereState`], the option structs), `Serialize` for the
 //! errors ([`Error`], [`bvp::PlanError`], [`Interrupted`]). Vectors are lists of numbers
 //! (nalgebra's `serde-serialize-no-std`); it builds without std too.
 #![cfg_attr(not(feature = "std"), no_std)]
@@ -55,34 +63,54 @@
 #![warn(missing_docs)]
 
 #[cfg(feature = "std")]
-pub mod banded;
-#[cfg(feature = "std")]
 pub mod bvp;
-pub mod compose;
-pub mod diagnostics;
 mod error;
-pub mod forced;
-pub mod lifted;
-pub mod linalg;
-pub mod map;
+pub mod manifold;
 pub mod models;
-pub mod newton;
+pub mod numeric;
 #[cfg(feature = "std")]
 pub mod output;
-pub mod reduced;
-pub mod se3;
+pub mod scheme;
 #[cfg(all(feature = "serde", feature = "std"))]
 mod serde_float;
-pub mod so3;
-pub mod special;
-pub mod sphere;
-pub mod split;
-pub mod split_methods;
-pub mod split_stepper;
 pub mod state;
-pub mod step;
 pub mod system;
-pub mod taylor;
+
+// The paths before the layers, for one release (the planner and generated code name them).
+#[doc(hidden)]
+pub use manifold::{se3, so3, sphere};
+#[cfg(feature = "std")]
+#[doc(hidden)]
+pub use numeric::banded;
+#[doc(hidden)]
+pub use numeric::{linalg, newton, special, taylor};
+#[doc(hidden)]
+pub use scheme::{
+    compose, diagnostics, forced, lifted, map, reduced, split, split_methods, split_stepper, step,
+};
+
+/// What generated code names and a user does not: the traits it implements, the functions
+/// its impls call and the types they return, in one flat module that the macro's output can
+/// reach by one path (as `::thiserror::__private`). Not a public API: it follows the macros
+/// of the same version.
+#[doc(hidden)]
+pub mod __private {
+    pub use crate::manifold::se3::Se3System;
+    pub use crate::manifold::so3::So3System;
+    pub use crate::manifold::sphere::SphereSystem;
+    pub use crate::numeric::linalg::solve;
+    pub use crate::numeric::special::stumpff;
+    pub use crate::scheme::lifted::{hamiltonian, legendre, predictor, step_cost, vector_field};
+    pub use crate::scheme::map::{CovectorHessian, DiscretizationMap, MapJacobians};
+    pub use crate::scheme::reduced::{
+        ClosedForm, ReducedFactors, ReducedScheme, two_product, two_sum,
+    };
+    pub use crate::scheme::split::Separable;
+    pub use crate::system::{
+        Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction,
+    };
+    pub use crate::{DomainKind, DomainViolation, Error, Float, nalgebra};
+}
 
 // the optimizer at the root, beside the legacy root finder (both live in `bvp`)
 #[cfg(feature = "std")]

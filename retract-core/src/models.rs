@@ -79,7 +79,7 @@ impl Lagrangian<2, 2> for PlanarBarrier {
 crate::impl_lifted_system!(PlanarBarrier, n = 2, k = 2);
 
 /// $L = \tfrac{m}{2} |q''|^2 + V(q)$: the weight $c = m$.
-impl crate::split::Separable<2, 2> for PlanarBarrier {
+impl crate::scheme::split::Separable<2, 2> for PlanarBarrier {
     fn kinetic_weight(&self) -> f64 {
         self.mass
     }

@@ -36,8 +36,8 @@
 
 use nalgebra::SVector;
 
-use crate::lifted::{Blocks, join, split};
-use crate::step::StepReport;
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::step::StepReport;
 use crate::{Error, Lagrangian, LiftedSystem, StepOptions};
 
 /// Derivative data $(q, q', \dots, q^{(2k-1)})$ of a curve at one time, $K = k$ blocks below
@@ -208,7 +208,7 @@ impl<const N: usize, const K: usize> State<N, K> {
     where
         Sys: LiftedSystem<S, M> + ?Sized,
     {
-        crate::step::step(system, &self.to_vector::<S>(), h, options)
+        crate::scheme::step::step(system, &self.to_vector::<S>(), h, options)
             .map(|(z, report)| (Self::from_vector(&z), report))
     }
 
@@ -228,7 +228,17 @@ impl<const N: usize, const K: usize> State<N, K> {
     where
         Sys: LiftedSystem<S, M> + ?Sized,
     {
-        crate::step::trajectory(system, &self.to_vector::<S>(), h, steps, options)
+        crate::scheme::step::trajectory(system, &self.to_vector::<S>(), h, steps, options)
+    }
+}
+
+// (here rather than beside `Trajectory`, so that the schemes do not import the states)
+#[cfg(feature = "std")]
+impl<const S: usize> crate::Trajectory<S> {
+    /// State $z_i$ by blocks ([`State`]: $q^{(j)}$, $p_j$ by name), or `None` past the end;
+    /// `S` $= 2nk$ is checked at compile time.
+    pub fn state<const N: usize, const K: usize>(&self, i: usize) -> Option<State<N, K>> {
+        self.states.get(i).map(State::from_vector)
     }
 }
 
@@ -244,7 +254,7 @@ mod blocks_serde {
     use serde::ser::SerializeTuple;
     use serde::{Deserializer, Serializer};
 
-    use crate::lifted::Blocks;
+    use crate::scheme::lifted::Blocks;
 
     pub fn serialize<S: Serializer, const N: usize, const K: usize>(
         blocks: &Blocks<N, K>,

@@ -10,7 +10,7 @@
 //! - [`LiftedSystem<S, M>`]: the flat interface the runtime drives, with the Hamiltonian
 //!   state $z = (x, p) \in \mathbb{R}^S$, $S = 2nk$, and the Newton unknowns
 //!   $w = (z_1, u) \in \mathbb{R}^M$, $M = S + n$ for the general scheme. The functions of
-//!   [`crate::lifted`] implement it from a [`Lagrangian`]; [`impl_lifted_system!`](crate::impl_lifted_system)
+//!   [`crate::scheme::lifted`] implement it from a [`Lagrangian`]; [`impl_lifted_system!`](crate::impl_lifted_system)
 //!   writes that impl for a concrete type.
 //!
 //! # Layout of the flat vectors
@@ -161,7 +161,7 @@ pub trait Lagrangian<const N: usize, const K: usize> {
 
     /// Solves $p_{k-1} = \partial L/\partial u\thinspace(x, u)$ for $u$, starting from `guess`.
     ///
-    /// The default runs [`crate::newton::solve`] with the Jacobian
+    /// The default runs [`crate::numeric::newton::solve`] with the Jacobian
     /// $\partial^2 L / \partial u^2$; a system with a closed-form inverse overrides it.
     ///
     /// # Errors
@@ -178,7 +178,7 @@ pub trait Lagrangian<const N: usize, const K: usize> {
             x,
             p_top,
         };
-        crate::newton::solve(&problem, *guess, &crate::NewtonOptions::default())
+        crate::numeric::newton::solve(&problem, *guess, &crate::NewtonOptions::default())
             .map(|solution| solution.w)
     }
 }
@@ -190,7 +190,8 @@ struct TopDerivative<'a, L: ?Sized, const N: usize, const K: usize> {
     p_top: &'a SVector<f64, N>,
 }
 
-impl<L, const N: usize, const K: usize> crate::newton::Problem<N> for TopDerivative<'_, L, N, K>
+impl<L, const N: usize, const K: usize> crate::numeric::newton::Problem<N>
+    for TopDerivative<'_, L, N, K>
 where
     L: Lagrangian<N, K> + ?Sized,
 {
@@ -317,7 +318,7 @@ pub trait LiftedSystem<const S: usize, const M: usize> {
     /// every guarded expression is a polynomial of degree at most 2 in the jet, so the
     /// quadratic through its samples at $x_0$, $x_\theta$ and $x_1$ is the expression along the
     /// straight chord, and the check's "stays clear of zero" rule is exact there (for
-    /// $\theta$ not within $10^{-3}$ of an end). [`crate::step::check_step_domain`] then
+    /// $\theta$ not within $10^{-3}$ of an end). [`crate::scheme::step::check_step_domain`] then
     /// skips the chord's pieces. Generated systems answer from their guards (for example
     /// `x^2 + y^2 - r^2`: yes; `1 - cos(q)`: no); the default is `false`.
     fn guards_quadratic(&self) -> bool {

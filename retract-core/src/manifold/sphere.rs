@@ -27,10 +27,11 @@
 
 use nalgebra::{Matrix2x3, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 
-use crate::lifted::{Blocks, join, split};
-use crate::map::DiscretizationMap;
-use crate::newton::NewtonOptions;
-use crate::step::StepReport;
+use crate::manifold::{CentredSystem, MovingChart};
+use crate::numeric::newton::NewtonOptions;
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::map::DiscretizationMap;
+use crate::scheme::step::StepReport;
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// The longest jet handled here: $q, \dots, q^{(2k-1)}$ for $k \le 4$.
@@ -423,8 +424,8 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
         for (j, pj) in p.iter().enumerate() {
             rhs.fixed_rows_mut::<2>(2 * j).copy_from(pj);
         }
-        let solved =
-            crate::linalg::solve(&tt, &rhs).ok_or(Error::SingularJacobian { iteration: 0 })?;
+        let solved = crate::numeric::linalg::solve(&tt, &rhs)
+            .ok_or(Error::SingularJacobian { iteration: 0 })?;
         let x_b: Blocks<2, K> = core::array::from_fn(|j| values.0[j]);
         let p_b: Blocks<2, K> = core::array::from_fn(|j| solved.fixed_rows::<2>(2 * j).into());
         let z = join::<2, K, S>(&x_b, &p_b);
@@ -444,7 +445,9 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
     /// As [`Self::validate`] and [`Self::in_chart`].
     pub fn recentred(&self) -> Result<Self, Error> {
         self.validate()?;
-        self.in_chart(&self.chart.carried_to(&self.point()))
+        let (mut chart, mut z) = (self.chart, self.z);
+        Sphere::recentre::<K, S>(&mut chart, &mut z)?;
+        Ok(Self { chart, z })
     }
 
     /// The Noether momentum of rotations: component $a$ is $\mu_a = \sum_j p_j \cdot
@@ -479,6 +482,51 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
     }
 }
 
+/// The unit sphere $S^2$ in moving gnomonic charts: a chart is a [`Chart`], the point of
+/// the chart coordinates $y$ is $\varphi(y)$, and the transition to the chart centred at
+/// $\varphi(a)$ (its frame carried from the current one) is [`SphereState::in_chart`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sphere;
+
+impl MovingChart<2> for Sphere {
+    type Chart = Chart;
+    type Point = Vector3<f64>;
+
+    /// $\varphi(y)$ ([`Chart::point`]).
+    fn point(chart: &Chart, y: &Vector2<f64>) -> Vector3<f64> {
+        chart.point(y)
+    }
+
+    /// $\varphi^{-1}(q) = (e_1 \cdot q, e_2 \cdot q) / (c \cdot q)$ ([`Chart::coordinates`]):
+    /// `None` outside the chart's open hemisphere $c \cdot q > 0$.
+    fn chart_point(chart: &Chart, q: &Vector3<f64>) -> Option<Vector2<f64>> {
+        chart.coordinates(&[*q]).ok().map(|[y]| y)
+    }
+
+    /// The chart centred at $\varphi(a)$, its $e_1$ carried from `chart`'s, and
+    /// [`SphereState::in_chart`] of `z` (`S` $= 4k$).
+    fn transition<const K: usize, const S: usize>(
+        chart: &Chart,
+        a: &Vector2<f64>,
+        z: &SVector<f64, S>,
+    ) -> Result<(Chart, SVector<f64, S>), Error> {
+        let to = chart.carried_to(&chart.point(a));
+        let state = SphereState::<K, S> {
+            chart: *chart,
+            z: *z,
+        };
+        Ok((to, state.in_chart(&to)?.z))
+    }
+}
+
+/// A system on $S^2$ is written in any gnomonic chart: its chart parameter is the frame
+/// ([`Chart::params`]).
+impl<Sys: SphereSystem> CentredSystem<Sphere, 2> for Sys {
+    fn centred(&self, chart: &Chart) -> Self {
+        self.with_chart(chart.params())
+    }
+}
+
 /// One step of the integrator of the discretization map `map` on $S^2$ (paper Prop. 5.1),
 /// computed in the chart of `state` (centred at its point after [`SphereState::recentred`]
 /// or [`SphereState::from_ambient`]), then written in the chart centred at the new point.
@@ -486,7 +534,7 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
 /// # Errors
 /// Those of [`SphereState::validate`] for `state` (a chart frame that is not orthonormal, a
 /// non-finite state, a point off the unit sphere, e.g. chart coordinates that overflow it), of
-/// [`crate::map::step`] and of the chart change [`SphereState::recentred`].
+/// [`crate::scheme::map::step`] and of the chart change [`SphereState::recentred`].
 pub fn step<Sys, Map, const K: usize, const S: usize, const M: usize>(
     system: &Sys,
     map: &Map,
@@ -499,10 +547,9 @@ where
     Map: SphereMap<K>,
 {
     state.validate()?;
-    let params = state.chart.params();
-    let (z, report) = crate::map::step(
-        &system.with_chart(params),
-        &map.in_chart(params),
+    let (z, report) = crate::scheme::map::step(
+        &system.centred(&state.chart),
+        &map.in_chart(state.chart.params()),
         &state.z,
         h,
         options,
@@ -517,6 +564,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::manifold::testing;
 
     /// A chart jet along y(t) = (a t + b t^2 + t^3 / 3, c t - t^2): (y, y', y'').
     fn curve(t: f64) -> [Vector2<f64>; 3] {
@@ -578,5 +626,52 @@ mod tests {
         let next = c.carried_to(&c.point(&Vector2::new(0.01, 0.0)));
         assert!((next.e2 - c.e2).norm() < 1e-3 && (next.e1 - c.e1).norm() < 0.02);
         assert!(Chart::at(&Vector3::zeros()).is_err());
+    }
+
+    #[test]
+    fn a_transition_there_and_back_is_the_identity_in_the_first_chart() {
+        let mut seed = 17;
+        for _ in 0..50 {
+            let chart = Chart::at(&testing::vector::<3>(&mut seed, 1.0)).unwrap();
+            let z: SVector<f64, 8> = testing::vector(&mut seed, 1.0);
+            let a: Vector2<f64> = testing::vector(&mut seed, 0.5);
+            let (back, z_back) = testing::there_and_back::<Sphere, 2, 2, 8>(&chart, &a, &z);
+            // the same centre, the frame turned about it (carried there and back)
+            assert!((back.centre - chart.centre).amax() < 1e-12);
+            let z_back = SphereState::<2, 8> {
+                chart: back,
+                z: z_back,
+            };
+            let z_first = z_back.in_chart(&chart).unwrap().z;
+            assert!((z_first - z).amax() < 1e-12, "{z_first} {z}");
+        }
+    }
+
+    #[test]
+    fn recentring_puts_the_point_at_the_origin_and_keeps_the_point() {
+        let mut seed = 19;
+        for _ in 0..50 {
+            let chart = Chart::at(&testing::vector::<3>(&mut seed, 1.0)).unwrap();
+            let state = SphereState::<2, 8> {
+                chart,
+                z: testing::vector(&mut seed, 1.0),
+            };
+            let moved = state.recentred().unwrap();
+            assert!(moved.z.fixed_rows::<2>(0).amax() < 1e-15, "{}", moved.z);
+            assert!((moved.point() - state.point()).amax() < 1e-12);
+            assert!((moved.chart.centre - state.point()).amax() < 1e-12);
+            let (before, after) = (state.momentum(), moved.momentum());
+            assert!((after - before).amax() < 1e-12 * (1.0 + before.amax()));
+        }
+    }
+
+    #[test]
+    fn chart_points_invert_points() {
+        let chart = Chart::at(&Vector3::new(0.3, -1.0, 0.4)).unwrap();
+        let y = Vector2::new(0.7, -1.9);
+        let q = Sphere::point(&chart, &y);
+        let back = Sphere::chart_point(&chart, &q).unwrap();
+        assert!((back - y).amax() < 1e-12, "{back} {y}");
+        assert!(Sphere::chart_point(&chart, &-q).is_none());
     }
 }

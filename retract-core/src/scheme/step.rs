@@ -1,12 +1,12 @@
 //! One step of the lifted theta-scheme, and trajectories.
 //!
 //! A step solves $F(z_0, w) = 0$ (see [`LiftedSystem`]) for $w = (z_1, \dots)$ by
-//! [`newton::solve`](crate::newton::solve()) from the explicit predictor
+//! [`newton::solve`](crate::numeric::newton::solve()) from the explicit predictor
 //! [`LiftedSystem::predictor`]. [`step`] neither allocates nor panics.
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::newton::{self, NewtonOptions, Problem};
+use crate::numeric::newton::{self, NewtonOptions, Problem};
 use crate::{Error, LiftedSystem};
 
 /// Options of a step: the scheme parameter $\theta$ and the Newton options.
@@ -61,7 +61,7 @@ pub struct StepOptions {
     pub max_halvings: u32,
     /// In [`crate::ReducedStepper`]: recover the step's unknowns with the rounding corrections
     /// of the cached factors, $w = (T + T_{lo}) z_0 - (A^{-1} + A^{-1}_{lo}) n$
-    /// ([`crate::ReducedScheme::recover`], [`crate::reduced`]); on by default. Off, each entry
+    /// ([`crate::ReducedScheme::recover`], [`crate::scheme::reduced`]); on by default. Off, each entry
     /// is one rounded sum of $T z_0 - A^{-1} n$ ([`crate::ReducedScheme::recover_plain`]): the
     /// step is about a fifth cheaper (a quarter over a run of dependent steps), and every step
     /// applies the same rounded linear map, so a quadratic invariant (an angular momentum)
@@ -359,7 +359,7 @@ pub struct StepReport {
 }
 
 /// $F(z_0, \cdot) - c$ of one step as a Newton [`Problem`], $c$ a constant `offset` (an
-/// external force, [`crate::forced`]) or zero.
+/// external force, [`crate::scheme::forced`]) or zero.
 struct StepProblem<'a, Sys: ?Sized, const S: usize, const M: usize> {
     system: &'a Sys,
     z0: &'a SVector<f64, S>,
@@ -536,12 +536,6 @@ impl<const S: usize> Trajectory<S> {
     /// The times $t_i = i h$ of the states, $i = 0, \dots, m$.
     pub fn times(&self) -> Vec<f64> {
         (0..self.states.len()).map(|i| i as f64 * self.h).collect()
-    }
-
-    /// State $z_i$ by blocks ([`crate::State`]: $q^{(j)}$, $p_j$ by name), or `None` past the
-    /// end; `S` $= 2nk$ is checked at compile time.
-    pub fn state<const N: usize, const K: usize>(&self, i: usize) -> Option<crate::State<N, K>> {
-        self.states.get(i).map(crate::State::from_vector)
     }
 
     /// The largest number of Newton iterations of any step (0 for no step).

@@ -14,7 +14,7 @@
 
 use nalgebra::SVector;
 
-use crate::step::{StepOptions, StepReport, name_parameter, solve_offset};
+use crate::scheme::step::{StepOptions, StepReport, name_parameter, solve_offset};
 use crate::{Error, LiftedSystem};
 
 /// One step $z_0 \mapsto z_1$ of the theta-scheme under the force `force` $= f$ (module

@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::step::{StepOptions, solve_step};
+use crate::scheme::step::{StepOptions, solve_step};
 use crate::{Error, LiftedSystem};
 
 /// $\max_i |H(z_i) - H(z_0)|$ over `states` (0 for an empty slice).
@@ -76,7 +76,7 @@ where
     let guess = system.predictor(z0, h, options.theta)?;
     let (w, report) = solve_step(system, z0, guess, h, options)?;
     let theta = options.theta;
-    let dw = crate::linalg::solve(
+    let dw = crate::numeric::linalg::solve(
         &system.jacobian(z0, &w, h, theta),
         &system.jacobian_initial(z0, &w, h, theta),
     )

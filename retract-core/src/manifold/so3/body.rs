@@ -12,8 +12,9 @@
 
 use nalgebra::{SVector, UnitQuaternion, Vector3};
 
-use super::moving::recentre;
-use crate::lifted::join;
+use super::moving::So3;
+use crate::manifold::CentredSystem;
+use crate::scheme::lifted::join;
 use crate::{Error, Lagrangian};
 
 /// A generated Lagrangian or jet function on SO(3) (`so3`): a system on $\mathbb{R}^3$,
@@ -32,22 +33,30 @@ pub fn centre_matrix(rotation: &UnitQuaternion<f64>) -> [f64; 9] {
     core::array::from_fn(|e| r[(e / 3, e % 3)])
 }
 
-/// `system` with its chart centred at `centre`.
+/// `system` with its chart centred at `centre` ([`CentredSystem::centred`]).
 pub fn centred<Sys: So3System>(system: &Sys, centre: &UnitQuaternion<f64>) -> Sys {
-    system.with_centre(centre_matrix(centre))
+    CentredSystem::<So3, 3>::centred(system, centre)
 }
 
-/// Moves the chart of the state `z` (order $k$) to its own point, as [`recentre`], and the
+/// A system on SO(3) is written in the chart centred at any rotation: its centre parameter
+/// is the rotation matrix of the chart's centre ([`centre_matrix`]).
+impl<Sys: So3System> CentredSystem<So3, 3> for Sys {
+    fn centred(&self, chart: &UnitQuaternion<f64>) -> Self {
+        self.with_centre(centre_matrix(chart))
+    }
+}
+
+/// Moves the chart of the state `z` (order $k$) to its own point, as
+/// [`recentre`](super::recentre), and the
 /// centre of `system` with it: afterwards $y = 0$, `centre` is the state's rotation and
-/// `system` is centred there. An error (nothing changed) as for [`recentre`].
+/// `system` is centred there ([`crate::manifold::recentre_system`]). An error (nothing
+/// changed) as for [`recentre`](super::recentre).
 pub fn recentre_system<Sys: So3System, const K: usize, const S: usize>(
     system: &mut Sys,
     centre: &mut UnitQuaternion<f64>,
     z: &mut SVector<f64, S>,
 ) -> Result<(), Error> {
-    recentre::<K, S>(centre, z)?;
-    *system = centred(system, centre);
-    Ok(())
+    crate::manifold::recentre_system::<So3, Sys, 3, K, S>(system, centre, z)
 }
 
 /// The derivatives $(y', \dots, y^{(J)})$ of the chart curve through the chart point `y`

@@ -1,5 +1,5 @@
 //! Coefficients of splitting methods for $H = H_0 + H_V$ (the free flow $e^{tA}$ of $H_0$ and
-//! the kick $K_t$ of $H_V$, [`crate::split`]):
+//! the kick $K_t$ of $H_V$, [`crate::scheme::split`]):
 //!
 //! $$\Psi_h = e^{a_{s+1} h A} \circ K_{b_s h} \circ e^{a_s h A} \circ \dots \circ
 //!   K_{b_1 h} \circ e^{a_1 h A}, \qquad \sum_i a_i = \sum_i b_i = 1,$$
@@ -25,10 +25,10 @@
 //!   (github.com/mockingbirdnest/Principia); the last coefficient of each half is computed
 //!   from $\sum a_i = \sum b_i = 1$, as in the paper.
 //! - W. Kahan, R.-C. Li (1997) and H. Yoshida (1990) for the compositions
-//!   ([`crate::compose`]).
+//!   ([`crate::scheme::compose`]).
 
 use crate::Error;
-use crate::compose::{self, MAX_STAGES};
+use crate::scheme::compose::{self, MAX_STAGES};
 
 /// Most kicks of a supported method (the order-8 triple jump's 27 Strang steps).
 pub const MAX_KICKS: usize = MAX_STAGES;
@@ -184,7 +184,7 @@ impl SplittingMethod {
     }
 
     /// Blanes and Moan's SRKN$_6^b$: order 4 with 6 gradients per step (7 kicks, the last one
-    /// at the next step's first point, which [`crate::split_stepper::SplitStepper`] reuses).
+    /// at the next step's first point, which [`crate::scheme::split_stepper::SplitStepper`] reuses).
     pub fn blanes_moan_4() -> Self {
         let (b, a) = BM_SRKN6B;
         let a_centre = 0.5 - a.iter().sum::<f64>();

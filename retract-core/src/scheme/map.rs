@@ -42,9 +42,9 @@ use nalgebra::{SMatrix, SVector};
 pub(crate) mod taylor_lift;
 pub use taylor_lift::{BaseMap, TaylorLift};
 
-use crate::lifted::{Blocks, join, split};
-use crate::newton::{self, NewtonOptions, Problem};
-use crate::step::StepReport;
+use crate::numeric::newton::{self, NewtonOptions, Problem};
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::step::StepReport;
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// An $nk \times nk$ matrix as $k \times k$ blocks of $n \times n$: `m[i][j]` is the block of
@@ -518,7 +518,7 @@ where
 {
     let (scheme, w, report) = solve(system, map, z0, h, options)?;
     let dw_dz0 = -scheme.jacobian_initial::<M, S>(&w);
-    let dw = crate::linalg::solve(&Problem::<M>::jacobian(&scheme, &w), &dw_dz0).ok_or(
+    let dw = crate::numeric::linalg::solve(&Problem::<M>::jacobian(&scheme, &w), &dw_dz0).ok_or(
         Error::SingularJacobian {
             iteration: report.iterations,
         },

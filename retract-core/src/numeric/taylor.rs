@@ -4,7 +4,7 @@
 //!
 //! A function written once over a [`Scalar`] and evaluated on `Taylor<Hyper<V>, D>` gives, in
 //! one pass, the Taylor coefficients along a curve of its value, its gradient and its Hessian
-//! in $V$ variables. [`crate::map::TaylorLift`] uses this to lift a discretization map to
+//! in $V$ variables. [`crate::scheme::map::TaylorLift`] uses this to lift a discretization map to
 //! $T^{(k-1)}Q$ at any order without generating the lift's code.
 //!
 //! Only the field operations are provided ($+$, $-$, $\times$, $/$ and negation, with an `f64`
@@ -35,7 +35,7 @@ pub trait Scalar:
     fn constant(c: f64) -> Self;
     /// $1 / x$.
     fn recip(self) -> Self;
-    /// The Stumpff function $c_k(x)$ ([`crate::special`]), differentiated by
+    /// The Stumpff function $c_k(x)$ ([`crate::numeric::special`]), differentiated by
     /// $c_k' = \tfrac12 (k\thinspace c_{k+2} - c_{k+1})$. On [`Taylor`] series of up to 16 terms
     /// (a longer series does not compile).
     fn stumpff(self, k: u32) -> Self;
@@ -52,14 +52,14 @@ impl Scalar for f64 {
     }
     #[inline(always)]
     fn stumpff(self, k: u32) -> Self {
-        crate::special::stumpff(k, self)
+        crate::numeric::special::stumpff(k, self)
     }
 }
 
 /// $c_k(s)$, $c_k'(s) = \tfrac12 (k c_{k+2} - c_{k+1})$ and
 /// $c_k''(s) = \tfrac14 (k (k+2) c_{k+4} - (2k+1) c_{k+3} + c_{k+2})$.
 fn stumpff_and_derivatives(k: u32, s: f64) -> [f64; 3] {
-    let c = |i: u32| crate::special::stumpff(k.saturating_add(i), s);
+    let c = |i: u32| crate::numeric::special::stumpff(k.saturating_add(i), s);
     let kf = k as f64;
     [
         c(0),
@@ -254,7 +254,7 @@ impl<const V: usize> Scalar for Dual<V> {
     }
     fn stumpff(self, k: u32) -> Self {
         // c_k and c_k' = (k c_{k+2} - c_{k+1}) / 2 (no second derivative)
-        let c = |i: u32| crate::special::stumpff(k.saturating_add(i), self.f);
+        let c = |i: u32| crate::numeric::special::stumpff(k.saturating_add(i), self.f);
         let (c, d1) = (c(0), 0.5 * (f64::from(k) * c(2) - c(1)));
         Self {
             f: c,

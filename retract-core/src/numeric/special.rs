@@ -13,7 +13,7 @@
 //! $$c_k'(s) = \tfrac12 \big(k\thinspace c_{k+2}(s) - c_{k+1}(s)\big),$$
 //!
 //! which is what `#[higher_order_lagrangian]` and `#[discretization_map]` differentiate
-//! `stumpff(k, s)` by, and what [`crate::taylor::Scalar::stumpff`] lifts.
+//! `stumpff(k, s)` by, and what [`crate::numeric::taylor::Scalar::stumpff`] lifts.
 
 /// Entries of the tables below.
 const TABLE: usize = 256;

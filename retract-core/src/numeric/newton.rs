@@ -292,7 +292,7 @@ where
                 location: "Jacobian",
             });
         }
-        let delta = match crate::linalg::solve(&jacobian, &(-r)) {
+        let delta = match crate::numeric::linalg::solve(&jacobian, &(-r)) {
             Some(delta) if all_finite(&delta) => delta,
             _ => return Err(Error::SingularJacobian { iteration }),
         };

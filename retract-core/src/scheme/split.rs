@@ -11,7 +11,7 @@
 //! $p_0 \mathrel{+}= t\thinspace \nabla V(x_0)$. [`split_step`] is Strang's splitting
 //! $e^{hA/2} \circ \mathrm{kick}_h \circ e^{hA/2}$: explicit (one gradient of $V$ per step, no
 //! Newton solve), symplectic and symmetric, of order 2; compose it with
-//! [`crate::compose::compose`] for orders 4, 6 and 8.
+//! [`crate::scheme::compose::compose`] for orders 4, 6 and 8.
 //!
 //! `#[higher_order_lagrangian]` implements [`Separable`] when it finds this form in $L$.
 //! Where it does not apply ($L$ not separable, such as $\tfrac12 |M(q) q'' + c|^2$), the
@@ -21,8 +21,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::lifted::split;
-use crate::step::{StepOptions, StepReport, check_step_domain};
+use crate::scheme::lifted::split;
+use crate::scheme::step::{StepOptions, StepReport, check_step_domain};
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// The largest order the free flow supports (that of the macro).

@@ -59,8 +59,8 @@ use core::cell::Cell;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::newton::{self, Problem, all_finite, max_abs, sum_abs};
-use crate::step::StepReport;
+use crate::numeric::newton::{self, Problem, all_finite, max_abs, sum_abs};
+use crate::scheme::step::StepReport;
 use crate::{Error, LiftedSystem, StepOptions};
 
 /// A system whose step reduces to its nonlinear core of `R` variables (emitted by the macro;
@@ -434,7 +434,7 @@ where
                 nd += 1;
             }
         }
-        let solved = crate::linalg::solve_columns(
+        let solved = crate::numeric::linalg::solve_columns(
             block,
             n,
             &mut b_block.as_mut_slice()[..nb * M],
@@ -564,7 +564,7 @@ impl Dot2 {
 /// planar rigid body, $S = 12$, $M = 15$: 111 KB in the stepper itself, no heap; empty slots
 /// are not written when the stepper is made). The least recently used pair is
 /// replaced, so a controller that cycles through at most this many distinct step sizes
-/// factorises once per size: every composition of [`crate::compose`] (at most 8 distinct
+/// factorises once per size: every composition of [`crate::scheme::compose`] (at most 8 distinct
 /// stage sizes), a controller alternating up to 16 sizes. A cycle through more sizes than
 /// this, or an adaptive controller whose sizes never repeat, factorises on every step with a
 /// size not used among the last `CACHE_SIZE` distinct ones
@@ -657,7 +657,7 @@ where
     ) -> Result<(newton::Solution<R>, SVector<f64, M>), Error> {
         let (h, theta) = (factors.h, factors.theta);
         let (r0, j0) = system.core_system(factors, &offset, &offset, h, theta);
-        let guess = match crate::linalg::solve(&j0, &r0) {
+        let guess = match crate::numeric::linalg::solve(&j0, &r0) {
             Some(step) => offset - step,
             None => fixed_point,
         };
@@ -810,7 +810,7 @@ where
     ) -> Result<(SVector<f64, S>, StepReport), Error> {
         let system = self.system;
         self.step_unnamed(z0, h, options)
-            .map_err(|e| crate::step::name_parameter(system, e))
+            .map_err(|e| crate::scheme::step::name_parameter(system, e))
     }
 
     /// [`Self::step`] before a non-finite value is traced to a parameter.
@@ -871,7 +871,8 @@ where
             });
         }
         if options.check_domain {
-            crate::step::check_step_domain(system, z0, &w, options).map_err(Error::Domain)?;
+            crate::scheme::step::check_step_domain(system, z0, &w, options)
+                .map_err(Error::Domain)?;
         }
         Ok((
             w.fixed_rows::<S>(0).into_owned(),
@@ -905,7 +906,7 @@ where
         options: &StepOptions,
     ) -> Result<crate::Trajectory<S>, crate::Interrupted<S>> {
         let system = self.system;
-        crate::step::drive_system::<Sys, S, M>(
+        crate::scheme::step::drive_system::<Sys, S, M>(
             system,
             |z: &SVector<f64, S>, h, o: &StepOptions| self.step(z, h, o),
             z0,

@@ -362,7 +362,7 @@ macro_rules! impl_lifted_system {
                 &self,
                 z: &$crate::nalgebra::SVector<f64, { 2 * $n * $k }>,
             ) -> ::core::result::Result<f64, $crate::Error> {
-                $crate::lifted::hamiltonian::<Self, $n, $k, { 2 * $n * $k }>(self, z)
+                $crate::scheme::lifted::hamiltonian::<Self, $n, $k, { 2 * $n * $k }>(self, z)
             }
 
             fn vector_field(
@@ -372,14 +372,14 @@ macro_rules! impl_lifted_system {
                 $crate::nalgebra::SVector<f64, { 2 * $n * $k }>,
                 $crate::Error,
             > {
-                $crate::lifted::vector_field::<Self, $n, $k, { 2 * $n * $k }>(self, z)
+                $crate::scheme::lifted::vector_field::<Self, $n, $k, { 2 * $n * $k }>(self, z)
             }
 
             fn legendre(
                 &self,
                 jet: &$crate::nalgebra::SVector<f64, { 2 * $n * $k }>,
             ) -> $crate::nalgebra::SVector<f64, { 2 * $n * $k }> {
-                $crate::lifted::legendre::<Self, $n, $k, { 2 * $n * $k }>(self, jet)
+                $crate::scheme::lifted::legendre::<Self, $n, $k, { 2 * $n * $k }>(self, jet)
             }
 
             fn residual(
@@ -389,9 +389,13 @@ macro_rules! impl_lifted_system {
                 h: f64,
                 theta: f64,
             ) -> $crate::nalgebra::SVector<f64, { 2 * $n * $k + $n }> {
-                $crate::lifted::residual::<Self, $n, $k, { 2 * $n * $k }, { 2 * $n * $k + $n }>(
-                    self, z0, w, h, theta,
-                )
+                $crate::scheme::lifted::residual::<
+                    Self,
+                    $n,
+                    $k,
+                    { 2 * $n * $k },
+                    { 2 * $n * $k + $n },
+                >(self, z0, w, h, theta)
             }
 
             fn jacobian(
@@ -401,9 +405,13 @@ macro_rules! impl_lifted_system {
                 h: f64,
                 theta: f64,
             ) -> $crate::nalgebra::SMatrix<f64, { 2 * $n * $k + $n }, { 2 * $n * $k + $n }> {
-                $crate::lifted::jacobian::<Self, $n, $k, { 2 * $n * $k }, { 2 * $n * $k + $n }>(
-                    self, z0, w, h, theta,
-                )
+                $crate::scheme::lifted::jacobian::<
+                    Self,
+                    $n,
+                    $k,
+                    { 2 * $n * $k },
+                    { 2 * $n * $k + $n },
+                >(self, z0, w, h, theta)
             }
 
             fn jacobian_initial(
@@ -413,7 +421,7 @@ macro_rules! impl_lifted_system {
                 h: f64,
                 theta: f64,
             ) -> $crate::nalgebra::SMatrix<f64, { 2 * $n * $k + $n }, { 2 * $n * $k }> {
-                $crate::lifted::jacobian_initial::<
+                $crate::scheme::lifted::jacobian_initial::<
                     Self,
                     $n,
                     $k,
@@ -429,9 +437,13 @@ macro_rules! impl_lifted_system {
                 h: f64,
                 theta: f64,
             ) -> f64 {
-                $crate::lifted::step_cost::<Self, $n, $k, { 2 * $n * $k }, { 2 * $n * $k + $n }>(
-                    self, z0, w, h, theta,
-                )
+                $crate::scheme::lifted::step_cost::<
+                    Self,
+                    $n,
+                    $k,
+                    { 2 * $n * $k },
+                    { 2 * $n * $k + $n },
+                >(self, z0, w, h, theta)
             }
 
             fn predictor(
@@ -443,9 +455,13 @@ macro_rules! impl_lifted_system {
                 $crate::nalgebra::SVector<f64, { 2 * $n * $k + $n }>,
                 $crate::Error,
             > {
-                $crate::lifted::predictor::<Self, $n, $k, { 2 * $n * $k }, { 2 * $n * $k + $n }>(
-                    self, z0, h,
-                )
+                $crate::scheme::lifted::predictor::<
+                    Self,
+                    $n,
+                    $k,
+                    { 2 * $n * $k },
+                    { 2 * $n * $k + $n },
+                >(self, z0, h)
             }
         }
     };

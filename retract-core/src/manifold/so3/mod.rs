@@ -19,13 +19,13 @@
 //!
 //! It is symmetric ($R_d(y, -v) = (R_2, R_1)(y, v)$), so of order 2, and equivariant under
 //! left multiplication, so a left-invariant Lagrangian's spatial momentum
-//! ([`spatial_momentum`]) is conserved by its cotangent lift; [`crate::map::TaylorLift`]
+//! ([`spatial_momentum`]) is conserved by its cotangent lift; [`crate::scheme::map::TaylorLift`]
 //! lifts it to every order (and [`ExpMidpoint`], through [`Scalar::stumpff`], to order 16).
 //!
 //! [`ExpMidpoint`] is the map with the group's exponential, $R_d(g, \xi) = (g \exp(-\xi/2),
 //! g \exp(\xi/2))$: the same products with $w = \tan(\theta/2)\thinspace \phi/\theta$, $\phi = \xi/2$,
 //! $\theta = |\phi|$, written as $c_2(\theta^2)/c_1(\theta^2)\thinspace \phi$ in Stumpff functions
-//! ([`crate::special`]) so that it is smooth through $\xi = 0$. It follows a one-parameter
+//! ([`crate::numeric::special`]) so that it is smooth through $\xi = 0$. It follows a one-parameter
 //! subgroup (a spherical body's motion) exactly.
 //!
 //! One chart ends at a turn by $\pi$ from its centre. Moving charts ([`recentre`] after each
@@ -43,13 +43,14 @@ use nalgebra::{SVector, Vector3};
 mod body;
 mod moving;
 pub use body::{So3System, body_state, centre_matrix, centred, chart_derivatives, recentre_system};
-pub(crate) use moving::{chart_momentum, transition_blocks};
 pub use moving::{
-    chart_point, chart_quaternion, orientation, recentre, transition, translate, world_momentum,
+    So3, chart_point, chart_quaternion, orientation, recentre, transition, translate,
+    world_momentum,
 };
+pub(crate) use moving::{chart_momentum, transition_blocks};
 
-use crate::map::BaseMap;
-use crate::taylor::Scalar;
+use crate::numeric::taylor::Scalar;
+use crate::scheme::map::BaseMap;
 
 /// The Cayley midpoint map of SO(3) in the Gibbs chart (module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -99,7 +100,7 @@ impl BaseMap<3> for CayleyMidpoint {
 /// \exp(-\xi/2), g \exp(\xi/2))$, the exact flow of the constant body velocity $\xi$ over
 /// half a step either way, where [`CayleyMidpoint`] takes the Cayley map. Its Gibbs vector is
 /// $w = \tan(\theta/2)\thinspace \phi / \theta$ with $\phi = \xi/2$, $\theta = |\phi|$: the ratio
-/// $\rho(s) = c_2(s) / c_1(s)$ of Stumpff functions ([`crate::special`]), entire near
+/// $\rho(s) = c_2(s) / c_1(s)$ of Stumpff functions ([`crate::numeric::special`]), entire near
 /// $\xi = 0$, so the map and its derivatives need no branch there. It is symmetric and
 /// left-equivariant as the Cayley map is, and a step costs a few more operations.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -118,7 +119,7 @@ impl BaseMap<3> for ExpMidpoint {
 /// the spatial angular momentum $R\thinspace \partial L / \partial \Omega$, conserved by the
 /// cotangent lift of [`CayleyMidpoint`].
 pub fn spatial_momentum(y: &Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
-    let z = crate::lifted::join::<3, 1, 6>(&[*y], &[*p]);
+    let z = crate::scheme::lifted::join::<3, 1, 6>(&[*y], &[*p]);
     world_momentum::<1, 6>(&nalgebra::UnitQuaternion::identity(), &z)
 }
 

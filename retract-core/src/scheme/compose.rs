@@ -17,7 +17,7 @@
 
 use nalgebra::SVector;
 
-use crate::step::StepReport;
+use crate::scheme::step::StepReport;
 use crate::{Error, LiftedSystem, StepOptions};
 
 /// Most stages of a supported composition (the order-8 triple jump).

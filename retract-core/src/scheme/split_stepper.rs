@@ -1,4 +1,4 @@
-//! A stepper for splitting methods on $L = \tfrac{c}{2} |q^{(k)}|^2 + V(q)$ ([`crate::split`]):
+//! A stepper for splitting methods on $L = \tfrac{c}{2} |q^{(k)}|^2 + V(q)$ ([`crate::scheme::split`]):
 //! one step of size $h$ of a [`SplittingMethod`],
 //!
 //! $$z_1 = e^{a_{s+1} h A}\thinspace K_{b_s h}\thinspace e^{a_s h A} \cdots K_{b_1 h}\thinspace
@@ -19,12 +19,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::split::{
+use crate::scheme::split::{
     MAX_K, Separable, flow_jet, free_flow, free_flow_matrix, jet_of, jet_of_state, state_of_jet,
     taylor_powers, weight_of,
 };
-use crate::split_methods::{MAX_KICKS, SplittingMethod};
-use crate::step::{StepOptions, StepReport, check_step_domain};
+use crate::scheme::split_methods::{MAX_KICKS, SplittingMethod};
+use crate::scheme::step::{StepOptions, StepReport, check_step_domain};
 use crate::{Error, LiftedSystem};
 
 /// Steps a [`Separable`] system with a [`SplittingMethod`], caching per step size (module

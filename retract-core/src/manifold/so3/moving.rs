@@ -15,7 +15,7 @@
 //! point transformation, $p_{\rm new} = (\partial Y_{\rm new} / \partial Y)^{-T} p$: a
 //! symplectic change of coordinates. The Jacobian is block lower triangular with blocks
 //! $\partial y^{(j)}_{\rm new} / \partial y^{(i)} = \frac{j!}{i!} c_{j-i}[D\phi_a]$ (the
-//! Taylor coefficients of $D\phi_a$ along the curve, as in [`crate::map::TaylorLift`]).
+//! Taylor coefficients of $D\phi_a$ along the curve, as in [`crate::scheme::map::TaylorLift`]).
 //! The Cayley midpoint map and a Lagrangian written in body coordinates are both invariant
 //! under left translations, so a step commutes with the change of chart: stepping and
 //! recentring give the same rotations as stepping in one chart, wherever that chart is
@@ -24,9 +24,10 @@
 use nalgebra::{Matrix3, Quaternion, SVector, UnitQuaternion, Vector3};
 
 use crate::Error;
-use crate::lifted::{Blocks, join, split};
-use crate::map::taylor_lift::{curve, falling};
-use crate::taylor::{Dual, Scalar, Taylor};
+use crate::manifold::MovingChart;
+use crate::numeric::taylor::{Dual, Scalar, Taylor};
+use crate::scheme::lifted::{Blocks, join, split};
+use crate::scheme::map::taylor_lift::{curve, falling};
 
 /// $\phi_a(y) = (y - a - a \times y) / (1 + a \cdot y)$: the chart point, in the chart
 /// centred at $c\thinspace Q(a)$, of the point $y$ of the chart centred at $c$.
@@ -52,7 +53,7 @@ pub fn orientation<const K: usize, const S: usize>(
 ) -> UnitQuaternion<f64> {
     const { assert!(K >= 1, "the order k is at least 1") };
     let (x, _) = split::<3, K, S>(z);
-    centre * chart_quaternion(&x[0])
+    So3::point(centre, &x[0])
 }
 
 /// The chart point of the rotation `g` in the chart centred at `centre`:
@@ -127,18 +128,47 @@ pub(crate) fn transition_blocks<const K: usize>(
 }
 
 /// Moves the chart of `z` to its own point: `centre` becomes $c\thinspace Q(y)$ (renormalised) and
-/// `z` the same state in that chart ([`transition`] with $a = y$), whose point is 0. An
-/// error (with nothing changed) if `z` is not finite.
+/// `z` the same state in that chart ([`transition`] with $a = y$), whose point is 0
+/// ([`So3`]'s [`MovingChart::recentre`]). An error (with nothing changed) if `z` is not
+/// finite.
 pub fn recentre<const K: usize, const S: usize>(
     centre: &mut UnitQuaternion<f64>,
     z: &mut SVector<f64, S>,
 ) -> Result<(), Error> {
-    let (x, _) = split::<3, K, S>(z);
-    let moved = transition::<K, S>(&x[0], z)?;
-    *centre =
-        UnitQuaternion::new_normalize(centre.into_inner() * chart_quaternion(&x[0]).into_inner());
-    *z = moved;
-    Ok(())
+    So3::recentre::<K, S>(centre, z)
+}
+
+/// The rotation group in moving Gibbs charts: a chart is its centre $c$ (a unit
+/// quaternion), the point of the chart coordinates $y$ is the rotation $c\thinspace Q(y)$, and
+/// the transition to the chart centred at $c\thinspace Q(a)$ is [`transition`] (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct So3;
+
+impl MovingChart<3> for So3 {
+    type Chart = UnitQuaternion<f64>;
+    type Point = UnitQuaternion<f64>;
+
+    /// The rotation $c\thinspace Q(y)$.
+    fn point(chart: &UnitQuaternion<f64>, y: &Vector3<f64>) -> UnitQuaternion<f64> {
+        chart * chart_quaternion(y)
+    }
+
+    /// [`chart_point`]: `None` for a half-turn from the centre.
+    fn chart_point(chart: &UnitQuaternion<f64>, g: &UnitQuaternion<f64>) -> Option<Vector3<f64>> {
+        chart_point(chart, g)
+    }
+
+    /// The centre $c\thinspace Q(a)$ (renormalised) and [`transition`] of `z`.
+    fn transition<const K: usize, const S: usize>(
+        chart: &UnitQuaternion<f64>,
+        a: &Vector3<f64>,
+        z: &SVector<f64, S>,
+    ) -> Result<(UnitQuaternion<f64>, SVector<f64, S>), Error> {
+        let moved = transition::<K, S>(a, z)?;
+        let next =
+            UnitQuaternion::new_normalize(chart.into_inner() * chart_quaternion(a).into_inner());
+        Ok((next, moved))
+    }
 }
 
 /// The spatial angular momentum (the Noether momentum of left multiplication, in the world
@@ -176,4 +206,55 @@ pub(crate) fn chart_momentum<const K: usize>(x: &Blocks<3, K>, p: &Blocks<3, K>)
             .map(|j| (0..3).map(|c| p[j][c] * d[c][j]).sum::<f64>())
             .sum::<f64>()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::manifold::testing::{there_and_back, vector};
+
+    /// A rotation from a seeded axis-angle vector (angles up to $\pi$).
+    fn rotation(seed: &mut u64) -> UnitQuaternion<f64> {
+        UnitQuaternion::from_scaled_axis(vector::<3>(seed, 1.8))
+    }
+
+    #[test]
+    fn a_transition_there_and_back_is_the_identity() {
+        let mut seed = 7;
+        for _ in 0..50 {
+            let centre = rotation(&mut seed);
+            let z: SVector<f64, 12> = vector(&mut seed, 1.0);
+            let a: Vector3<f64> = vector(&mut seed, 0.5);
+            let (back, z_back) = there_and_back::<So3, 3, 2, 12>(&centre, &a, &z);
+            assert!(back.angle_to(&centre) < 1e-12, "{back} {centre}");
+            assert!((z_back - z).amax() < 1e-12, "{z_back} {z}");
+        }
+    }
+
+    #[test]
+    fn recentring_puts_the_point_at_the_origin_and_keeps_the_rotation() {
+        let mut seed = 11;
+        for _ in 0..50 {
+            let mut centre = rotation(&mut seed);
+            let mut z: SVector<f64, 12> = vector(&mut seed, 1.0);
+            let before = orientation::<2, 12>(&centre, &z);
+            let momentum = world_momentum::<2, 12>(&centre, &z);
+            So3::recentre::<2, 12>(&mut centre, &mut z).unwrap();
+            assert_eq!(z.fixed_rows::<3>(0).into_owned(), Vector3::zeros());
+            assert!(centre.angle_to(&before) < 1e-12);
+            // the spatial momentum is a function on the cotangent bundle, whatever the chart
+            let after = world_momentum::<2, 12>(&centre, &z);
+            assert!((after - momentum).amax() < 1e-12 * (1.0 + momentum.amax()));
+        }
+    }
+
+    #[test]
+    fn chart_points_invert_points() {
+        let mut seed = 3;
+        let centre = rotation(&mut seed);
+        let y: Vector3<f64> = vector(&mut seed, 2.0);
+        let g = So3::point(&centre, &y);
+        let back = So3::chart_point(&centre, &g).unwrap();
+        assert!((back - y).amax() < 1e-12 * (1.0 + y.amax()), "{back} {y}");
+    }
 }

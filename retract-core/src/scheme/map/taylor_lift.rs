@@ -17,8 +17,8 @@
 use nalgebra::SVector;
 
 use super::{BlockMatrix, CovectorHessian, DiscretizationMap, MapJacobians};
-use crate::lifted::Blocks;
-use crate::taylor::{Dual, Hyper, Scalar, Taylor};
+use crate::numeric::taylor::{Dual, Hyper, Scalar, Taylor};
+use crate::scheme::lifted::Blocks;
 
 /// A discretization map $R_d(q, v) = (R_1, R_2)$ on $\mathbb{R}^n$ written once over a
 /// [`Scalar`], so that it can be evaluated on Taylor and dual numbers.
@@ -177,7 +177,7 @@ taylor_lift!(3, 6);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::map::ThetaMap;
+    use crate::scheme::map::ThetaMap;
 
     /// $R_1 = q - v/2 + q_0 v_1 v$, $R_2 = q + v/2 + v_0 q_1 q / (1 + q_0^2)$: a nonlinear
     /// rational map on $\mathbb{R}^2$.
