@@ -1,15 +1,15 @@
 //! Token helpers shared by the emitted items (and by `#[jet_function]`): literals, the
 //! names of the leaves inside the generated methods, the parameter struct, the lints and
 //! imports of generated impls, and balanced signed sums. They use the earlier stages
-//! (`signature`, `graph`, `codegen`) and nothing of the items that use them.
+//! (`front::signature`, `ir::graph`, `emit::codegen`) and nothing of the items that use them.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use syn::ItemFn;
 
-use crate::codegen::{Leaves, signed_add};
-use crate::graph::Var;
-use crate::signature::{Kind, SE3_CENTRE, SO3_CENTRE, SPHERE_CHART, Signature, Space};
+use crate::emit::codegen::{Leaves, signed_add};
+use crate::front::signature::{Kind, SE3_CENTRE, SO3_CENTRE, SPHERE_CHART, Signature, Space};
+use crate::ir::graph::Var;
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {

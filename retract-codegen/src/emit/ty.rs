@@ -28,8 +28,8 @@ pub(crate) fn type_and_constructor(e: &Emission<'_>) -> TokenStream {
     let body_text = tidy(&function.block.to_token_stream().to_string());
     let space = space_description(sig);
     let args = match sig.space {
-        crate::signature::Space::So3 => format!("R, Omega, ..., Omega^({})", k - 1),
-        crate::signature::Space::Se3 => format!("(R, p), xi, ..., xi^({})", k - 1),
+        crate::front::signature::Space::So3 => format!("R, Omega, ..., Omega^({})", k - 1),
+        crate::front::signature::Space::Se3 => format!("(R, p), xi, ..., xi^({})", k - 1),
         _ => format!("q, ..., q^({k})"),
     };
     let struct_doc = format!(

@@ -4,8 +4,8 @@
 //!
 //! The stages: `signature` (order, dimension, parameters; (q, v) instead of a jet) ->
 //! `lower` (the `let`s of the body, then the points, here: the body must end with the pair
-//! of array literals) -> `map_check` (R_d(q, 0) = (q, q), d_v R2 - d_v R1 = I at v = 0) ->
-//! `map_lift` (the lift by total derivatives, its Jacobians and the covector Hessian) ->
+//! of array literals) -> `mechanics::map_conditions` (R_d(q, 0) = (q, q), d_v R2 - d_v R1 = I at v = 0) ->
+//! `mechanics::lift` (the lift by total derivatives, its Jacobians and the covector Hessian) ->
 //! `emit::map` (the items).
 
 use proc_macro2::TokenStream;
@@ -14,11 +14,11 @@ use syn::spanned::Spanned as _;
 use syn::{Block, Expr, ItemFn, Stmt};
 
 use crate::emit::map::map_items;
-use crate::graph::Graph;
-use crate::lower::Lower;
-use crate::map_check::{self, Spanned};
-use crate::map_lift::lift;
-use crate::signature::{self, Attribute, Signature};
+use crate::front::lower::Lower;
+use crate::front::signature::{self, Attribute, Signature};
+use crate::ir::graph::Graph;
+use crate::mechanics::lift::lift;
+use crate::mechanics::map_conditions::{self, Spanned};
 use crate::util::combine;
 
 /// Expands `#[discretization_map(attr)] item`; on error, the original item plus
@@ -28,7 +28,7 @@ pub fn expand_discretization_map(attr: TokenStream, item: TokenStream) -> TokenS
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
+            let item = crate::front::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }
@@ -52,7 +52,7 @@ pub fn try_expand_discretization_map(
         points
     };
     if sig.check
-        && let Some(e) = combine(map_check::check(&mut graph, &sig, &points))
+        && let Some(e) = combine(map_conditions::check(&mut graph, &sig, &points))
     {
         return Err(e);
     }

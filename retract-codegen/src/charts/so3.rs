@@ -12,11 +12,11 @@
 //! with [y]x v = y x v, Q(y)^T Q(y)' = [Omega]x, and D the total derivative of the chart jet
 //! (D y^(i) = y^(i+1)); Omega^(k-1) reads y^(k). Every argument of L (and of its guards) is
 //! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard. The
-//! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::se3`).
+//! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::charts::se3`).
 
-use crate::diff::{Differentiator, substitute_jet, total_derivative};
-use crate::graph::{Graph, Id, Var};
-use crate::signature::Signature;
+use crate::front::signature::Signature;
+use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
+use crate::ir::graph::{Graph, Id, Var};
 
 /// `a x b` in the graph.
 fn cross(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> [Id; 3] {

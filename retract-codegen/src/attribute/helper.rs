@@ -9,7 +9,7 @@
 //! An attribute with `helpers = [a, b]` expands to `a! { @retract_helpers [] [b] ... }`; each
 //! helper's macro adds itself and calls the next, the last calls
 //! [`expand_with_helpers`], which puts the functions into the body as nested helper `fn`s
-//! (inlined by the lowering, `lower::values`) and expands the attribute without the option.
+//! (inlined by the lowering, `front::lower`) and expands the attribute without the option.
 //! The macros follow `macro_rules!` scoping: a helper is visible to the items after it in
 //! its module (and in modules declared after it).
 
@@ -19,7 +19,7 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Ident, ItemFn, Meta, Token};
 
-use crate::lower::helper_signature_problem;
+use crate::front::lower::helper_signature_problem;
 
 /// Expands `#[helper] item`: the function, and its macro (module docs).
 pub fn expand_helper(attr: TokenStream, item: TokenStream) -> TokenStream {

@@ -14,10 +14,10 @@ use crate::emit::outputs::outputs_impl;
 use crate::emit::reduced::reduced_scheme_impl;
 use crate::emit::separable::separable_impl;
 use crate::emit::ty::type_and_constructor;
-use crate::graph::{Graph, Id};
-use crate::lower::{Guard, Lower, without_output_marks};
+use crate::front::lower::{Guard, Lower, without_output_marks};
+use crate::front::signature::{self, Attribute, Signature, Space};
+use crate::ir::graph::{Graph, Id};
 use crate::mechanics::{self, Degenerate};
-use crate::signature::{self, Attribute, Signature, Space};
 use crate::util::combine;
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
@@ -27,7 +27,7 @@ pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
+            let item = crate::front::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }
@@ -65,9 +65,14 @@ fn expand_counted(
     item: TokenStream,
     stats: &mut ExpansionStats,
 ) -> syn::Result<TokenStream> {
-    let helpers = crate::helper::helper_names(&attr)?;
+    let helpers = crate::attribute::helper::helper_names(&attr)?;
     if !helpers.is_empty() {
-        return Ok(crate::helper::chain(&helpers, "lagrangian", &attr, &item));
+        return Ok(crate::attribute::helper::chain(
+            &helpers,
+            "lagrangian",
+            &attr,
+            &item,
+        ));
     }
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;

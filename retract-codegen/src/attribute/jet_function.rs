@@ -4,7 +4,7 @@
 //! `retract_core::VectorJetFunction`, each component with its own straight-line value,
 //! gradient and Hessian.
 //!
-//! The same stages as the Lagrangian (`signature` -> `lower` -> derivatives -> `codegen`),
+//! The same stages as the Lagrangian (`front` -> `charts` -> derivatives -> `emit`),
 //! without the mechanics: g may be linear in, or independent of, the top derivative, so
 //! there are no momenta, Legendre map, scheme or domain check.
 
@@ -18,10 +18,10 @@ use crate::emit::helpers::{
     space_description,
 };
 use crate::emit::scalar::{ScalarBodies, scalar_bodies};
-use crate::graph::{Graph, Id};
-use crate::lower::Lower;
+use crate::front::lower::Lower;
+use crate::front::signature::{self, Attribute};
+use crate::ir::graph::{Graph, Id};
 use crate::mechanics;
-use crate::signature::{self, Attribute};
 use crate::util::{combine, tidy};
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
@@ -31,7 +31,7 @@ pub fn expand_jet_function(attr: TokenStream, item: TokenStream) -> TokenStream 
         Ok(tokens) => tokens,
         Err(error) => {
             let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
+            let item = crate::front::lower::item_without_output_marks(item);
             quote!(#item #errors)
         }
     }
@@ -40,9 +40,14 @@ pub fn expand_jet_function(attr: TokenStream, item: TokenStream) -> TokenStream 
 /// The expansion of `#[jet_function(attr)] item`, or the errors of the input combined into
 /// one `syn::Error`.
 pub fn try_expand_jet_function(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
-    let helpers = crate::helper::helper_names(&attr)?;
+    let helpers = crate::attribute::helper::helper_names(&attr)?;
     if !helpers.is_empty() {
-        return Ok(crate::helper::chain(&helpers, "jet_function", &attr, &item));
+        return Ok(crate::attribute::helper::chain(
+            &helpers,
+            "jet_function",
+            &attr,
+            &item,
+        ));
     }
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, Attribute::JetFunction)?;

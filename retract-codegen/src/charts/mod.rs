@@ -1,10 +1,13 @@
 //! The chart stages, by space: a function on the sphere (`sphere`), on SO(3) (`so3`) or on
-//! SE(3) (`se3`) is composed with its chart (`crate::sphere`, `crate::so3`, `crate::se3`)
+//! SE(3) (`se3`) is composed with its chart (`crate::charts::sphere`, `crate::charts::so3`, `crate::charts::se3`)
 //! before it is differentiated.
 
-use crate::graph::{Graph, Id};
-use crate::signature::{Kind, Param, Signature, Space};
-use crate::{se3, so3, sphere};
+pub(crate) mod se3;
+pub(crate) mod so3;
+pub(crate) mod sphere;
+
+use crate::front::signature::{Kind, Param, Signature, Space};
+use crate::ir::graph::{Graph, Id};
 
 /// `roots` composed with the chart of `sig`'s space, with the signature of the composed
 /// function (the chart's frame appended to the parameters); unchanged on R^n.

@@ -9,14 +9,16 @@
 //! (R, p) = (C, c) (Q(y), x) = (C Q(y), c + C x),
 //! Omega = s (y' - y x y'),  v = R^T p' = Q(y)^T x',  xi^(j) = D^j xi,
 //!
-//! with Q the Gibbs chart of `crate::so3` and D the total derivative of the chart jet. A
+//! with Q the Gibbs chart of `crate::charts::so3` and D the total derivative of the chart jet. A
 //! left-invariant L (one that reads only xi, ..., xi^(k-1)) is the same function of the chart
 //! jet for every centre.
 
-use crate::diff::substitute_jet;
-use crate::graph::{Graph, Id};
-use crate::signature::Signature;
-use crate::so3::{body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates};
+use crate::charts::so3::{
+    body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates,
+};
+use crate::front::signature::Signature;
+use crate::ir::diff::substitute_jet;
+use crate::ir::graph::{Graph, Id};
 
 /// `roots` (L and its guarded expressions, in the arguments g, xi, ... of `sig`) rewritten
 /// in the chart jet: `Var::Jet { order: 0, index: e }` becomes g_e of the pose (R, p) and

@@ -11,9 +11,9 @@
 //! chart jet (D y^(i) = y^(i+1)). Every ambient jet variable of L (and of its guards) is
 //! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
 
-use crate::diff::{Differentiator, substitute_jet, total_derivative};
-use crate::graph::{Func, Graph, Id, Var};
-use crate::signature::Signature;
+use crate::front::signature::Signature;
+use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
+use crate::ir::graph::{Func, Graph, Id, Var};
 
 /// The ambient jet q^(j)_a = D^j phi_a(y), j = 0..=k, as nodes in the chart jet
 /// (`Var::Jet` with index 0, 1) and the chart parameter (`Var::Param { param: chart }`).
@@ -66,10 +66,10 @@ mod tests {
     /// Evaluates `node` at the chart jet `y[order][a]` and chart `[c, e1, e2]`.
     fn eval(g: &Graph, node: Id, y: &[[f64; 2]], chart: &[f64; 9]) -> f64 {
         let values = g.evaluate(node, &|n| match n {
-            crate::graph::Node::Var(Var::Jet { order, index }) => {
+            crate::ir::graph::Node::Var(Var::Jet { order, index }) => {
                 Some(y[*order as usize][*index as usize])
             }
-            crate::graph::Node::Var(Var::Param { index, .. }) => Some(chart[*index as usize]),
+            crate::ir::graph::Node::Var(Var::Param { index, .. }) => Some(chart[*index as usize]),
             _ => None,
         });
         values[node.0 as usize].expect("evaluable")
