@@ -20,7 +20,8 @@
 //! - `emit`: the generated items, one module each over a shared context, their code written by
 //!   `codegen` (one `let` per shared node).
 //!
-//! Helpers used by several stages (`util`) import none of them.
+//! `pipeline` chains the stages, once for every attribute. Helpers used by several stages
+//! (`util`) import none of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -30,11 +31,13 @@ mod emit;
 mod front;
 mod ir;
 mod mechanics;
+mod pipeline;
 mod util;
 
 pub mod samples;
 
-pub use attribute::helper::{expand_helper, expand_with_helpers};
+pub use attribute::expand_with_helpers;
+pub use attribute::helper::expand_helper;
 pub use attribute::jet_function::{expand_jet_function, try_expand_jet_function};
 pub use attribute::lagrangian::{ExpansionStats, expand, expansion_stats, try_expand};
 pub use attribute::map::{expand_discretization_map, try_expand_discretization_map};
