@@ -181,12 +181,10 @@ impl Passes for LagrangianPasses<'_> {
 /// The error of a Lagrangian whose Legendre map is singular, at its top argument.
 fn degenerate(sig: &Signature, reason: Degenerate) -> syn::Error {
     let top = &sig.jet[sig.order];
-    // (on SO(3) the top argument is Omega^(k-1), which holds the chart's q^(k))
-    let what = match sig.space {
-        Space::So3 => format!("Omega^({})", sig.order - 1),
-        Space::Se3 => format!("xi^({})", sig.order - 1),
-        _ => format!("q^({})", sig.order),
-    };
+    let what = charts::of(sig.space).map_or_else(
+        || format!("q^({})", sig.order),
+        |chart| chart.top(sig.order),
+    );
     let msg = match reason {
         Degenerate::Independent => format!(
             "the Lagrangian does not depend on `{top}` = {what}: its Legendre map is \

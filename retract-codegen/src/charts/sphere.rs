@@ -12,6 +12,10 @@
 //! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
 
 use crate::front::signature::Signature;
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::Chart;
 use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
 use crate::ir::graph::{Func, Graph, Id, Var};
 
@@ -57,6 +61,32 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
     let chart = sig.params.len() as u32;
     let jet = ambient_jet(g, chart, sig.order);
     substitute_jet(g, roots, jet.into_iter().map(|q| q.to_vec()).collect())
+}
+
+/// The gnomonic chart of S^2 (module docs).
+pub(crate) struct Sphere;
+
+impl Chart for Sphere {
+    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+        compose(graph, sig, roots)
+    }
+
+    fn description(&self) -> &'static str {
+        "the unit sphere S^2, in the gnomonic chart `sphere_chart` (R^2; see `retract::sphere`),"
+    }
+
+    fn runtime(&self) -> [&'static str; 4] {
+        ["sphere", "SphereSystem", "chart", "with_chart"]
+    }
+
+    fn frame_doc(&self) -> &'static str {
+        "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set by \
+         `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`."
+    }
+
+    fn initial_frame(&self) -> TokenStream {
+        quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    }
 }
 
 #[cfg(test)]
