@@ -16,9 +16,9 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::Emission;
-use crate::codegen::emit;
-use crate::graph::Id;
-use crate::lower::{Guard, GuardKind};
+use crate::emit::codegen::emit;
+use crate::front::lower::{Guard, GuardKind};
+use crate::ir::graph::Id;
 
 /// The method `check_domain`, where L has guarded expressions.
 pub(crate) fn check_domain(e: &Emission<'_>) -> Option<TokenStream> {

@@ -1,15 +1,16 @@
 //! Token helpers shared by the emitted items (and by `#[jet_function]`): literals, the
 //! names of the leaves inside the generated methods, the parameter struct, the lints and
 //! imports of generated impls, and balanced signed sums. They use the earlier stages
-//! (`signature`, `graph`, `codegen`) and nothing of the items that use them.
+//! (`front::signature`, `ir::graph`, `emit::codegen`) and nothing of the items that use them.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use syn::ItemFn;
 
-use crate::codegen::{Leaves, signed_add};
-use crate::graph::Var;
-use crate::signature::{Kind, SE3_CENTRE, SO3_CENTRE, SPHERE_CHART, Signature, Space};
+use crate::charts;
+use crate::emit::codegen::{Leaves, signed_add};
+use crate::front::signature::{Kind, Signature, Space};
+use crate::ir::graph::Var;
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -169,52 +170,26 @@ pub(crate) fn function_and_type(
 
 /// Where a generated system lives, for its docs: "R^n", or the space and its chart.
 pub(crate) fn space_description(sig: &Signature) -> String {
-    match sig.space {
-        Space::Flat => format!("R^{}", sig.dim),
-        Space::Sphere => "the unit sphere S^2, in the gnomonic chart `sphere_chart` (R^2; see \
-                          `retract::sphere`),"
-            .into(),
-        Space::So3 => "SO(3), written in the rotation R and the body velocity Omega with its \
-                       derivatives, in the Gibbs chart centred at `so3_centre` (R^3; see \
-                       `retract::so3`),"
-            .into(),
-        Space::Se3 => "SE(3), written in the pose (R, p) and the body velocity (Omega, v) with \
-                       its derivatives, in the chart (Gibbs chart of R, position in the \
-                       centre's axes) centred at `se3_centre` (R^6; see `retract::se3`),"
-            .into(),
-    }
+    charts::of(sig.space).map_or_else(
+        || format!("R^{}", sig.dim),
+        |chart| chart.description().into(),
+    )
 }
 
 /// For a function on the sphere (`sphere`), `SphereSystem`; on SO(3) (`so3`), `So3System`;
-/// on SE(3) (`se3`), `Se3System`: the chart parameter, read and replaced. Nothing on R^n.
+/// on SE(3) (`se3`), `Se3System` (`charts::Chart::runtime`): the chart parameter, read and
+/// replaced. Nothing on R^n.
 pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStream {
     let (generics, ty) = (&params.generics, &params.ty_full);
     let allow = allow_generated();
-    let Some((name, len)) = space.chart_param() else {
+    let (Some((name, len)), Some(chart)) = (space.chart_param(), charts::of(space)) else {
         return TokenStream::new();
     };
     let field = syn::Ident::new(name, proc_macro2::Span::call_site());
     let len = index(len);
-    let (module, tr, read, replace) = match space {
-        Space::So3 => (
-            quote!(so3),
-            quote!(So3System),
-            quote!(centre),
-            quote!(with_centre),
-        ),
-        Space::Se3 => (
-            quote!(se3),
-            quote!(Se3System),
-            quote!(centre),
-            quote!(with_centre),
-        ),
-        _ => (
-            quote!(sphere),
-            quote!(SphereSystem),
-            quote!(chart),
-            quote!(with_chart),
-        ),
-    };
+    let [module, tr, read, replace] = chart
+        .runtime()
+        .map(|name| syn::Ident::new(name, proc_macro2::Span::call_site()));
     quote! {
         #[automatically_derived]
         #allow
@@ -254,6 +229,8 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
     } else {
         (quote!(), quote!(#ty))
     };
+    // the chart of a system on a manifold is set by the stepper, not by the user
+    let chart = sig.space.chart_param();
     let fields = sig
         .params
         .iter()
@@ -273,32 +250,13 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
                     )
                 }
             };
-            let doc = match sig.space {
-                Space::Sphere if name == SPHERE_CHART => {
-                    "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), \
-                     set by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after \
-                     `new`."
-                        .to_string()
-                }
-                Space::So3 if name == SO3_CENTRE => {
-                    "The Gibbs chart's centre C, a rotation matrix row major \
-                     (`retract::so3::centre_matrix`), moved by `retract::so3`; the identity \
-                     after `new`."
-                        .to_string()
-                }
-                Space::Se3 if name == SE3_CENTRE => {
-                    "The chart's centre (C, c), a pose: C row major, then c \
-                     (`retract::se3::centre_pose`), moved by `retract::se3`; the identity \
-                     after `new`."
-                        .to_string()
-                }
+            let doc = match (chart, charts::of(sig.space)) {
+                (Some((frame, _)), Some(chart)) if name == frame => chart.frame_doc().to_string(),
                 _ => doc,
             };
             quote!(#[doc = #doc] pub #name: #t)
         })
         .collect();
-    // the chart of a system on the sphere is set by the stepper, not by the user
-    let chart = sig.space.chart_param();
     let user_params = &sig.params[..sig.params.len() - usize::from(chart.is_some())];
     let ctor_args = user_params
         .iter()
@@ -324,14 +282,9 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
             quote!(#name)
         })
         .collect();
-    if let Some((name, _)) = chart {
+    if let (Some((name, _)), Some(chart)) = (chart, charts::of(sig.space)) {
         let field = syn::Ident::new(name, proc_macro2::Span::call_site());
-        // the sphere's north pole, or the identity rotation
-        let frame = match sig.space {
-            Space::So3 => quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
-            Space::Se3 => quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
-            _ => quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
-        };
+        let frame = chart.initial_frame();
         field_names.push(quote!(#field: #frame));
     }
     ParamTokens {

@@ -10,7 +10,7 @@ use quote::quote;
 use super::Emission;
 use super::helpers::{Names, index, xu_leaf};
 use super::scalar::{ScalarBodies, scalar_bodies};
-use crate::codegen::{constant, emit};
+use crate::emit::codegen::{constant, emit};
 use crate::mechanics::LegendreInverse;
 
 /// `impl Lagrangian<n, k>`.

@@ -11,8 +11,8 @@ use quote::quote;
 use super::Emission;
 use super::domain::check_domain;
 use super::helpers::index;
-use crate::codegen::emit;
-use crate::signature::Kind;
+use crate::emit::codegen::emit;
+use crate::front::signature::Kind;
 
 /// `impl LiftedSystem<s, m>`.
 pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {

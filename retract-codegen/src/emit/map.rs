@@ -10,10 +10,10 @@ use syn::ItemFn;
 use super::helpers::{
     Names, ParamTokens, allow_generated, float_import, function_and_type, index, param_tokens,
 };
-use crate::codegen::emit;
-use crate::graph::{Graph, Id};
-use crate::map_lift::Lift;
-use crate::signature::Signature;
+use crate::emit::codegen::emit;
+use crate::front::signature::Signature;
+use crate::ir::graph::{Graph, Id};
+use crate::mechanics::lift::Lift;
 use crate::util::tidy;
 
 /// The function, its parameter struct and the `DiscretizationMap` impl.

@@ -12,23 +12,25 @@
 //! - `outputs`: a method per named output (`#[output] let`) of the Lagrangian.
 //!
 //! `map` emits the items of `#[discretization_map]` (its own type and `DiscretizationMap`
-//! impl, from the stages `map_lift` and `map_check`).
+//! impl, from the stages `mechanics::lift` and `mechanics::map_conditions`).
 //!
 //! Shared by them (and by `#[jet_function]`): the token helpers (`helpers`) and the
 //! straight-line bodies of a scalar function of the jet (`scalar`). The items are
-//! concatenated by `expand`, in the order above.
+//! concatenated by `attribute::lagrangian`, in the order above; their code is written by
+//! `codegen` (one `let` per shared node), its nesting bounded by `scopes`.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use syn::ItemFn;
 
-use crate::codegen::emit;
-use crate::graph::{Graph, Id};
-use crate::lower::Guard;
+use crate::emit::codegen::emit;
+use crate::front::lower::Guard;
+use crate::front::signature::Signature;
+use crate::ir::graph::{Graph, Id};
 use crate::mechanics::{Mechanics, Reduced};
-use crate::signature::Signature;
 use helpers::{Names, ParamTokens, allow_generated, float_import, index, param_tokens};
 
+pub(crate) mod codegen;
 pub(crate) mod domain;
 pub(crate) mod helpers;
 pub(crate) mod lagrangian;
@@ -37,6 +39,7 @@ pub(crate) mod map;
 pub(crate) mod outputs;
 pub(crate) mod reduced;
 pub(crate) mod scalar;
+pub(crate) mod scopes;
 pub(crate) mod separable;
 pub(crate) mod ty;
 

@@ -7,8 +7,8 @@ use quote::quote;
 
 use super::Emission;
 use super::helpers::{Names, ParamTokens, xu_leaf};
-use crate::codegen::emit;
-use crate::lower::Output;
+use crate::emit::codegen::emit;
+use crate::front::lower::Output;
 
 /// `impl Type { pub fn name(&self, x, u) -> f64 | [f64; len] }` for the outputs (nothing
 /// without any).

@@ -18,8 +18,8 @@ use quote::{format_ident, quote};
 
 use super::Emission;
 use super::helpers::{index, signed_sum};
-use crate::codegen::{Emitted, constant, emit};
-use crate::graph::Id;
+use crate::emit::codegen::{Emitted, constant, emit};
+use crate::ir::graph::Id;
 use crate::mechanics::{self, Reduced};
 
 /// `impl ReducedScheme<s, m, r>`, where the step reduces.

@@ -6,9 +6,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::helpers::{Names, float_import, index, xu_leaf};
-use crate::codegen::emit;
-use crate::graph::{Graph, Id};
-use crate::signature::Signature;
+use crate::emit::codegen::emit;
+use crate::front::signature::Signature;
+use crate::ir::graph::{Graph, Id};
 
 /// The bodies of the value, gradient and Hessian methods of a scalar function of the jet,
 /// in `(x, u)`: shared by `Lagrangian` and `JetFunction`.

@@ -1,12 +1,12 @@
-//! The `Separable` impl, where L = c/2 |u|^2 + V(q) (`crate::separable`): the weight c, for
+//! The `Separable` impl, where L = c/2 |u|^2 + V(q) (`crate::mechanics::separable`): the weight c, for
 //! the explicit splitting of `retract_core::split`.
 
 use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Emission;
-use crate::codegen::emit;
-use crate::separable;
+use crate::emit::codegen::emit;
+use crate::mechanics::separable;
 
 /// `impl Separable<n, k>` with `kinetic_weight` = c, or nothing when L is not of the form.
 pub(crate) fn separable_impl(e: &Emission<'_>) -> Option<TokenStream> {

@@ -11,9 +11,13 @@
 //! chart jet (D y^(i) = y^(i+1)). Every ambient jet variable of L (and of its guards) is
 //! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
 
-use crate::diff::{Differentiator, substitute_jet, total_derivative};
-use crate::graph::{Func, Graph, Id, Var};
-use crate::signature::Signature;
+use crate::front::signature::Signature;
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::Chart;
+use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
+use crate::ir::graph::{Func, Graph, Id, Var};
 
 /// The ambient jet q^(j)_a = D^j phi_a(y), j = 0..=k, as nodes in the chart jet
 /// (`Var::Jet` with index 0, 1) and the chart parameter (`Var::Param { param: chart }`).
@@ -59,6 +63,32 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
     substitute_jet(g, roots, jet.into_iter().map(|q| q.to_vec()).collect())
 }
 
+/// The gnomonic chart of S^2 (module docs).
+pub(crate) struct Sphere;
+
+impl Chart for Sphere {
+    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+        compose(graph, sig, roots)
+    }
+
+    fn description(&self) -> &'static str {
+        "the unit sphere S^2, in the gnomonic chart `sphere_chart` (R^2; see `retract::sphere`),"
+    }
+
+    fn runtime(&self) -> [&'static str; 4] {
+        ["sphere", "SphereSystem", "chart", "with_chart"]
+    }
+
+    fn frame_doc(&self) -> &'static str {
+        "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set by \
+         `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`."
+    }
+
+    fn initial_frame(&self) -> TokenStream {
+        quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,10 +96,10 @@ mod tests {
     /// Evaluates `node` at the chart jet `y[order][a]` and chart `[c, e1, e2]`.
     fn eval(g: &Graph, node: Id, y: &[[f64; 2]], chart: &[f64; 9]) -> f64 {
         let values = g.evaluate(node, &|n| match n {
-            crate::graph::Node::Var(Var::Jet { order, index }) => {
+            crate::ir::graph::Node::Var(Var::Jet { order, index }) => {
                 Some(y[*order as usize][*index as usize])
             }
-            crate::graph::Node::Var(Var::Param { index, .. }) => Some(chart[*index as usize]),
+            crate::ir::graph::Node::Var(Var::Param { index, .. }) => Some(chart[*index as usize]),
             _ => None,
         });
         values[node.0 as usize].expect("evaluable")

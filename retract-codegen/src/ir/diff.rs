@@ -6,7 +6,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use crate::graph::{Func, Graph, Id, Node, Var, children};
+use crate::ir::graph::{Func, Graph, Id, Node, Var, children};
 
 /// The nodes below `root` (itself included) that `pending` accepts, each once, in ascending
 /// order, which is children before parents (a node's children have smaller ids); found with
@@ -354,7 +354,7 @@ pub fn substitute_jet(g: &mut Graph, roots: &[Id], jet: Vec<Vec<Id>>) -> Vec<Id>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::tests::show;
+    use crate::ir::graph::tests::show;
 
     fn q(g: &mut Graph, order: u8, index: u32) -> Id {
         g.var(Var::Jet { order, index })

@@ -4,7 +4,7 @@
 //! `retract_core::VectorJetFunction`, each component with its own straight-line value,
 //! gradient and Hessian.
 //!
-//! The same stages as the Lagrangian (`signature` -> `lower` -> derivatives -> `codegen`),
+//! The same stages as the Lagrangian (`front` -> `charts` -> derivatives -> `emit`),
 //! without the mechanics: g may be linear in, or independent of, the top derivative, so
 //! there are no momenta, Legendre map, scheme or domain check.
 
@@ -12,58 +12,81 @@ use proc_macro2::TokenStream;
 use quote::{ToTokens, quote};
 use syn::ItemFn;
 
+use super::helper;
 use crate::charts;
 use crate::emit::helpers::{
     ParamTokens, allow_generated, chart_system_impl, function_and_type, param_tokens,
     space_description,
 };
 use crate::emit::scalar::{ScalarBodies, scalar_bodies};
-use crate::graph::{Graph, Id};
-use crate::lower::Lower;
+use crate::front::lower::Lower;
+use crate::front::signature::{Attribute, Signature};
+use crate::ir::graph::{Graph, Id};
 use crate::mechanics;
-use crate::signature::{self, Attribute};
-use crate::util::{combine, tidy};
+use crate::pipeline::{self, Passes, fail_softly};
+use crate::util::tidy;
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
 /// so the rest of the crate still type-checks. Never panics.
 pub fn expand_jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
-    match try_expand_jet_function(attr, item.clone()) {
-        Ok(tokens) => tokens,
-        Err(error) => {
-            let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
-            quote!(#item #errors)
-        }
-    }
+    fail_softly(item.clone(), try_expand_jet_function(attr, item))
 }
 
 /// The expansion of `#[jet_function(attr)] item`, or the errors of the input combined into
 /// one `syn::Error`.
 pub fn try_expand_jet_function(attr: TokenStream, item: TokenStream) -> syn::Result<TokenStream> {
-    let helpers = crate::helper::helper_names(&attr)?;
-    if !helpers.is_empty() {
-        return Ok(crate::helper::chain(&helpers, "jet_function", &attr, &item));
+    if let Some(chain) = helper::chain_if_named(&attr, "jet_function", &item)? {
+        return Ok(chain);
     }
-    let function: ItemFn = syn::parse2(item)?;
-    let sig = signature::parse(attr, &function, Attribute::JetFunction)?;
-    let mut graph = Graph::default();
-    let roots = {
-        let mut lower = Lower::new(&mut graph, &sig);
-        let roots = match sig.components {
+    pipeline::run(&mut JetFunctionPasses, attr, item)
+}
+
+/// The passes of `#[jet_function]`: the value (one root per component), composed with its
+/// chart, each component's derivatives, the items.
+struct JetFunctionPasses;
+
+impl Passes for JetFunctionPasses {
+    const ATTRIBUTE: Attribute = Attribute::JetFunction;
+    type Lowered = Vec<Id>;
+    type Derived = Vec<Component>;
+
+    fn lower(&mut self, lower: &mut Lower<'_>, function: &ItemFn, sig: &Signature) -> Vec<Id> {
+        match sig.components {
             Some(m) => lower.vector_body(&function.block, m),
             None => vec![lower.body(&function.block)],
-        };
-        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
-            return Err(e);
         }
-        roots
-    };
-    let (sig, roots) = charts::compose(&mut graph, sig, &roots);
-    let components: Vec<Component> = roots
-        .iter()
-        .map(|&root| component(&mut graph, &sig, root))
-        .collect();
-    Ok(generate(&function, &sig, components))
+    }
+
+    fn charts(
+        &mut self,
+        graph: &mut Graph,
+        sig: Signature,
+        roots: Vec<Id>,
+    ) -> (Signature, Vec<Id>) {
+        charts::compose(graph, sig, &roots)
+    }
+
+    fn mechanics(
+        &mut self,
+        graph: &mut Graph,
+        sig: &Signature,
+        roots: Vec<Id>,
+    ) -> syn::Result<Vec<Component>> {
+        Ok(roots
+            .iter()
+            .map(|&root| component(graph, sig, root))
+            .collect())
+    }
+
+    fn emit(
+        &self,
+        function: &ItemFn,
+        sig: &Signature,
+        _: &Graph,
+        components: Vec<Component>,
+    ) -> TokenStream {
+        generate(function, sig, components)
+    }
 }
 
 /// One component of the function: its method bodies and whether it involves q^(k).
@@ -73,7 +96,7 @@ struct Component {
 }
 
 /// The value, gradient and Hessian bodies of the function with value `root`.
-fn component(graph: &mut Graph, sig: &signature::Signature, root: Id) -> Component {
+fn component(graph: &mut Graph, sig: &Signature, root: Id) -> Component {
     let (n, k) = (sig.dim, sig.order);
     let (_, gradient, hessian) = mechanics::derivatives(graph, root, n, k);
     let involves_top = gradient[k * n..(k + 1) * n]
@@ -87,11 +110,7 @@ fn component(graph: &mut Graph, sig: &signature::Signature, root: Id) -> Compone
 
 /// The function, its parameter struct and the `JetFunction` impl (the `VectorJetFunction`
 /// impl for a function returning `[f64; m]`).
-fn generate(
-    function: &ItemFn,
-    sig: &signature::Signature,
-    mut components: Vec<Component>,
-) -> TokenStream {
+fn generate(function: &ItemFn, sig: &Signature, mut components: Vec<Component>) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let (n_lit, k_lit) = (
         proc_macro2::Literal::usize_unsuffixed(n),
@@ -182,11 +201,7 @@ fn generate(
 
 /// `impl VectorJetFunction<n, k>`: each method a `match` on the component, one arm per
 /// component with its own straight-line body (NaN, zero gradient and Hessian past the last).
-fn vector_impl(
-    sig: &signature::Signature,
-    params: &ParamTokens,
-    components: &[Component],
-) -> TokenStream {
+fn vector_impl(sig: &Signature, params: &ParamTokens, components: &[Component]) -> TokenStream {
     let (n_lit, k_lit) = (
         proc_macro2::Literal::usize_unsuffixed(sig.dim),
         proc_macro2::Literal::usize_unsuffixed(sig.order),

@@ -17,9 +17,9 @@ use std::collections::HashMap;
 
 use proc_macro2::Span;
 
-use crate::diff::{Differentiator, substitute};
-use crate::graph::{Graph, Id, Node, Var};
-use crate::signature::{Kind, Signature};
+use crate::front::signature::{Kind, Signature};
+use crate::ir::diff::{Differentiator, substitute};
+use crate::ir::graph::{Graph, Id, Node, Var};
 
 /// Number of pseudo-random points of the numerical test.
 pub const POINTS: usize = 4;

@@ -31,8 +31,8 @@ use std::collections::BinaryHeap;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::graph::{Func, Graph, Id, Node, Var, children};
-use crate::scopes::bounded_scopes;
+use crate::emit::scopes::bounded_scopes;
+use crate::ir::graph::{Func, Graph, Id, Node, Var, children};
 
 /// How a function names the leaves: symbol -> expression tokens.
 pub trait Leaves {

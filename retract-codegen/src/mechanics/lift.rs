@@ -8,8 +8,8 @@
 //! x_i = q^(i) (`Jet { order: i, index: a }`) and xi_i = v^(i) (`Jet { order: i, index: n + a
 //! }`), i <= j.
 
-use crate::diff::{Differentiator, total_derivative};
-use crate::graph::{Graph, Id, Var};
+use crate::ir::diff::{Differentiator, total_derivative};
+use crate::ir::graph::{Graph, Id, Var};
 
 /// The lifted map and its derivatives; every matrix is row-major nk x nk over the flat
 /// index `j * n + a` of component a of block j.
@@ -116,7 +116,7 @@ fn symmetric(g: &mut Graph, d: &mut Differentiator, gradient: &[Id], vars: &[Var
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::graph::tests::show;
+    use crate::ir::graph::tests::show;
 
     #[test]
     fn the_lift_of_a_product_is_its_total_derivative() {

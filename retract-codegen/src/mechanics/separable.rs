@@ -5,7 +5,7 @@
 
 use std::collections::HashSet;
 
-use crate::graph::{Func, Graph, Id, Node, Var, children};
+use crate::ir::graph::{Func, Graph, Id, Node, Var, children};
 use crate::mechanics::Mechanics;
 
 /// Whether `node` depends on a jet variable accepted by `which` (`Var::Jet { order, .. }`).
@@ -76,7 +76,7 @@ pub fn kinetic_weight(g: &Graph, mech: &Mechanics, n: usize, k: usize) -> Option
 
 #[cfg(test)]
 mod tests {
-    use crate::expand::try_expand;
+    use crate::attribute::lagrangian::try_expand;
 
     /// Whether the expansion of `body` (order 2 on R^2, parameters `tau` and `m`) implements
     /// `Separable`.

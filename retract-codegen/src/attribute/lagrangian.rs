@@ -1,11 +1,13 @@
-//! The expansion as a plain function, `TokenStream -> TokenStream`, testable without the
-//! compiler's proc-macro bridge: the stages in order (`signature` -> `lower` -> `mechanics`)
-//! and the items emitted from an [`Emission`] context (module `emit`), concatenated.
+//! `#[higher_order_lagrangian]` as a plain function, `TokenStream -> TokenStream`, testable
+//! without the compiler's proc-macro bridge: its passes of the pipeline (`crate::pipeline`):
+//! the body lowered with its guards and named outputs, composed with its chart, the mechanics
+//! (momenta, scheme, Jacobians, the guards at the step's points, the reduced scheme), and the
+//! items emitted from an [`Emission`] context (module `emit`), concatenated.
 
 use proc_macro2::TokenStream;
-use quote::quote;
 use syn::ItemFn;
 
+use super::helper;
 use crate::charts;
 use crate::emit::Emission;
 use crate::emit::lagrangian::lagrangian_impl;
@@ -14,23 +16,16 @@ use crate::emit::outputs::outputs_impl;
 use crate::emit::reduced::reduced_scheme_impl;
 use crate::emit::separable::separable_impl;
 use crate::emit::ty::type_and_constructor;
-use crate::graph::{Graph, Id};
-use crate::lower::{Guard, Lower, without_output_marks};
-use crate::mechanics::{self, Degenerate};
-use crate::signature::{self, Attribute, Signature, Space};
-use crate::util::combine;
+use crate::front::lower::{Guard, Lower, Output, without_output_marks};
+use crate::front::signature::{Attribute, Signature, Space};
+use crate::ir::graph::{Graph, Id};
+use crate::mechanics::{self, Degenerate, Mechanics, Reduced};
+use crate::pipeline::{self, Passes, fail_softly};
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
 pub fn expand(attr: TokenStream, item: TokenStream) -> TokenStream {
-    match try_expand(attr, item.clone()) {
-        Ok(tokens) => tokens,
-        Err(error) => {
-            let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
-            quote!(#item #errors)
-        }
-    }
+    fail_softly(item.clone(), try_expand(attr, item))
 }
 
 /// The expansion, or the errors of the input combined into one `syn::Error`.
@@ -65,19 +60,43 @@ fn expand_counted(
     item: TokenStream,
     stats: &mut ExpansionStats,
 ) -> syn::Result<TokenStream> {
-    let helpers = crate::helper::helper_names(&attr)?;
-    if !helpers.is_empty() {
-        return Ok(crate::helper::chain(&helpers, "lagrangian", &attr, &item));
+    if let Some(chain) = helper::chain_if_named(&attr, "lagrangian", &item)? {
+        return Ok(chain);
     }
-    let function: ItemFn = syn::parse2(item)?;
-    let sig = signature::parse(attr, &function, Attribute::Lagrangian)?;
-    let mut graph = Graph::default();
-    let (root, guards, outputs) = {
-        let mut lower = Lower::new(&mut graph, &sig);
+    pipeline::run(&mut LagrangianPasses { stats }, attr, item)
+}
+
+/// The passes of `#[higher_order_lagrangian]`, counting their work in `stats`.
+struct LagrangianPasses<'a> {
+    stats: &'a mut ExpansionStats,
+}
+
+/// L, its guarded expressions and its named outputs, as lowered.
+struct Lowered {
+    root: Id,
+    guards: Vec<Guard>,
+    outputs: Vec<Output>,
+}
+
+/// The mechanics of L, its guards at the step's points, the reduced scheme where it applies,
+/// and the named outputs.
+struct Derived {
+    mech: Mechanics,
+    guards: Vec<(Guard, [Id; 3])>,
+    reduced: Option<Reduced>,
+    outputs: Vec<Output>,
+}
+
+impl Passes for LagrangianPasses<'_> {
+    const ATTRIBUTE: Attribute = Attribute::Lagrangian;
+    type Lowered = Lowered;
+    type Derived = Derived;
+
+    fn lower(&mut self, lower: &mut Lower<'_>, function: &ItemFn, sig: &Signature) -> Lowered {
         let root = lower.body(&function.block);
-        stats.lowered_nodes = lower.g.len();
-        stats.graph_nodes = lower.g.len();
-        stats.guards = lower.guards.len();
+        self.stats.lowered_nodes = lower.g.len();
+        self.stats.graph_nodes = lower.g.len();
+        self.stats.guards = lower.guards.len();
         if let Some(output) = lower.outputs.first().filter(|_| sig.space != Space::Flat) {
             let span = output.name.span();
             lower.errors.push(syn::Error::new(
@@ -86,59 +105,102 @@ fn expand_counted(
                  works in a chart)",
             ));
         }
-        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
-            return Err(e);
+        Lowered {
+            root,
+            guards: std::mem::take(&mut lower.guards),
+            outputs: std::mem::take(&mut lower.outputs),
         }
-        let outputs = std::mem::take(&mut lower.outputs);
-        (root, std::mem::take(&mut lower.guards), outputs)
-    };
-    let function = without_output_marks(&function);
-    let (sig, root, guards) = in_chart(&mut graph, sig, root, guards);
-    let mech = mechanics::build(&mut graph, root, sig.dim, sig.order);
-    stats.graph_nodes = graph.len();
-    let mech = mech.map_err(|reason| {
-        let top = &sig.jet[sig.order];
-        // (on SO(3) the top argument is Omega^(k-1), which holds the chart's q^(k))
-        let what = match sig.space {
-            Space::So3 => format!("Omega^({})", sig.order - 1),
-            Space::Se3 => format!("xi^({})", sig.order - 1),
-            _ => format!("q^({})", sig.order),
+    }
+
+    fn charts(
+        &mut self,
+        graph: &mut Graph,
+        sig: Signature,
+        lowered: Lowered,
+    ) -> (Signature, Lowered) {
+        let (sig, root, guards) = in_chart(graph, sig, lowered.root, lowered.guards);
+        let outputs = lowered.outputs;
+        (
+            sig,
+            Lowered {
+                root,
+                guards,
+                outputs,
+            },
+        )
+    }
+
+    fn mechanics(
+        &mut self,
+        graph: &mut Graph,
+        sig: &Signature,
+        lowered: Lowered,
+    ) -> syn::Result<Derived> {
+        let mech = mechanics::build(graph, lowered.root, sig.dim, sig.order);
+        self.stats.graph_nodes = graph.len();
+        let mech = mech.map_err(|reason| degenerate(sig, reason))?;
+        let guards: Vec<(Guard, [Id; 3])> = if sig.guard {
+            lowered
+                .guards
+                .into_iter()
+                .map(|guard| {
+                    let points = mechanics::at_step_points(graph, guard.node, sig.dim, sig.order);
+                    (guard, points)
+                })
+                .collect()
+        } else {
+            Vec::new()
         };
-        let msg = match reason {
-            Degenerate::Independent => format!(
-                "the Lagrangian does not depend on `{top}` = {what}: its Legendre map is \
-                 singular; lower the order or add a term in `{top}` (e.g. 0.5 * |{top}|^2)"
-            ),
-            Degenerate::Linear => format!(
-                "the Lagrangian is linear in `{top}` = {what}: d2L/d{top}2 = 0, so its Legendre \
-                 map is singular; it must be (at least locally) strictly convex in `{top}`"
-            ),
-            Degenerate::Singular => format!(
-                "d2L/d{top}2 is a singular constant matrix (or has a non-finite entry): the \
-                 Legendre map is singular; every component of `{top}` must enter L \
-                 quadratically with finite weights"
-            ),
-        };
-        syn::Error::new(top.span(), msg)
-    })?;
-    let guards: Vec<(Guard, [Id; 3])> = if sig.guard {
-        guards
-            .into_iter()
-            .map(|guard| {
-                let points = mechanics::at_step_points(&mut graph, guard.node, sig.dim, sig.order);
-                (guard, points)
-            })
-            .collect()
-    } else {
-        Vec::new()
+        let flat: Vec<Vec<Id>> = mech.hessian.clone();
+        let reduced = mechanics::reduce(graph, &mech.gradient, &flat, sig.dim, sig.order);
+        self.stats.graph_nodes = graph.len();
+        Ok(Derived {
+            mech,
+            guards,
+            reduced,
+            outputs: lowered.outputs,
+        })
+    }
+
+    fn emit(&self, function: &ItemFn, sig: &Signature, graph: &Graph, d: Derived) -> TokenStream {
+        let function = without_output_marks(function);
+        let emission = Emission::new(
+            &function,
+            sig,
+            graph,
+            &d.mech,
+            &d.guards,
+            d.reduced.as_ref(),
+        );
+        let mut out = generate(&emission);
+        out.extend(outputs_impl(&emission, &d.outputs));
+        out
+    }
+}
+
+/// The error of a Lagrangian whose Legendre map is singular, at its top argument.
+fn degenerate(sig: &Signature, reason: Degenerate) -> syn::Error {
+    let top = &sig.jet[sig.order];
+    let what = charts::of(sig.space).map_or_else(
+        || format!("q^({})", sig.order),
+        |chart| chart.top(sig.order),
+    );
+    let msg = match reason {
+        Degenerate::Independent => format!(
+            "the Lagrangian does not depend on `{top}` = {what}: its Legendre map is \
+             singular; lower the order or add a term in `{top}` (e.g. 0.5 * |{top}|^2)"
+        ),
+        Degenerate::Linear => format!(
+            "the Lagrangian is linear in `{top}` = {what}: d2L/d{top}2 = 0, so its Legendre \
+             map is singular; it must be (at least locally) strictly convex in `{top}`"
+        ),
+        Degenerate::Singular => format!(
+            "d2L/d{top}2 is a singular constant matrix (or has a non-finite entry): the \
+             Legendre map is singular; every component of `{top}` must enter L \
+             quadratically with finite weights"
+        ),
     };
-    let flat: Vec<Vec<Id>> = mech.hessian.clone();
-    let reduced = mechanics::reduce(&mut graph, &mech.gradient, &flat, sig.dim, sig.order);
-    stats.graph_nodes = graph.len();
-    let emission = Emission::new(&function, &sig, &graph, &mech, &guards, reduced.as_ref());
-    let mut out = generate(&emission);
-    out.extend(outputs_impl(&emission, &outputs));
-    Ok(out)
+    syn::Error::new(top.span(), msg)
 }
 
 /// L and its guards composed with the chart of their space (`charts`), with the signature

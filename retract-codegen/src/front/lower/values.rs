@@ -14,8 +14,8 @@ use syn::spanned::Spanned;
 use syn::{Expr, Pat, Stmt};
 
 use super::{Binding, Lower};
-use crate::graph::{Id, Var};
-use crate::signature::Kind;
+use crate::front::signature::Kind;
+use crate::ir::graph::{Id, Var};
 
 /// Helper calls nested deeper than this are an error.
 const MAX_INLINE_DEPTH: usize = 16;

@@ -127,16 +127,16 @@ pub enum Space {
     /// R^n: the jet is the argument list as written.
     Flat,
     /// The unit sphere S^2 (`sphere`): the jet is ambient (`[f64; 3]`) and the generated
-    /// system works in a gnomonic chart (`crate::sphere`).
+    /// system works in a gnomonic chart (`crate::charts::sphere`).
     Sphere,
     /// The rotation group SO(3) (`so3`): the arguments are the rotation R (`[f64; 9]`, row
     /// major) and the body velocity Omega with its derivatives (`[f64; 3]`); the generated
-    /// system works in a Gibbs chart centred at a rotation (`crate::so3`).
+    /// system works in a Gibbs chart centred at a rotation (`crate::charts::so3`).
     So3,
     /// The rigid motions SE(3) (`se3`): the arguments are the pose g = (R, p) (`[f64; 12]`,
     /// R row major, then the position p) and the body velocity xi = (Omega, v), v = R^T p',
     /// with its derivatives (`[f64; 6]`); the generated system works in the product chart
-    /// (Gibbs chart of R, position in the centre's axes) centred at a pose (`crate::se3`).
+    /// (Gibbs chart of R, position in the centre's axes) centred at a pose (`crate::charts::se3`).
     Se3,
 }
 

@@ -2,10 +2,14 @@
 //! Ostrogradsky momenta, the Legendre inversion when L is quadratic in u, and the residual
 //! and Jacobians of the lifted theta-scheme (formulas in `retract_core::LiftedSystem`).
 
+pub(crate) mod lift;
+pub(crate) mod map_conditions;
+pub(crate) mod separable;
+
 use std::collections::HashMap;
 
-use crate::diff::{Differentiator, substitute, total_derivative};
-use crate::graph::{Graph, Id, Var};
+use crate::ir::diff::{Differentiator, substitute, total_derivative};
+use crate::ir::graph::{Graph, Id, Var};
 
 /// u = A^{-1} (p_{k-1} - b(x)) where L is quadratic in u: A = d2L/du2 does not depend on u,
 /// b = dL/du at u = 0.
@@ -624,8 +628,8 @@ fn depends_on(g: &Graph, id: Id, target: &dyn Fn(&Var) -> bool) -> bool {
             continue;
         }
         match g.node(node) {
-            crate::graph::Node::Var(v) if target(v) => return true,
-            other => stack.extend(crate::graph::children(other)),
+            crate::ir::graph::Node::Var(v) if target(v) => return true,
+            other => stack.extend(crate::ir::graph::children(other)),
         }
     }
     false

@@ -6,7 +6,7 @@ use syn::spanned::Spanned;
 use syn::{Expr, Pat, Stmt};
 
 use super::{Binding, Lower, Output};
-use crate::signature::Attribute;
+use crate::front::signature::Attribute;
 
 /// The methods a generated Lagrangian's type already has, which an output of the same name
 /// would shadow (an inherent method wins over a trait's at a call `sys.name(..)`) or clash

@@ -8,8 +8,10 @@
 //! different namespaces) that appends the function's tokens to a list and passes the list on.
 //! An attribute with `helpers = [a, b]` expands to `a! { @retract_helpers [] [b] ... }`; each
 //! helper's macro adds itself and calls the next, the last calls
-//! [`expand_with_helpers`], which puts the functions into the body as nested helper `fn`s
-//! (inlined by the lowering, `lower::values`) and expands the attribute without the option.
+//! `expand_with_helpers` (the re-entry, in `attribute`), which puts the functions into the
+//! body as nested helper `fn`s ([`with_helpers_inlined`]; inlined by the lowering,
+//! `front::lower`) and expands the attribute without the option. This module imports none
+//! of the attributes, so that they can all start the chain ([`chain_if_named`]).
 //! The macros follow `macro_rules!` scoping: a helper is visible to the items after it in
 //! its module (and in modules declared after it).
 
@@ -19,7 +21,7 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Ident, ItemFn, Meta, Token};
 
-use crate::lower::helper_signature_problem;
+use crate::front::lower::helper_signature_problem;
 
 /// Expands `#[helper] item`: the function, and its macro (module docs).
 pub fn expand_helper(attr: TokenStream, item: TokenStream) -> TokenStream {
@@ -63,8 +65,19 @@ fn try_expand_helper(attr: TokenStream, item: TokenStream) -> syn::Result<TokenS
     })
 }
 
+/// Where the attribute's options `attr` name helpers, the start of the chain for the attribute
+/// `which` (module docs); `None` without them.
+pub(crate) fn chain_if_named(
+    attr: &TokenStream,
+    which: &str,
+    item: &TokenStream,
+) -> syn::Result<Option<TokenStream>> {
+    let helpers = helper_names(attr)?;
+    Ok((!helpers.is_empty()).then(|| chain(&helpers, which, attr, item)))
+}
+
 /// The names of `helpers = [a, b]` in an attribute's options (none without it).
-pub(crate) fn helper_names(attr: &TokenStream) -> syn::Result<Vec<Ident>> {
+fn helper_names(attr: &TokenStream) -> syn::Result<Vec<Ident>> {
     let metas = syn::parse::Parser::parse2(
         Punctuated::<Meta, Token![,]>::parse_terminated,
         attr.clone(),
@@ -101,18 +114,14 @@ pub(crate) fn helper_names(attr: &TokenStream) -> syn::Result<Vec<Ident>> {
 }
 
 /// The start of the chain for an attribute `which` with helpers `names` (module docs).
-pub(crate) fn chain(
-    names: &[Ident],
-    which: &str,
-    attr: &TokenStream,
-    item: &TokenStream,
-) -> TokenStream {
+fn chain(names: &[Ident], which: &str, attr: &TokenStream, item: &TokenStream) -> TokenStream {
     let which = Ident::new(which, proc_macro2::Span::call_site());
     let (first, rest) = (&names[0], &names[1..]);
     quote!(#first! { @retract_helpers [] [#(#rest),*] #which [#attr] #item })
 }
 
-/// The input of [`expand_with_helpers`]: `[fns] which [attr] item`.
+/// The input of the end of the chain (`attribute::expand_with_helpers`): `[fns] which [attr]
+/// item`.
 struct WithHelpers {
     helpers: Vec<ItemFn>,
     which: Ident,
@@ -142,18 +151,17 @@ impl Parse for WithHelpers {
     }
 }
 
-/// The end of the chain: the attribute `which` expanded on `item` with the helper functions
-/// put first in its body and the `helpers` option removed.
-pub fn expand_with_helpers(input: TokenStream) -> TokenStream {
+/// The end of the chain, `[fns] which [attr] item`: the attribute's name `which`, its options
+/// without `helpers`, and `item` with the helper functions put first in its body.
+pub(crate) fn with_helpers_inlined(
+    input: TokenStream,
+) -> syn::Result<(Ident, TokenStream, TokenStream)> {
     let WithHelpers {
         helpers,
         which,
         attr,
         mut item,
-    } = match syn::parse2(input) {
-        Ok(parsed) => parsed,
-        Err(error) => return error.to_compile_error(),
-    };
+    } = syn::parse2(input)?;
     let metas = syn::parse::Parser::parse2(Punctuated::<Meta, Token![,]>::parse_terminated, attr)
         .unwrap_or_default();
     let kept: Punctuated<Meta, Token![,]> = metas
@@ -164,10 +172,5 @@ pub fn expand_with_helpers(input: TokenStream) -> TokenStream {
         .into_iter()
         .map(|f| syn::Stmt::Item(syn::Item::Fn(f)));
     item.block.stmts.splice(0..0, stmts);
-    let (attr, item) = (kept.to_token_stream(), item.to_token_stream());
-    if which == "jet_function" {
-        crate::expand_jet_function(attr, item)
-    } else {
-        crate::expand(attr, item)
-    }
+    Ok((which, kept.to_token_stream(), item.to_token_stream()))
 }

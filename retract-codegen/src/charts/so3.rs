@@ -12,11 +12,15 @@
 //! with [y]x v = y x v, Q(y)^T Q(y)' = [Omega]x, and D the total derivative of the chart jet
 //! (D y^(i) = y^(i+1)); Omega^(k-1) reads y^(k). Every argument of L (and of its guards) is
 //! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard. The
-//! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::se3`).
+//! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::charts::se3`).
 
-use crate::diff::{Differentiator, substitute_jet, total_derivative};
-use crate::graph::{Graph, Id, Var};
-use crate::signature::Signature;
+use crate::front::signature::Signature;
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::Chart;
+use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
+use crate::ir::graph::{Graph, Id, Var};
 
 /// `a x b` in the graph.
 fn cross(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> [Id; 3] {
@@ -139,4 +143,40 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
     let mut jet = vec![r];
     jet.extend(rates(g, omega, 3, sig.order));
     substitute_jet(g, roots, jet)
+}
+
+/// The Gibbs chart of SO(3) (module docs).
+pub(crate) struct So3;
+
+impl Chart for So3 {
+    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
+        compose(graph, sig, roots)
+    }
+
+    fn description(&self) -> &'static str {
+        "SO(3), written in the rotation R and the body velocity Omega with its derivatives, in \
+         the Gibbs chart centred at `so3_centre` (R^3; see `retract::so3`),"
+    }
+
+    fn arguments(&self, k: usize) -> String {
+        format!("R, Omega, ..., Omega^({})", k - 1)
+    }
+
+    fn top(&self, k: usize) -> String {
+        // (the top argument is Omega^(k-1), which holds the chart's q^(k))
+        format!("Omega^({})", k - 1)
+    }
+
+    fn runtime(&self) -> [&'static str; 4] {
+        ["so3", "So3System", "centre", "with_centre"]
+    }
+
+    fn frame_doc(&self) -> &'static str {
+        "The Gibbs chart's centre C, a rotation matrix row major (`retract::so3::centre_matrix`), \
+         moved by `retract::so3`; the identity after `new`."
+    }
+
+    fn initial_frame(&self) -> TokenStream {
+        quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
+    }
 }

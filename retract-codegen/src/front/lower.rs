@@ -21,8 +21,8 @@ use quote::ToTokens;
 use syn::spanned::Spanned;
 use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
-use crate::graph::{Func, Graph, Id, Node, Var};
-use crate::signature::{Attribute, Kind, Signature};
+use crate::front::signature::{Attribute, Kind, Signature};
+use crate::ir::graph::{Func, Graph, Id, Node, Var};
 use crate::util::tidy;
 
 mod outputs;
@@ -1394,7 +1394,7 @@ impl<'a> Lower<'a> {
             match self.g.node(n) {
                 Node::Var(v) if target(v) => return true,
                 Node::Sum { .. } if !into_sums => {}
-                node => stack.extend(crate::graph::children(node)),
+                node => stack.extend(crate::ir::graph::children(node)),
             }
         }
         false

@@ -4,34 +4,27 @@
 //!
 //! The stages: `signature` (order, dimension, parameters; (q, v) instead of a jet) ->
 //! `lower` (the `let`s of the body, then the points, here: the body must end with the pair
-//! of array literals) -> `map_check` (R_d(q, 0) = (q, q), d_v R2 - d_v R1 = I at v = 0) ->
-//! `map_lift` (the lift by total derivatives, its Jacobians and the covector Hessian) ->
+//! of array literals) -> `mechanics::map_conditions` (R_d(q, 0) = (q, q), d_v R2 - d_v R1 = I at v = 0) ->
+//! `mechanics::lift` (the lift by total derivatives, its Jacobians and the covector Hessian) ->
 //! `emit::map` (the items).
 
 use proc_macro2::TokenStream;
-use quote::quote;
 use syn::spanned::Spanned as _;
 use syn::{Block, Expr, ItemFn, Stmt};
 
 use crate::emit::map::map_items;
-use crate::graph::Graph;
-use crate::lower::Lower;
-use crate::map_check::{self, Spanned};
-use crate::map_lift::lift;
-use crate::signature::{self, Attribute, Signature};
+use crate::front::lower::Lower;
+use crate::front::signature::{Attribute, Signature};
+use crate::ir::graph::Graph;
+use crate::mechanics::lift::{Lift, lift};
+use crate::mechanics::map_conditions::{self, Spanned};
+use crate::pipeline::{self, Passes, fail_softly};
 use crate::util::combine;
 
 /// Expands `#[discretization_map(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
 pub fn expand_discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
-    match try_expand_discretization_map(attr, item.clone()) {
-        Ok(tokens) => tokens,
-        Err(error) => {
-            let errors = error.to_compile_error();
-            let item = crate::lower::item_without_output_marks(item);
-            quote!(#item #errors)
-        }
-    }
+    fail_softly(item.clone(), try_expand_discretization_map(attr, item))
 }
 
 /// The expansion of `#[discretization_map(attr)] item`, or the errors of the input combined
@@ -40,25 +33,55 @@ pub fn try_expand_discretization_map(
     attr: TokenStream,
     item: TokenStream,
 ) -> syn::Result<TokenStream> {
-    let function: ItemFn = syn::parse2(item)?;
-    let sig = signature::parse(attr, &function, Attribute::Map)?;
-    let mut graph = Graph::default();
-    let points = {
-        let mut lower = Lower::new(&mut graph, &sig);
-        let points = points(&mut lower, &function.block, &sig);
-        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
+    pipeline::run(&mut MapPasses, attr, item)
+}
+
+/// The passes of `#[discretization_map]`: the pair of points, no chart, the conditions
+/// checked and the lift, the items.
+struct MapPasses;
+
+impl Passes for MapPasses {
+    const ATTRIBUTE: Attribute = Attribute::Map;
+    type Lowered = [Vec<Spanned>; 2];
+    type Derived = Lift;
+
+    fn lower(
+        &mut self,
+        lower: &mut Lower<'_>,
+        function: &ItemFn,
+        sig: &Signature,
+    ) -> [Vec<Spanned>; 2] {
+        points(lower, &function.block, sig)
+    }
+
+    /// A map is written on a chart of R^n (it takes no space option): unchanged.
+    fn charts(
+        &mut self,
+        _: &mut Graph,
+        sig: Signature,
+        points: [Vec<Spanned>; 2],
+    ) -> (Signature, [Vec<Spanned>; 2]) {
+        (sig, points)
+    }
+
+    fn mechanics(
+        &mut self,
+        graph: &mut Graph,
+        sig: &Signature,
+        points: [Vec<Spanned>; 2],
+    ) -> syn::Result<Lift> {
+        if sig.check
+            && let Some(e) = combine(map_conditions::check(graph, sig, &points))
+        {
             return Err(e);
         }
-        points
-    };
-    if sig.check
-        && let Some(e) = combine(map_check::check(&mut graph, &sig, &points))
-    {
-        return Err(e);
+        let r = points.map(|side| side.iter().map(|&(id, _)| id).collect());
+        Ok(lift(graph, &r, sig.dim, sig.order))
     }
-    let r = points.map(|side| side.iter().map(|&(id, _)| id).collect());
-    let lifted = lift(&mut graph, &r, sig.dim, sig.order);
-    Ok(map_items(&function, &sig, &graph, &lifted))
+
+    fn emit(&self, function: &ItemFn, sig: &Signature, graph: &Graph, lifted: Lift) -> TokenStream {
+        map_items(function, sig, graph, &lifted)
+    }
 }
 
 /// The supported form of the body, for messages.

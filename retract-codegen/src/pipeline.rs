@@ -1,0 +1,95 @@
+//! The pipeline every attribute runs, written once: parse the item, read the signature
+//! (`front::signature`), lower the body to the expression graph (`front::lower`, every error
+//! of the body reported at once), compose with the chart of the function's space (`charts`),
+//! build what the attribute derives from it (`mechanics`) and emit the items (`emit`).
+//!
+//! The attributes differ only in their passes, as pest's optimizer chains its passes: each
+//! implements [`Passes`] (what it lowers, how it composes with a chart, what it derives and
+//! what it emits), and [`run`] chains them in that order.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+use syn::ItemFn;
+
+use crate::front::lower::Lower;
+use crate::front::signature::{self, Attribute, Signature};
+use crate::ir::graph::Graph;
+use crate::util::combine;
+
+/// The passes of one attribute, chained by [`run`].
+pub(crate) trait Passes {
+    /// The attribute, for the options it accepts and its messages.
+    const ATTRIBUTE: Attribute;
+    /// What lowering the body yields: the roots in the graph and what travels with them.
+    type Lowered;
+    /// What the mechanics pass derives from the lowered function, for the emission.
+    type Derived;
+
+    /// Lowers the body of `function` through `lower`; errors go to `lower.errors`.
+    fn lower(&mut self, lower: &mut Lower<'_>, function: &ItemFn, sig: &Signature)
+    -> Self::Lowered;
+
+    /// The lowered function composed with the chart of `sig`'s space, with the signature of
+    /// the composed function.
+    fn charts(
+        &mut self,
+        graph: &mut Graph,
+        sig: Signature,
+        lowered: Self::Lowered,
+    ) -> (Signature, Self::Lowered);
+
+    /// What the attribute derives (derivatives, momenta, scheme, lift), or the error that
+    /// stops the expansion.
+    fn mechanics(
+        &mut self,
+        graph: &mut Graph,
+        sig: &Signature,
+        lowered: Self::Lowered,
+    ) -> syn::Result<Self::Derived>;
+
+    /// The generated items.
+    fn emit(
+        &self,
+        function: &ItemFn,
+        sig: &Signature,
+        graph: &Graph,
+        derived: Self::Derived,
+    ) -> TokenStream;
+}
+
+/// Runs the pipeline (module docs) with `passes` on `#[attribute(attr)] item`: the generated
+/// items, or the errors of the first stage that failed, combined into one `syn::Error`.
+pub(crate) fn run<P: Passes>(
+    passes: &mut P,
+    attr: TokenStream,
+    item: TokenStream,
+) -> syn::Result<TokenStream> {
+    let function: ItemFn = syn::parse2(item)?;
+    let sig = signature::parse(attr, &function, P::ATTRIBUTE)?;
+    let mut graph = Graph::default();
+    let lowered = {
+        let mut lower = Lower::new(&mut graph, &sig);
+        let lowered = passes.lower(&mut lower, &function, &sig);
+        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
+            return Err(e);
+        }
+        lowered
+    };
+    let (sig, lowered) = passes.charts(&mut graph, sig, lowered);
+    let derived = passes.mechanics(&mut graph, &sig, lowered)?;
+    Ok(passes.emit(&function, &sig, &graph, derived))
+}
+
+/// The expansion of `item` where it succeeded; where it failed, the original item (its
+/// `#[output]` marks removed) followed by the errors as `compile_error!`s, so that the rest of
+/// the crate still type-checks and the errors do not cascade.
+pub(crate) fn fail_softly(item: TokenStream, result: syn::Result<TokenStream>) -> TokenStream {
+    match result {
+        Ok(tokens) => tokens,
+        Err(error) => {
+            let errors = error.to_compile_error();
+            let item = crate::front::lower::item_without_output_marks(item);
+            quote!(#item #errors)
+        }
+    }
+}
