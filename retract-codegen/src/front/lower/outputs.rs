@@ -53,6 +53,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "with_chart",
     "centre",
     "with_centre",
+    "centred",
 ];
 
 /// Whether a `let` is marked `#[output]`.
@@ -171,11 +172,12 @@ mod tests {
         let traits = [
             ("system.rs", "Lagrangian"),
             ("system.rs", "LiftedSystem"),
-            ("reduced.rs", "ReducedScheme"),
-            ("split.rs", "Separable"),
-            ("sphere.rs", "SphereSystem"),
-            ("so3/body.rs", "So3System"),
-            ("se3.rs", "Se3System"),
+            ("scheme/reduced.rs", "ReducedScheme"),
+            ("scheme/split.rs", "Separable"),
+            ("manifold/sphere.rs", "SphereSystem"),
+            ("manifold/so3/body.rs", "So3System"),
+            ("manifold/se3.rs", "Se3System"),
+            ("manifold/mod.rs", "CentredSystem"),
         ];
         let mut checked = 0;
         for (file, name) in traits {
