@@ -64,6 +64,7 @@ pub(crate) fn run<P: Passes>(
     attr: TokenStream,
     item: TokenStream,
 ) -> syn::Result<TokenStream> {
+    crate::util::check_group_nesting(&item)?;
     let function: ItemFn = syn::parse2(item)?;
     let sig = signature::parse(attr, &function, P::ATTRIBUTE)?;
     let mut graph = Graph::default();

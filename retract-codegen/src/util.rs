@@ -13,6 +13,35 @@ pub(crate) fn combine(errors: Vec<syn::Error>) -> Option<syn::Error> {
     Some(first)
 }
 
+/// The deepest nesting of delimited groups (`()`, `[]`, `{}`) an attribute parses. syn parses
+/// a nested group by recursion, about 16 KiB of stack a level when unoptimised (as a
+/// proc-macro's dependencies are built): 512 levels of `(1.0 + (...))` overflowed rustc's
+/// 8 MiB stack, 384 did not. Past this the item is refused before it is parsed.
+pub(crate) const MAX_GROUP_NESTING: usize = 256;
+
+/// `Err` at the first group nested deeper than [`MAX_GROUP_NESTING`] in `tokens`, found
+/// without recursion (the walk is iterative, linear in the tokens).
+pub(crate) fn check_group_nesting(tokens: &proc_macro2::TokenStream) -> syn::Result<()> {
+    let mut stack = vec![(tokens.clone(), 0)];
+    while let Some((tokens, depth)) = stack.pop() {
+        for tree in tokens {
+            if let proc_macro2::TokenTree::Group(g) = tree {
+                if depth + 1 > MAX_GROUP_NESTING {
+                    return Err(syn::Error::new(
+                        g.span_open(),
+                        format!(
+                            "brackets nest deeper than {MAX_GROUP_NESTING} levels here: bind \
+                             intermediate values with `let`"
+                        ),
+                    ));
+                }
+                stack.push((g.stream(), depth + 1));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Token text with the spaces that `to_string` puts around `.`, `[` and calls removed.
 pub(crate) fn tidy(text: &str) -> String {
     let mut out = String::with_capacity(text.len());

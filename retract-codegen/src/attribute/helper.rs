@@ -41,6 +41,7 @@ fn try_expand_helper(attr: TokenStream, item: TokenStream) -> syn::Result<TokenS
             "`#[helper]` takes no options",
         ));
     }
+    crate::util::check_group_nesting(&item)?;
     let function: ItemFn = syn::parse2(item)?;
     if let Some((span, message)) = helper_signature_problem(&function.sig) {
         return Err(syn::Error::new(span, message));
@@ -161,7 +162,10 @@ pub(crate) fn with_helpers_inlined(
         which,
         attr,
         mut item,
-    } = syn::parse2(input)?;
+    } = {
+        crate::util::check_group_nesting(&input)?;
+        syn::parse2(input)?
+    };
     let metas = syn::parse::Parser::parse2(Punctuated::<Meta, Token![,]>::parse_terminated, attr)
         .unwrap_or_default();
     let kept: Punctuated<Meta, Token![,]> = metas

@@ -192,6 +192,8 @@ pub struct Lower<'a> {
     /// The depth of expression nesting being lowered, and whether [`MAX_NESTING`] was
     /// reported.
     nesting: (usize, bool),
+    /// Whether each node depends on the jet, where decided ([`Self::depends_on_jet`]).
+    jet_memo: Vec<Option<bool>>,
     /// Helper calls inlined so far (every call is inlined; capped by
     /// `values::MAX_INLINED`), and whether the cap was reported.
     inlined: (usize, bool),
@@ -253,6 +255,7 @@ impl<'a> Lower<'a> {
             inlining: Vec::new(),
             inlined: (0, false),
             nesting: (0, false),
+            jet_memo: Vec::new(),
             barrier: 0,
             outputs: Vec::new(),
             top_level: false,
@@ -840,31 +843,10 @@ impl<'a> Lower<'a> {
                 }
                 _ => self.error(u.span(), "unsupported unary operator; supported: `-`"),
             },
-            Expr::Binary(b) => {
-                let (l, r) = (self.expr(&b.left), self.expr(&b.right));
-                match b.op {
-                    BinOp::Add(_) => self.g.add_op(l, r),
-                    BinOp::Sub(_) => self.g.sub(l, r),
-                    BinOp::Mul(_) => self.g.mul(l, r),
-                    BinOp::Div(_) => {
-                        self.guard(GuardKind::Denominator, r, &b.right);
-                        self.g.div(l, r)
-                    }
-                    op if is_assign_op(&op) => {
-                        self.error(b.span(), "an assignment is a statement, not a value")
-                    }
-                    _ => self.error(
-                        b.op.span(),
-                        format!(
-                            "unsupported operator `{}`; supported: + - * /",
-                            b.op.to_token_stream()
-                        ),
-                    ),
-                }
-            }
+            Expr::Binary(b) => self.binary_chain(b),
             Expr::Path(p) => self.path(p),
             Expr::Index(ix) => self.index(ix),
-            Expr::MethodCall(m) => self.method(m),
+            Expr::MethodCall(m) => self.method_chain(m),
             Expr::Call(c) => self.call(c),
             Expr::Cast(c) => {
                 if let Some(v) = self.int_silently(&c.expr) {
@@ -1050,20 +1032,80 @@ impl<'a> Lower<'a> {
         }
     }
 
-    fn method(&mut self, m: &syn::ExprMethodCall) -> Id {
+    /// `a op b op c ...`, a left-associative chain of binary operators (a long sum or
+    /// product): the left spine is walked without recursion and each operator costs no level
+    /// of nesting ([`MAX_NESTING`]), so a sum of many terms lowers in linear time and stack.
+    /// The operands are lowered left to right, as by recursion.
+    fn binary_chain(&mut self, top: &syn::ExprBinary) -> Id {
+        let mut spine = vec![top];
+        let mut first = &*top.left;
+        while let Expr::Binary(b) = first {
+            spine.push(b);
+            first = &b.left;
+        }
+        let mut acc = self.expr(first);
+        for b in spine.into_iter().rev() {
+            let r = self.expr(&b.right);
+            acc = self.binary(b, acc, r);
+        }
+        acc
+    }
+
+    /// `l op r` for the lowered operands of `b`.
+    fn binary(&mut self, b: &syn::ExprBinary, l: Id, r: Id) -> Id {
+        match b.op {
+            BinOp::Add(_) => self.g.add_op(l, r),
+            BinOp::Sub(_) => self.g.sub(l, r),
+            BinOp::Mul(_) => self.g.mul(l, r),
+            BinOp::Div(_) => {
+                self.guard(GuardKind::Denominator, r, &b.right);
+                self.g.div(l, r)
+            }
+            op if is_assign_op(&op) => {
+                self.error(b.span(), "an assignment is a statement, not a value")
+            }
+            _ => self.error(
+                b.op.span(),
+                format!(
+                    "unsupported operator `{}`; supported: + - * /",
+                    b.op.to_token_stream()
+                ),
+            ),
+        }
+    }
+
+    /// `x.f().g(y)...`, a chain of method calls (parenthesised receivers included): the
+    /// receivers are walked without recursion and each call costs no level of nesting, so
+    /// that a long chain lowers in linear time and stack.
+    fn method_chain(&mut self, top: &syn::ExprMethodCall) -> Id {
+        let mut spine = vec![top];
+        let mut inner = &*top.receiver;
+        loop {
+            match inner {
+                Expr::MethodCall(m) => {
+                    spine.push(m);
+                    inner = &m.receiver;
+                }
+                Expr::Paren(p) => inner = &p.expr,
+                Expr::Group(g) => inner = &g.expr,
+                _ => break,
+            }
+        }
+        let mut x = self.expr(inner);
+        for m in spine.into_iter().rev() {
+            x = self.method(m, x);
+        }
+        x
+    }
+
+    /// The call `m` on its lowered receiver `receiver`.
+    fn method(&mut self, m: &syn::ExprMethodCall, receiver: Id) -> Id {
         if m.turbofish.is_some() {
             return self.error(m.span(), "turbofish is not supported");
         }
         let name = m.method.to_string();
-        let receiver = self.expr(&m.receiver);
         let args: Vec<&Expr> = m.args.iter().collect();
-        self.apply(
-            &name,
-            m.method.span(),
-            m.span(),
-            (receiver, &m.receiver),
-            &args,
-        )
+        self.apply(&name, m.method.span(), m, (receiver, &m.receiver), &args)
     }
 
     /// `f64::sqrt(x)` and friends: the method form with the receiver as first argument.
@@ -1109,13 +1151,7 @@ impl<'a> Lower<'a> {
             let args: Vec<&Expr> = c.args.iter().collect();
             let receiver = self.expr(args[0]);
             let span = p.path.segments[1].ident.span();
-            return self.apply(
-                &segments[1],
-                span,
-                c.span(),
-                (receiver, args[0]),
-                &args[1..],
-            );
+            return self.apply(&segments[1], span, c, (receiver, args[0]), &args[1..]);
         }
         self.error(
             c.func.span(),
@@ -1181,7 +1217,7 @@ impl<'a> Lower<'a> {
         &mut self,
         name: &str,
         name_span: Span,
-        span: Span,
+        call: &dyn Spanned,
         (x, x_expr): (Id, &Expr),
         args: &[&Expr],
     ) -> Id {
@@ -1199,7 +1235,11 @@ impl<'a> Lower<'a> {
             }
         };
         if args.len() != expected {
-            return self.error(span, format!("`{name}` takes {expected} argument(s)"));
+            // the span of the whole call only here: it costs the call's size
+            return self.error(
+                call.span(),
+                format!("`{name}` takes {expected} argument(s)"),
+            );
         }
         let unary = |f| Some(f);
         let func = match name {
@@ -1292,7 +1332,6 @@ impl<'a> Lower<'a> {
     /// and log10 x > 0; ln_1p 1 + x > 0; asin and acos 1 - x^2 > 0; tan a nonzero cos(x);
     /// cbrt (whose derivative is singular at 0) a nonzero x. The others are entire.
     fn guard_function(&mut self, f: Func, x: Id, x_expr: &Expr) {
-        let atom = atom_text(x_expr);
         match f {
             Func::Sqrt => self.guard(GuardKind::SqrtArgument, x, x_expr),
             Func::Ln | Func::Log2 | Func::Log10 => self.guard(GuardKind::LnArgument, x, x_expr),
@@ -1312,7 +1351,10 @@ impl<'a> Lower<'a> {
             Func::Tan => {
                 // tan = sin / cos: singular where cos(x) = 0
                 let cos = self.g.unary(Func::Cos, x);
-                self.guard_text(GuardKind::Denominator, cos, format!("{atom}.cos()"));
+                if self.depends_on_jet(cos) {
+                    let text = format!("{}.cos()", atom_text(x_expr));
+                    self.guard_text(GuardKind::Denominator, cos, text);
+                }
             }
             _ => {}
         }
@@ -1378,8 +1420,33 @@ impl<'a> Lower<'a> {
         self.reaches(id, |v| matches!(v, Var::Elem { .. }), false)
     }
 
-    fn depends_on_jet(&self, id: Id) -> bool {
-        self.reaches(id, |v| matches!(v, Var::Jet { .. }), true)
+    /// Whether `id` depends on the jet (inside sums too), memoised per node in `jet_memo` (a
+    /// walk per guarded node made nested guards quadratic in the depth).
+    fn depends_on_jet(&mut self, id: Id) -> bool {
+        if self.jet_memo.len() < self.g.len() {
+            self.jet_memo.resize(self.g.len(), None);
+        }
+        // post-order without recursion: a node is decided once its children are
+        let mut stack = vec![(id, false)];
+        while let Some((n, children_done)) = stack.pop() {
+            if self.jet_memo[n.0 as usize].is_some() {
+                continue;
+            }
+            let node = self.g.node(n);
+            let children = crate::ir::graph::children(node);
+            if let Node::Var(v) = node {
+                self.jet_memo[n.0 as usize] = Some(matches!(v, Var::Jet { .. }));
+            } else if children_done {
+                let any = children
+                    .iter()
+                    .any(|c| self.jet_memo[c.0 as usize] == Some(true));
+                self.jet_memo[n.0 as usize] = Some(any);
+            } else {
+                stack.push((n, true));
+                stack.extend(children.into_iter().map(|c| (c, false)));
+            }
+        }
+        self.jet_memo[id.0 as usize] == Some(true)
     }
 
     /// Whether a variable with `target` is reachable from `id`; `into_sums`: whether to look
@@ -1425,12 +1492,63 @@ fn is_const_name(name: &str) -> bool {
             .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
 }
 
-/// `expr` as written, without enclosing parentheses.
+/// Expressions of at most this many nodes are quoted in full in the guards' messages; larger
+/// ones with their operands elided, so that a guard's text costs constant time and nested
+/// guards (a chain of `atan2`) emit text linear, not quadratic, in the depth.
+const QUOTED_NODES: usize = 48;
+
+/// `expr` as written, without enclosing parentheses; elided past [`QUOTED_NODES`] nodes (as
+/// `(…).sin()`, `… + …`, `f64::atan2(…)`).
 fn text_of(mut expr: &Expr) -> String {
     while let Expr::Paren(p) = expr {
         expr = &p.expr;
     }
-    tidy(&expr.to_token_stream().to_string())
+    if has_at_most(expr, QUOTED_NODES) {
+        return tidy(&expr.to_token_stream().to_string());
+    }
+    match expr {
+        Expr::MethodCall(m) if m.args.is_empty() => format!("(…).{}()", m.method),
+        Expr::MethodCall(m) => format!("(…).{}(…)", m.method),
+        Expr::Binary(b) => format!("… {} …", b.op.to_token_stream()),
+        Expr::Unary(_) => "-(…)".to_string(),
+        Expr::Call(c) if has_at_most(&c.func, QUOTED_NODES) => {
+            format!("{}(…)", tidy(&c.func.to_token_stream().to_string()))
+        }
+        _ => "…".to_string(),
+    }
+}
+
+/// Whether `expr` has at most `budget` expression nodes, counted without recursion and
+/// stopping past the budget (constant time for a large expression).
+fn has_at_most(expr: &Expr, budget: usize) -> bool {
+    let mut stack = vec![expr];
+    let mut count = 0;
+    while let Some(e) = stack.pop() {
+        count += 1;
+        if count > budget {
+            return false;
+        }
+        match e {
+            Expr::Binary(b) => stack.extend([&*b.left, &*b.right]),
+            Expr::Unary(u) => stack.push(&u.expr),
+            Expr::Paren(p) => stack.push(&p.expr),
+            Expr::Group(g) => stack.push(&g.expr),
+            Expr::Cast(c) => stack.push(&c.expr),
+            Expr::Index(i) => stack.extend([&*i.expr, &*i.index]),
+            Expr::MethodCall(m) => {
+                stack.push(&m.receiver);
+                stack.extend(m.args.iter());
+            }
+            Expr::Call(c) => {
+                stack.push(&c.func);
+                stack.extend(c.args.iter());
+            }
+            Expr::Lit(_) | Expr::Path(_) => {}
+            // anything else (an error elsewhere) counts as the whole budget
+            _ => count = budget,
+        }
+    }
+    true
 }
 
 /// `expr` as the receiver of a method call: parenthesised unless it is an atom.

@@ -169,3 +169,91 @@ fn sizes_beyond_the_limits_are_errors() {
         assert!(e.contains("loop too long to unroll"), "{e}");
     }
 }
+
+/// The work of expanding an order-1 Lagrangian on R^2 ending in `+ tail`, on rustc's stack:
+/// graph nodes and the length of the code, or the error messages.
+fn work(tail: String) -> Result<(usize, usize), String> {
+    on_rustc_stack(move || {
+        let item = format!(
+            "fn l(q: [f64; 2], dq: [f64; 2]) -> f64 {{ 0.5 * (dq[0] * dq[0] + dq[1] * dq[1]) + {tail} }}"
+        );
+        let (attr, item) = ("order = 1".parse().unwrap(), item.parse().unwrap());
+        let (result, stats) = retract_codegen::expansion_stats(attr, item);
+        match result {
+            Ok(tokens) => Ok((stats.graph_nodes, tokens.to_string().len())),
+            Err(e) => Err(e.into_iter().map(|e| e.to_string()).collect()),
+        }
+    })
+}
+
+/// Asserts that `make(4 m)` costs at most 4.5 times `make(m)` in graph nodes and in code:
+/// linear work in the depth or length (quadratic would be 16 times).
+fn linear(what: &str, m: usize, make: impl Fn(usize) -> String) {
+    let small = work(make(m)).unwrap_or_else(|e| panic!("{what} {m}: {e}"));
+    let large = work(make(4 * m)).unwrap_or_else(|e| panic!("{what} {}: {e}", 4 * m));
+    let ratio = |a: usize, b: usize| b as f64 / a as f64;
+    assert!(
+        ratio(small.0, large.0) < 4.5 && ratio(small.1, large.1) < 4.5,
+        "{what}: {m} -> {small:?}, {} -> {large:?} (nodes, bytes)",
+        4 * m
+    );
+}
+
+#[test]
+fn deep_chains_long_sums_and_products_expand_in_linear_work() {
+    // a chain of calls is lowered without recursion (5000 `.sin()` took more than a minute,
+    // then were refused past 512 levels); guarded calls quote their argument in constant
+    // space (nested `atan2` quoted each argument in full: quadratic code)
+    linear("sin chain", 1250, |m| format!("q[0]{}", ".sin()".repeat(m)));
+    linear("atan2 chain", 125, |m| {
+        format!("q[0]{}", ".atan2(dq[1])".repeat(m))
+    });
+    linear("sqrt chain", 125, |m| {
+        format!("q[0]{}", ".exp().sqrt()".repeat(m))
+    });
+    // nested in parentheses, within the bracket limit
+    let nested = |m: usize| {
+        let mut e = String::from("q[0]");
+        for _ in 0..m {
+            e = format!("({e}).sin().atan2(q[1])");
+        }
+        e
+    };
+    linear("nested atan2", 60, nested);
+    // a sum is lowered without a level of nesting per term (1000 terms were refused)
+    let sum = |m: usize| {
+        let terms: Vec<String> = (0..m)
+            .map(|i| format!("{}.5 * q[{}] * q[1]", i % 9, i % 2))
+            .collect();
+        terms.join(" + ")
+    };
+    linear("sum", 1250, sum);
+    let product = |m: usize| {
+        let factors: Vec<String> = (0..m).map(|i| format!("(q[{}] + {i}.5)", i % 2)).collect();
+        factors.join(" * ")
+    };
+    linear("product", 250, product);
+}
+
+#[test]
+fn brackets_nested_past_the_limit_are_one_error() {
+    // syn parses nested brackets by recursion: 5000 levels overflowed the stack
+    for (what, open, close) in [
+        ("parentheses", "(", ").sin()"),
+        ("atan2", "f64::atan2(", ", q[1])"),
+        ("sums", "(1.0 + ", ")"),
+    ] {
+        for depth in [257, 5000] {
+            let e =
+                work(format!("{}q[0]{}", open.repeat(depth), close.repeat(depth))).expect_err(what);
+            assert_eq!(
+                e.matches("brackets nest deeper than 256 levels").count(),
+                1,
+                "{what} {depth}: {e}"
+            );
+        }
+        // at the limit (the body's braces and the call's parentheses are two more)
+        let e = work(format!("{}q[0]{}", open.repeat(250), close.repeat(250)));
+        assert!(e.is_ok(), "{what} 250: {e:?}");
+    }
+}

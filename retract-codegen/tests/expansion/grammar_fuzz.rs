@@ -7,7 +7,8 @@
 //! the work bounded in expression-graph nodes (`expansion_stats`), not wall time.
 //!
 //! Each run takes `CASES` cases from a fixed seed and `CASES` from a random one (printed; set
-//! `RETRACT_FUZZ_SEED` to replay it). A sample of well-behaved Lagrangians from the fixed
+//! `RETRACT_FUZZ_SEED` to replay it, `RETRACT_FUZZ_CASES` for more cases per seed). The
+//! generated bodies include helper fns (some recursive: an error) and deep nesting. A sample of well-behaved Lagrangians from the fixed
 //! seed is compiled in the workspace's `tests/integrators/fuzz_corpus.rs`, whose derivatives are checked
 //! against finite differences there; `the_compiled_corpus_is_the_fixed_seed_sample`
 //! keeps that file equal to what the generator makes (`RETRACT_BLESS_CORPUS=1` rewrites it).
@@ -18,8 +19,18 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use proc_macro2::TokenStream;
 use retract_codegen::{ExpansionStats, expand, expansion_stats};
 
-/// Cases per seed (two seeds per run).
+/// Cases per seed (two seeds per run: 2000 cases); `RETRACT_FUZZ_CASES` sets another count
+/// per seed (the long run: `RETRACT_FUZZ_CASES=5000 cargo test -p retract-codegen --test
+/// expansion grammar_fuzz`, 10 000 cases).
 const CASES: usize = 1000;
+
+/// The cases per seed of this run.
+fn cases() -> usize {
+    std::env::var("RETRACT_FUZZ_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(CASES)
+}
 const FIXED_SEED: u64 = 0x5eed_0014_0010;
 /// Compiled sample size.
 const CORPUS: usize = 20;
@@ -200,6 +211,8 @@ impl Scope {
             }
             7 | 8 => self.binary_method(rng, d),
             9 if rng.chance(0.3) => self.long_sum(rng),
+            9 if rng.chance(0.05) => self.deep(rng),
+            9 if rng.chance(0.1) && !self.smooth => format!("h0({})", self.expr(rng, d)),
             10 if rng.chance(0.1) => rng.pick(UNSUPPORTED).replace("q0", &self.leaf(rng)),
             _ => format!("(({}))", self.expr(rng, d)),
         }
@@ -251,6 +264,35 @@ impl Scope {
         }
         out.push(')');
         out
+    }
+
+    /// Deep nesting: a chain of up to 300 calls, brackets nested up to 150 levels, or a
+    /// product of up to 300 factors (deeper cases, and brackets past the limit, are tested in
+    /// `expansion_limits`).
+    fn deep(&self, rng: &mut Rng) -> String {
+        let m = 1 + rng.below(300);
+        let x = self.leaf(rng);
+        match rng.below(3) {
+            0 => {
+                let calls: Vec<String> = (0..m)
+                    .map(|_| match rng.below(3) {
+                        0 => format!(".atan2({})", self.leaf(rng)),
+                        _ => format!(".{}()", rng.pick(&["sin", "cos", "tanh"])),
+                    })
+                    .collect();
+                format!("{x}{}", calls.concat())
+            }
+            1 => {
+                let m = m / 2;
+                format!("{}{x}{}", "(".repeat(m), ").sin()".repeat(m))
+            }
+            _ => {
+                let factors: Vec<String> = (0..m)
+                    .map(|_| format!("(1.0 + 0.01 * {})", self.leaf(rng)))
+                    .collect();
+                factors.join(" * ")
+            }
+        }
     }
 
     /// Smooth everywhere: every singular operation gets an argument bounded away from its
@@ -371,6 +413,14 @@ fn kinetic(scope: &Scope, rng: &mut Rng) -> String {
 fn body(scope: &mut Scope, rng: &mut Rng) -> String {
     let depth = if scope.smooth { 3 } else { 5 };
     let mut out = String::new();
+    if !scope.smooth {
+        // a helper fn, called by `h0(..)` (and calling another, or itself: an error)
+        let inner = *rng.pick(&["x.sin() * 0.5 + x", "h1(x) * x", "h0(x) + 1.0", "x * x"]);
+        let _ = write!(
+            out,
+            "fn h1(y: f64) -> f64 {{ y.cos() + y }} fn h0(x: f64) -> f64 {{ {inner} }} "
+        );
+    }
     if rng.chance(0.3) {
         out.push_str("const N_I: i32 = 2; const C_0: f64 = 1.25; ");
         scope.consts.push("C_0".into());
@@ -484,12 +534,16 @@ fn check_case(case: &Case, seed: u64, index: usize) -> (bool, ExpansionStats) {
 
 /// Runs `CASES` cases from `seed`; returns (expanded, total graph nodes).
 fn run(seed: u64) -> (usize, usize) {
+    let cases = cases();
     let mut rng = Rng(seed);
+    let mut slowest = std::time::Duration::ZERO;
     let (mut expanded, mut nodes, mut largest, mut ratio) = (0, 0, 0, 0.0_f64);
-    for i in 0..CASES {
+    for i in 0..cases {
         let smooth = rng.chance(0.2);
         let case = generate(&mut rng, smooth, &format!("l{i}"));
+        let start = std::time::Instant::now();
         let (ok, stats) = check_case(&case, seed, i);
+        slowest = slowest.max(start.elapsed());
         expanded += usize::from(ok);
         nodes += stats.graph_nodes;
         largest = largest.max(stats.graph_nodes);
@@ -498,11 +552,12 @@ fn run(seed: u64) -> (usize, usize) {
         ratio = ratio.max(per);
     }
     println!(
-        "seed {seed:#x}: {CASES} cases, {expanded} expanded, {nodes} graph nodes in all, \
-         largest {largest}, at most {ratio:.2} nodes per lowered node and Hessian entry"
+        "seed {seed:#x}: {cases} cases, {expanded} expanded, {nodes} graph nodes in all, \
+         largest {largest}, at most {ratio:.2} nodes per lowered node and Hessian entry, \
+         slowest case {slowest:?}"
     );
     assert!(
-        nodes <= NODES_PER_RUN,
+        nodes <= NODES_PER_RUN * cases / CASES,
         "seed {seed:#x}: {nodes} graph nodes > {NODES_PER_RUN}"
     );
     (expanded, nodes)
@@ -513,8 +568,9 @@ fn fuzzed_lagrangians_of_the_fixed_seed_expand_or_error_without_panic() {
     let (expanded, _) = run(FIXED_SEED);
     // the generator must exercise the expansion, not only the error paths
     assert!(
-        expanded >= CASES / 5,
-        "only {expanded} of {CASES} cases expanded"
+        expanded >= cases() / 5,
+        "only {expanded} of {} cases expanded",
+        cases()
     );
 }
 

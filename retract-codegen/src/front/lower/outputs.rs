@@ -71,8 +71,12 @@ pub fn without_output_marks(function: &syn::ItemFn) -> syn::ItemFn {
 }
 
 /// `item` without the `#[output]` marks if it is a function (else as it is): the original
-/// item emitted beside the errors of a failed expansion.
+/// item emitted beside the errors of a failed expansion. An item nested too deeply to parse
+/// (`util::MAX_GROUP_NESTING`) is returned as it is.
 pub fn item_without_output_marks(item: proc_macro2::TokenStream) -> proc_macro2::TokenStream {
+    if crate::util::check_group_nesting(&item).is_err() {
+        return item;
+    }
     match syn::parse2::<syn::ItemFn>(item.clone()) {
         Ok(function) => quote::ToTokens::into_token_stream(without_output_marks(&function)),
         Err(_) => item,
