@@ -57,7 +57,9 @@ pub struct StepOptions {
     pub locate_crossing: bool,
     /// In [`trajectory`]: when a step fails to converge, retry it as 2, 4, ... substeps, at
     /// most this many halvings (reported in [`StepReport::halvings`]); 0 (the default) stops
-    /// at the first failure. Domain violations are never retried.
+    /// at the first failure. Domain violations are never retried. At most [`MAX_HALVINGS`]
+    /// halvings ($2^{30}$ substeps) are tried, whatever this says: a larger value acts as
+    /// [`MAX_HALVINGS`], so that [`StepReport::halvings`] $= m$ always means $2^m$ substeps.
     pub max_halvings: u32,
     /// In [`crate::ReducedStepper`]: recover the step's unknowns with the rounding corrections
     /// of the cached factors, $w = (T + T_{lo}) z_0 - (A^{-1} + A^{-1}_{lo}) n$
@@ -177,6 +179,10 @@ impl StepOptions {
         self.newton.validate()
     }
 }
+
+/// The most halvings a trajectory tries on a failed step ([`StepOptions::max_halvings`]):
+/// the last retry is $2^{30}$ substeps of $h / 2^{30}$.
+pub const MAX_HALVINGS: u32 = 30;
 
 /// The largest [`StepOptions::max_chord_pieces`]: a step's chord is cut into at most this
 /// many pieces (one `check_domain` each, about 10 ns for the planar rigid body).
@@ -844,8 +850,10 @@ fn reserve<const S: usize>(trajectory: &mut Trajectory<S>, steps: usize) -> Resu
 }
 
 #[cfg(feature = "std")]
-/// One step of size `h`, retried as `2^m` substeps (m = 1..=`max_halvings`) when Newton
-/// fails; domain violations and invalid arguments are not retried.
+/// One step of size `h`, retried as $2^m$ substeps, $m = 1, \dots, \min(m_{\max}, 30)$
+/// ($m_{\max}$ = [`StepOptions::max_halvings`], 30 = [`MAX_HALVINGS`]) when Newton fails,
+/// the first that succeeds reported with `halvings` $= m$; domain violations and invalid
+/// arguments are not retried.
 fn step_with_halving<const S: usize>(
     one: &mut impl OneStep<S>,
     z0: &SVector<f64, S>,
@@ -856,11 +864,11 @@ fn step_with_halving<const S: usize>(
         Ok(done) => return Ok(done),
         Err(e) => e,
     };
-    for halvings in 1..=options.max_halvings {
+    for halvings in 1..=options.max_halvings.min(MAX_HALVINGS) {
         if matches!(error, Error::Domain(_) | Error::InvalidArgument { .. }) {
             break;
         }
-        let pieces = 1usize << halvings.min(30);
+        let pieces = 1usize << halvings;
         let sub = h / pieces as f64;
         let mut z = *z0;
         let mut report = StepReport {
@@ -943,6 +951,61 @@ mod tests {
         let read: StepOptions = serde_json::from_value(json)?;
         assert!(read.compensated);
         assert_eq!(read, StepOptions::default());
+        Ok(())
+    }
+}
+
+#[cfg(all(test, feature = "std"))]
+mod halving {
+    use nalgebra::SVector;
+
+    use super::{MAX_HALVINGS, StepOptions, StepReport, step_with_halving};
+    use crate::Error;
+
+    /// The result of a one-step map.
+    type Stepped = Result<(SVector<f64, 1>, StepReport), Error>;
+
+    /// A one-step map that converges only for steps of at most `largest`, counting its calls
+    /// and keeping the smallest step it was asked for.
+    fn fails_above<'a>(
+        largest: f64,
+        calls: &'a mut usize,
+        smallest: &'a mut f64,
+    ) -> impl FnMut(&SVector<f64, 1>, f64, &StepOptions) -> Stepped + 'a {
+        move |z, h, _| {
+            *calls += 1;
+            *smallest = smallest.min(h);
+            if h <= largest {
+                Ok((z.add_scalar(h), StepReport::default()))
+            } else {
+                Err(Error::NoConvergence {
+                    iterations: 1,
+                    residual_norm: 1.0,
+                })
+            }
+        }
+    }
+
+    #[test]
+    fn the_halving_count_is_the_base_two_log_of_the_substeps() -> Result<(), Error> {
+        let z0 = SVector::<f64, 1>::zeros();
+        let options = StepOptions::default().with_max_halvings(40);
+        // converges at a quarter step: 2 halvings, 1 + 1 + 4 calls, the whole step taken
+        let (mut calls, mut smallest) = (0, f64::INFINITY);
+        let mut one = fails_above(0.25, &mut calls, &mut smallest);
+        let (z1, report) = step_with_halving(&mut one, &z0, 1.0, &options)?;
+        drop(one);
+        assert_eq!(report.halvings, 2);
+        assert!((z1[0] - 1.0).abs() < 1e-15);
+        assert_eq!((calls, smallest), (1 + 1 + 4, 0.25));
+        // never converges: one try per count up to the cap, the last at h / 2^30, none after
+        // (the count went on to 40 while the pieces stopped at 2^30)
+        let (mut calls, mut smallest) = (0, f64::INFINITY);
+        let mut one = fails_above(0.0, &mut calls, &mut smallest);
+        assert!(step_with_halving(&mut one, &z0, 1.0, &options).is_err());
+        drop(one);
+        assert_eq!(calls, 1 + MAX_HALVINGS as usize);
+        assert_eq!(smallest, 1.0 / f64::from(1u32 << MAX_HALVINGS));
         Ok(())
     }
 }
