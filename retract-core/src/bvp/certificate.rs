@@ -107,9 +107,9 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
 pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
-    steps: usize,
     pool: &mut Pool<N, X>,
 ) -> f64 {
+    let steps = riccati.steps();
     let dim = (steps - 1) * X + steps * N;
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector

@@ -464,20 +464,21 @@ where
             riccati.recycle(&mut pool);
             Ok(None)
         };
-        let mut found = Err(Failure::Regularization);
-        if last < 1e-8 {
-            found = factor(0.0).and_then(|r| r.map(|r| (r, 0.0)).ok_or(Failure::Regularization));
-        }
+        // (no correction first; then rho growing until the inertia is right, or a failure)
+        let mut found = if last < 1e-8 {
+            factor(0.0).map(|r| r.map(|r| (r, 0.0)))
+        } else {
+            Ok(None)
+        };
         let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
-        while matches!(found, Err(Failure::Regularization)) && rho < 1e40 {
-            found =
-                factor(h * rho).and_then(|r| r.map(|r| (r, rho)).ok_or(Failure::Regularization));
+        while matches!(found, Ok(None)) && rho < 1e40 {
+            found = factor(h * rho).map(|r| r.map(|r| (r, rho)));
             rho *= if last > 0.0 { 8.0 } else { 100.0 };
         }
         if let Some(base) = base {
             self.pool.borrow_mut().stages.give(base);
         }
-        found
+        found?.ok_or(Failure::Regularization)
     }
 
     /// When the wall-time budget runs out: the start of the solve plus
@@ -508,14 +509,13 @@ where
         let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
         let mut pool = self.pool.borrow_mut();
-        let mut with_inequalities = pool.gradients.take(models.cost_gradient.len());
-        let gradients = if barrier.at_steps() > 0 {
-            with_inequalities.extend_from_slice(&models.cost_gradient);
-            barrier.lagrangian_gradients(&mut with_inequalities, &models.inequalities, z, h);
-            &with_inequalities
-        } else {
-            &models.cost_gradient
-        };
+        let with_inequalities = (barrier.at_steps() > 0).then(|| {
+            let mut g = pool.gradients.take(models.cost_gradient.len());
+            g.extend_from_slice(&models.cost_gradient);
+            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, h);
+            g
+        });
+        let gradients = with_inequalities.as_ref().unwrap_or(&models.cost_gradient);
         let end = (
             &models.terminal_gradient,
             &models.terminal.fixed,
@@ -534,7 +534,9 @@ where
             end,
             momenta,
         );
-        pool.gradients.give(with_inequalities);
+        if let Some(g) = with_inequalities {
+            pool.gradients.give(g);
+        }
         pool.jets.give(nodes);
         let complementarity = z
             .iter()
@@ -597,7 +599,7 @@ where
             cost,
             iterations,
             certificate,
-            violations: self.problem.violations(iterate, h, theta).0,
+            violations: self.problem.violations(iterate, theta).0,
             duals,
         }
     }
@@ -772,28 +774,28 @@ where
             let complementarity = st.barrier.complementarity().0;
             // converged, or at the acceptable level with no progress left but rounding
             let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
-            let sub = if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
-                match self.finish(point, &models, sub, iterations) {
-                    Finished::Plan(plan) => {
-                        self.give_models(models);
-                        return Ok((plan, true));
+            let mut sub =
+                if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
+                    match self.finish(point, &models, sub, iterations) {
+                        Finished::Plan(plan) => {
+                            self.give_models(models);
+                            return Ok((plan, true));
+                        }
+                        Finished::Failed(failure, certificate, sub) => {
+                            return Err(fail(failure, models.cost, certificate, sub.momenta));
+                        }
+                        Finished::Not(sub) => sub,
                     }
-                    Finished::Failed(failure, certificate, sub) => {
-                        return Err(fail(failure, models.cost, certificate, sub.momenta));
-                    }
-                    Finished::Not(sub) => sub,
-                }
-            } else {
-                sub
-            };
+                } else {
+                    sub
+                };
             let out_of_time = self.out_of_time();
             if iterations == options.max_iterations && self.real_time && !out_of_time {
                 let point = (&st.iterate, &st.y[..], &st.barrier);
-                let plan = self.plan(point, models.cost, done, sub.momenta, sub.certificate);
+                let momenta = core::mem::take(&mut sub.momenta);
+                let plan = self.plan(point, models.cost, done, momenta, sub.certificate);
                 self.give_models(models);
-                let mut pool = self.pool.borrow_mut();
-                sub.riccati.recycle(&mut pool);
-                sub.direction.recycle(&mut pool);
+                self.give_subproblem(sub);
                 return Ok((plan, false));
             }
             if iterations == options.max_iterations || out_of_time {
@@ -891,8 +893,7 @@ where
         if !matches!(failure, Failure::Regularization | Failure::LineSearch) {
             return failure;
         }
-        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
-        match self.problem.violations(iterate, h, theta) {
+        match self.problem.violations(iterate, self.dynamics.theta) {
             (violations, Some(worst))
                 if violations.imposed().is_nan()
                     || violations.imposed() > self.options.tolerance =>
@@ -1128,7 +1129,7 @@ where
         if self.options.min_eigenvalue && models.terminal.fixed.iter().all(|f| *f != 0.0) {
             let pool = &mut *self.pool.borrow_mut();
             certificate.min_reduced_hessian_eig =
-                min_reduced_eigenvalue(exact, &self.dynamics, self.problem.steps, pool);
+                min_reduced_eigenvalue(exact, &self.dynamics, pool);
         }
         Ok(certificate)
     }

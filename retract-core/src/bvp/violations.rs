@@ -131,12 +131,11 @@ impl Worst {
 impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     OptimalControlProblem<'_, Sys, N, K, X>
 {
-    /// The violations of `iterate` (jets and top derivatives) with step `h` and `theta`, and
-    /// the worst constraint at a node or evaluation point.
+    /// The violations of `iterate` (jets and top derivatives, the problem's steps) with
+    /// `theta`, and the worst constraint at a node or evaluation point.
     pub(super) fn violations(
         &self,
         iterate: &Iterate<N, X>,
-        h: f64,
         theta: f64,
     ) -> (Violations, Option<Infeasibility>) {
         let zero = SVector::<f64, N>::zeros();
@@ -165,7 +164,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 };
                 midpoints.see(g.value(&xb, u).abs(), constraint, Location::Step(i));
             }
-            self.between(iterate, i, h, &mut between);
+            self.between(iterate, i, &mut between);
         }
         let worst = [nodes.at, midpoints.at]
             .into_iter()
@@ -181,7 +180,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 
     /// The node inequalities on the interpolant inside step `i` (the Hermite polynomial
     /// between its end jets, [`interpolant_weights`]).
-    fn between(&self, iterate: &Iterate<N, X>, i: usize, h: f64, worst: &mut Worst) {
+    fn between(&self, iterate: &Iterate<N, X>, i: usize, worst: &mut Worst) {
         let mut at_nodes = self
             .inequalities
             .iter()
@@ -190,14 +189,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         if at_nodes.peek().is_none() {
             return;
         }
-        // (the problem's own step, the usual case, has its weights made once)
-        let own = h == self.t_end / self.steps as f64;
-        let other = (!own).then(|| interpolant_weights(h, K)).flatten();
-        let Some(weights) = (if own {
-            self.placed().interpolant.as_ref()
-        } else {
-            other.as_ref()
-        }) else {
+        let Some(weights) = &self.placed().interpolant else {
             return;
         };
         let (x0, x1) = (&iterate.x[i], &iterate.x[i + 1]);

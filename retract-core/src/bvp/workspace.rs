@@ -99,13 +99,8 @@ impl<const N: usize, const X: usize> Pool<N, X> {
 /// directions and plans, each vector kept with its capacity. It grows until it holds as many
 /// vectors as a solve of the problem needs at once; then a solve allocates nothing
 /// ([`super::OptimalControlProblem::solve_with`]). One per thread of solves: a workspace is
-/// borrowed mutably by one solve at a time.
-///
-/// ```
-/// # use retract::bvp::Workspace;
-/// let mut workspace = Workspace::<2, 4>::new();
-/// # let _ = &mut workspace;
-/// ```
+/// borrowed mutably by one solve at a time. The receding-horizon loop of
+/// [`super::OptimalControlProblem::solve_with`]'s example shows its use.
 pub struct Workspace<const N: usize, const X: usize> {
     pub(super) pool: RefCell<Pool<N, X>>,
 }
