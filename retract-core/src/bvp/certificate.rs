@@ -3,7 +3,8 @@
 
 use nalgebra::SVector;
 
-use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel};
+use super::dynamics::Dynamics;
+use super::riccati::{Direction, Riccati, StageLinear, StageModel};
 use super::workspace::Pool;
 use crate::newton::max_abs;
 

@@ -7,7 +7,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::guess::Hermite;
-use super::optimize::blocks;
+use super::iterate::blocks;
 use crate::{Gradient, Hessian, JetFunction, VectorJetFunction};
 
 /// A variable of a step that a bound applies to.

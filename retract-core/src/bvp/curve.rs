@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::optimize::Iterate;
+use super::iterate::Iterate;
 use crate::state::{Jet, State};
 use crate::{Error, Lagrangian, LiftedSystem};
 

@@ -82,8 +82,10 @@ mod constrain;
 mod constraints;
 mod curve;
 mod duals;
+mod dynamics;
 mod extrapolate;
 mod guess;
+mod iterate;
 mod optimize;
 mod plan;
 mod refine;
@@ -102,7 +104,6 @@ pub use violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations}
 pub use workspace::Workspace;
 
 mod root_finder;
-mod shift;
 
 pub use root_finder::{
     BoundaryValueProblem, BvpOptions, BvpSolution, ClearanceFn, Guess, LinearSolver, continuation,

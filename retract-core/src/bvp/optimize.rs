@@ -32,9 +32,10 @@ use nalgebra::SVector;
 
 use super::constraints::{Inequality, Placement, SAMPLE_MAX_ORDER, Sample};
 use super::curve::Curve;
+use super::dynamics::Dynamics;
 use super::guess::Hermite;
+use super::iterate::{Iterate, blocks};
 use super::plan::{Failure, Plan, PlanError, RealTime};
-use super::riccati::Dynamics;
 use super::sqp::Sqp;
 use super::workspace::Workspace;
 use crate::{DomainViolation, Error, JetFunction, Lagrangian, LiftedSystem};
@@ -483,20 +484,6 @@ fn free_components<const X: usize>(mask: &mut SVector<f64, X>, components: &[usi
         }
         None => false,
     })
-}
-
-/// $x$ as blocks $(x_0, \dots, x_{k-1})$.
-pub(crate) fn blocks<const N: usize, const K: usize, const X: usize>(
-    x: &SVector<f64, X>,
-) -> [SVector<f64, N>; K] {
-    core::array::from_fn(|j| SVector::from_fn(|a, _| x[j * N + a]))
-}
-
-/// The iterate of the optimizer.
-#[derive(Clone)]
-pub(super) struct Iterate<const N: usize, const X: usize> {
-    pub x: Vec<SVector<f64, X>>,
-    pub u: Vec<SVector<f64, N>>,
 }
 
 impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>

@@ -4,9 +4,9 @@
 use nalgebra::SVector;
 
 use super::duals::Duals;
+use super::dynamics::Dynamics;
 use super::guess::Hermite;
-use super::optimize::blocks;
-use super::riccati::Dynamics;
+use super::iterate::blocks;
 use super::violations::{Infeasibility, Violations};
 use crate::{DomainViolation, Error};
 

@@ -10,7 +10,8 @@
 
 use nalgebra::SVector;
 
-use super::riccati::{Direction, Dynamics, Riccati, StageLinear, StageModel, Terminal};
+use super::dynamics::Dynamics;
+use super::riccati::{Direction, Riccati, StageLinear, StageModel, Terminal};
 use super::workspace::Pool;
 
 /// The gradient in $(\delta x_i, \delta u_i)$ of the Lagrangian of stage $i$'s model

@@ -6,7 +6,8 @@ use nalgebra::SVector;
 
 use super::constraints::{ConstraintKind, ConstraintRef};
 use super::guess::Hermite;
-use super::optimize::{Iterate, OptimalControlProblem, blocks};
+use super::iterate::{Iterate, blocks};
+use super::optimize::OptimalControlProblem;
 
 /// The parts each step is cut into to check the interpolant ([`Violations::interpolant`]):
 /// at the 15 points $t_i + j h / 16$, $j = 1, \dots, 15$, inside it.

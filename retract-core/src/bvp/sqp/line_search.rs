@@ -15,7 +15,7 @@ use nalgebra::SVector;
 
 use super::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
-use crate::bvp::optimize::{Iterate, blocks};
+use crate::bvp::iterate::{Iterate, blocks};
 use crate::bvp::plan::Failure;
 use crate::bvp::riccati::Direction;
 use crate::{Lagrangian, LiftedSystem};

@@ -139,7 +139,7 @@ impl<const N: usize, const X: usize> BlockColumn<N, X> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::riccati::Dynamics;
+    use super::super::Dynamics;
     use super::*;
 
     /// Every structured product equals the dense one, for k = 1..3 and several theta.
