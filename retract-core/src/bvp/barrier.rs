@@ -102,7 +102,7 @@ impl Barrier {
     /// complementarity), and an unfinished plan's (a real-time iteration's) goes on from
     /// where it was.
     pub fn warm<const N: usize>(
-        duals: &super::duals::Duals<N>,
+        duals: &super::plan::duals::Duals<N>,
         (count, nodes, steps): (usize, usize, usize),
         floor: f64,
         [mut s, mut z, mut y]: [Vec<f64>; 3],

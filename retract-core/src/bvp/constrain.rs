@@ -5,7 +5,7 @@
 
 use super::constraints::{ConstraintRef, Inequality, Placement, Source, Variable};
 use super::optimize::OptimalControlProblem;
-use super::violations::{Infeasibility, Location};
+use super::plan::violations::{Infeasibility, Location};
 use crate::{JetFunction, VectorJetFunction};
 
 impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>

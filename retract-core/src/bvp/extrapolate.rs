@@ -333,7 +333,7 @@ mod tests {
             momenta: vec![SVector::zeros(); steps + 1],
             cost: 0.0,
             iterations: 0,
-            certificate: super::super::plan::unknown_certificate(),
+            certificate: super::super::plan::certificate::unknown_certificate(),
             violations: Default::default(),
             duals: Default::default(),
         };

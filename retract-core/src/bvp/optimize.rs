@@ -225,7 +225,7 @@ pub(super) struct Placed<'a, const N: usize, const K: usize> {
     /// At the interior nodes.
     pub at_nodes: Vec<Inequality<'a, N, K>>,
     /// The weights of the interpolant inside a step
-    /// ([`super::violations::interpolant_weights`]).
+    /// ([`super::plan::violations::interpolant_weights`]).
     pub interpolant: Option<Vec<f64>>,
 }
 
@@ -355,7 +355,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             } else {
                 placed(Placement::at_nodes)
             };
-            let interpolant = super::violations::interpolant_weights(self.h(), K);
+            let interpolant = super::plan::violations::interpolant_weights(self.h(), K);
             Placed {
                 at_steps,
                 at_nodes,

@@ -10,10 +10,10 @@ use nalgebra::{SMatrix, SVector};
 use super::barrier::Barrier;
 use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
-use super::duals::Duals;
 use super::dynamics::Dynamics;
 use super::iterate::{Iterate, blocks};
 use super::optimize::{OptimalControlProblem, PlanOptions};
+use super::plan::duals::Duals;
 use super::plan::{Certificate, Failure, Plan, PlanError};
 use super::refine::refine;
 use super::riccati::{Direction, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
@@ -748,7 +748,7 @@ where
             let mut models = match self.models(&st.iterate, &st.y, &st.barrier) {
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
-                    let unknown = super::plan::unknown_certificate();
+                    let unknown = super::plan::certificate::unknown_certificate();
                     return Err(fail(Failure::TimeLimit, f64::NAN, unknown, vec![]));
                 }
                 Err(failure) => return Err(PlanError::without_iterate(failure)),
@@ -756,7 +756,7 @@ where
             let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
-                    let mut partial = super::plan::unknown_certificate();
+                    let mut partial = super::plan::certificate::unknown_certificate();
                     partial.feasibility = models.violation_max();
                     let failure = self.name_infeasibility(failure, &st.iterate);
                     return Err(fail(failure, models.cost, partial, vec![]));

@@ -3,49 +3,20 @@
 
 use nalgebra::SVector;
 
-use super::duals::Duals;
+pub(crate) mod certificate;
+pub(crate) mod duals;
+pub(crate) mod failure;
+pub(crate) mod violations;
+
 use super::dynamics::Dynamics;
 use super::guess::Hermite;
 use super::iterate::blocks;
-use super::violations::{Infeasibility, Violations};
-use crate::{DomainViolation, Error};
-
-/// What a returned plan is certified to satisfy.
-///
-/// The residuals of a failed solve's last iterate may be NaN (not computed) or infinite; with
-/// `serde`, a non-finite field is written as the string `"NaN"`, `"inf"` or `"-inf"` and read
-/// back from it (or from `null`, as NaN), so that formats without such numbers (JSON) hold
-/// them; finite fields are plain numbers.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Certificate {
-    /// Max-norm of the gradient of the Lagrangian of the transcription, with the multipliers
-    /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
-    /// unit time relative to the size of the gradient of $L$.
-    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
-    pub stationarity: f64,
-    /// Max-norm of the constraint violation (dynamics defects, boundary data, stage
-    /// equalities).
-    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
-    pub feasibility: f64,
-    /// $\max_j z_j g_j$ over the inequalities $g_j \ge 0$ with their multipliers $z_j$ (0
-    /// without inequalities): how far the interior-point iterate is from complementarity.
-    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
-    pub complementarity: f64,
-    /// Negative eigenvalues of the reduced Hessian (0 for a returned plan).
-    pub negative_directions: usize,
-    /// The smallest eigenvalue of $Z^T \nabla^2 J\thinspace Z$, $Z$ an orthonormal basis of the
-    /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
-    /// u_{N-1})$; positive for a strict local minimum. With inequalities, the active ones
-    /// enter as the penalties of the second-order check (a lower bound on the value on their
-    /// null space too). Exactly 0 where the reduced Hessian is positive semidefinite and
-    /// singular: a minimum, but not a strict one (the cost is flat to second order along
-    /// some direction, e.g. ends that nothing fixes).
-    /// NaN if [`PlanOptions::min_eigenvalue`](super::PlanOptions::min_eigenvalue) is off or the end $x_N$ has free
-    /// components (the inertia count proves positivity either way).
-    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
-    pub min_reduced_hessian_eig: f64,
-}
+use crate::Error;
+pub use certificate::Certificate;
+use certificate::advice;
+use duals::Duals;
+pub use failure::Failure;
+use violations::Violations;
 
 /// A plan: a certified local minimum of the transcription.
 ///
@@ -281,52 +252,6 @@ pub struct RealTime<const N: usize, const X: usize> {
     pub converged: bool,
 }
 
-/// Why the optimizer stopped without a certified plan.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum Failure {
-    /// Invalid input (no iterate).
-    Invalid(Error),
-    /// The first guess leaves the domain of $L$ (e.g. passes through an obstacle) at step
-    /// `step`.
-    GuessOutsideDomain {
-        /// The step.
-        step: usize,
-        /// What was violated.
-        violation: DomainViolation,
-    },
-    /// A model value (cost, gradient, Hessian) was not finite.
-    NonFinite,
-    /// The iteration budget ran out.
-    IterationLimit,
-    /// The wall-time budget ran out.
-    TimeLimit,
-    /// No step along the (descent) direction was accepted.
-    LineSearch,
-    /// The inertia correction reached its cap without making the reduced Hessian definite.
-    Regularization,
-    /// A constraint the interior-point iteration cannot satisfy (refused before iterating):
-    /// its own data contradict themselves or leave no interior (equal sides: write an
-    /// equality), or the fixed start or goal violates it at the node.
-    Infeasible(Infeasibility),
-    /// The iteration stalled at a point that violates a constraint (the inertia correction or
-    /// the line search failed there): the constraint violated most at the last iterate, where,
-    /// and by how much. The constraints may contradict each other there (a point of local
-    /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
-    /// preferred.
-    StalledInfeasible(Infeasibility),
-    /// The KKT conditions hold but the reduced Hessian has negative curvature: a saddle, not
-    /// a minimum. (With 0 negative directions: the second-order check could not be made,
-    /// the stage constraints being dependent at the point. A reduced Hessian that is only
-    /// singular, positive semidefinite, is a minimum flat along some direction: certified
-    /// with [`Certificate::min_reduced_hessian_eig`] 0.)
-    NotAMinimum {
-        /// Negative eigenvalues of the reduced Hessian.
-        negative_directions: usize,
-    },
-}
-
 /// A failed solve: the reason and, where there was one, the last iterate with its residuals
 /// (its `certificate` describes it; it is not a minimum). Its `Debug` output summarises the
 /// iterate instead of listing it.
@@ -339,66 +264,9 @@ pub struct PlanError<const N: usize, const X: usize> {
     pub last: Option<Box<Plan<N, X>>>,
 }
 
-impl core::fmt::Display for Failure {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Failure::Invalid(e) => write!(f, "{e}"),
-            Failure::GuessOutsideDomain { step, violation } => write!(
-                f,
-                "the first guess leaves the domain of the Lagrangian at step {step} \
-                 ({violation}): pass a guess that stays inside it, e.g. around the obstacle"
-            ),
-            Failure::NonFinite => write!(
-                f,
-                "a non-finite cost, gradient or Hessian at an iterate: check the parameters"
-            ),
-            Failure::IterationLimit => write!(
-                f,
-                "no certified minimum within the iteration budget; the last iterate is attached"
-            ),
-            Failure::TimeLimit => write!(
-                f,
-                "the wall-time budget ran out; the best iterate is attached"
-            ),
-            Failure::LineSearch => write!(
-                f,
-                "the line search found no acceptable step (the direction descends, but every \
-                 trial point left the domain or did not decrease the merit function); the \
-                 last iterate is attached"
-            ),
-            Failure::Regularization => write!(
-                f,
-                "the inertia correction could not make the reduced Hessian positive definite"
-            ),
-            Failure::Infeasible(infeasibility) => write!(f, "infeasible: {infeasibility}"),
-            Failure::StalledInfeasible(infeasibility) => write!(
-                f,
-                "stalled at an infeasible point: {infeasibility}; check that the constraints \
-                 can hold together there, or start from a guess that satisfies them (around \
-                 an obstacle, not through it)"
-            ),
-            Failure::NotAMinimum {
-                negative_directions: 0,
-            } => write!(
-                f,
-                "the second-order check failed at the KKT point found: the stage \
-                 constraints are dependent there; remove the redundant ones or start from \
-                 another guess"
-            ),
-            Failure::NotAMinimum {
-                negative_directions,
-            } => write!(
-                f,
-                "the KKT point found is not a minimum: its reduced Hessian has \
-                 {negative_directions} negative eigenvalue(s); start from another guess"
-            ),
-        }
-    }
-}
-
 impl<const N: usize, const X: usize> PlanError<N, X> {
     /// A failure before the first iterate was formed.
-    pub(super) fn without_iterate(failure: Failure) -> Self {
+    pub(crate) fn without_iterate(failure: Failure) -> Self {
         Self {
             failure,
             last: None,
@@ -424,27 +292,6 @@ impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
     }
 }
 
-/// The iterations after which a budget that ran out is not advised to be raised (the
-/// constrained suite's hardest solve needs 1784).
-const LONG_RUN: usize = 2000;
-
-/// What to do about a budget that ran out, from the residuals the last iterate reached after
-/// `iterations`.
-fn advice(c: &Certificate, iterations: usize) -> &'static str {
-    if c.feasibility <= 1e-6 && c.stationarity <= 1e-4 {
-        "the iterate is feasible and nearly stationary: more iterations will not improve it \
-         beyond rounding; a looser tolerance accepts it (or raise the acceptable level)"
-    } else if c.feasibility.is_nan() || c.feasibility > 1e-3 {
-        "the iterate is still far from feasible: start from a guess that satisfies the \
-         constraints, or check that they can hold together"
-    } else if iterations >= LONG_RUN {
-        "the iteration is not settling: more iterations are unlikely to help; start from \
-         another guess (one closer to a solution, or inside the constraints)"
-    } else {
-        "raise max_iterations, or start from a better guess"
-    }
-}
-
 impl<const N: usize, const X: usize> core::fmt::Debug for PlanError<N, X> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         let mut d = f.debug_struct("PlanError");
@@ -461,21 +308,12 @@ impl<const N: usize, const X: usize> core::fmt::Debug for PlanError<N, X> {
 
 impl<const N: usize, const X: usize> std::error::Error for PlanError<N, X> {}
 
-pub(super) fn unknown_certificate() -> Certificate {
-    Certificate {
-        stationarity: f64::NAN,
-        feasibility: f64::NAN,
-        complementarity: f64::NAN,
-        negative_directions: 0,
-        min_reduced_hessian_eig: f64::NAN,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use nalgebra::SVector;
 
-    use super::{Certificate, Duals, LONG_RUN, Plan, Violations, advice};
+    use super::certificate::{LONG_RUN, advice};
+    use super::{Certificate, Duals, Plan, Violations};
     use crate::Error;
 
     fn residuals(stationarity: f64, feasibility: f64) -> Certificate {
@@ -629,7 +467,7 @@ mod tests {
     fn non_finite_fields_round_trip_through_json() {
         let mut plan = edited(|p| {
             p.cost = f64::NAN;
-            p.certificate = super::unknown_certificate();
+            p.certificate = super::certificate::unknown_certificate();
             p.certificate.complementarity = f64::INFINITY;
             p.violations = Violations {
                 nodes: f64::NAN,
@@ -687,7 +525,7 @@ mod tests {
         let json = serde_json::to_string(&plan).unwrap();
         assert_eq!(serde_json::from_str::<Plan<2, 4>>(&json).unwrap(), plan);
         // the certificate alone
-        let json = serde_json::to_string(&super::unknown_certificate()).unwrap();
+        let json = serde_json::to_string(&super::certificate::unknown_certificate()).unwrap();
         let read: Certificate = serde_json::from_str(&json).unwrap();
         assert!(read.stationarity.is_nan() && read.min_reduced_hessian_eig.is_nan());
     }

@@ -1,0 +1,107 @@
+//! Why a solve returns no plan ([`Failure`]) and the message of each reason.
+
+use super::violations::Infeasibility;
+use crate::{DomainViolation, Error};
+
+/// Why the optimizer stopped without a certified plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub enum Failure {
+    /// Invalid input (no iterate).
+    Invalid(Error),
+    /// The first guess leaves the domain of $L$ (e.g. passes through an obstacle) at step
+    /// `step`.
+    GuessOutsideDomain {
+        /// The step.
+        step: usize,
+        /// What was violated.
+        violation: DomainViolation,
+    },
+    /// A model value (cost, gradient, Hessian) was not finite.
+    NonFinite,
+    /// The iteration budget ran out.
+    IterationLimit,
+    /// The wall-time budget ran out.
+    TimeLimit,
+    /// No step along the (descent) direction was accepted.
+    LineSearch,
+    /// The inertia correction reached its cap without making the reduced Hessian definite.
+    Regularization,
+    /// A constraint the interior-point iteration cannot satisfy (refused before iterating):
+    /// its own data contradict themselves or leave no interior (equal sides: write an
+    /// equality), or the fixed start or goal violates it at the node.
+    Infeasible(Infeasibility),
+    /// The iteration stalled at a point that violates a constraint (the inertia correction or
+    /// the line search failed there): the constraint violated most at the last iterate, where,
+    /// and by how much. The constraints may contradict each other there (a point of local
+    /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
+    /// preferred.
+    StalledInfeasible(Infeasibility),
+    /// The KKT conditions hold but the reduced Hessian has negative curvature: a saddle, not
+    /// a minimum. (With 0 negative directions: the second-order check could not be made,
+    /// the stage constraints being dependent at the point. A reduced Hessian that is only
+    /// singular, positive semidefinite, is a minimum flat along some direction: certified
+    /// with [`Certificate::min_reduced_hessian_eig`](crate::bvp::Certificate::min_reduced_hessian_eig) 0.)
+    NotAMinimum {
+        /// Negative eigenvalues of the reduced Hessian.
+        negative_directions: usize,
+    },
+}
+
+impl core::fmt::Display for Failure {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Failure::Invalid(e) => write!(f, "{e}"),
+            Failure::GuessOutsideDomain { step, violation } => write!(
+                f,
+                "the first guess leaves the domain of the Lagrangian at step {step} \
+                 ({violation}): pass a guess that stays inside it, e.g. around the obstacle"
+            ),
+            Failure::NonFinite => write!(
+                f,
+                "a non-finite cost, gradient or Hessian at an iterate: check the parameters"
+            ),
+            Failure::IterationLimit => write!(
+                f,
+                "no certified minimum within the iteration budget; the last iterate is attached"
+            ),
+            Failure::TimeLimit => write!(
+                f,
+                "the wall-time budget ran out; the best iterate is attached"
+            ),
+            Failure::LineSearch => write!(
+                f,
+                "the line search found no acceptable step (the direction descends, but every \
+                 trial point left the domain or did not decrease the merit function); the \
+                 last iterate is attached"
+            ),
+            Failure::Regularization => write!(
+                f,
+                "the inertia correction could not make the reduced Hessian positive definite"
+            ),
+            Failure::Infeasible(infeasibility) => write!(f, "infeasible: {infeasibility}"),
+            Failure::StalledInfeasible(infeasibility) => write!(
+                f,
+                "stalled at an infeasible point: {infeasibility}; check that the constraints \
+                 can hold together there, or start from a guess that satisfies them (around \
+                 an obstacle, not through it)"
+            ),
+            Failure::NotAMinimum {
+                negative_directions: 0,
+            } => write!(
+                f,
+                "the second-order check failed at the KKT point found: the stage \
+                 constraints are dependent there; remove the redundant ones or start from \
+                 another guess"
+            ),
+            Failure::NotAMinimum {
+                negative_directions,
+            } => write!(
+                f,
+                "the KKT point found is not a minimum: its reduced Hessian has \
+                 {negative_directions} negative eigenvalue(s); start from another guess"
+            ),
+        }
+    }
+}
