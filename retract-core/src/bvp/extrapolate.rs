@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
-use super::optimize::{OptimalControlProblem, PlanGuess};
+use super::options::PlanGuess;
 use super::plan::{Failure, Plan, PlanError};
+use super::problem::OptimalControlProblem;
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// A plan extrapolated to $h \to 0$ from the plans with $N$, $2N$ and $4N$ steps

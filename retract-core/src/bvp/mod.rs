@@ -78,28 +78,29 @@
 
 mod barrier;
 mod certificate;
-mod constrain;
 mod constraints;
 mod curve;
 mod dynamics;
 mod extrapolate;
 mod guess;
 mod iterate;
-mod measure;
-mod optimize;
+mod options;
 mod plan;
+mod problem;
 mod refine;
 mod riccati;
+mod solve;
 mod sqp;
 mod workspace;
 
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
-pub use optimize::{MAX_INTERIOR_SAMPLES, OptimalControlProblem, PlanGuess, PlanOptions};
+pub use options::{MAX_INTERIOR_SAMPLES, PlanGuess, PlanOptions};
 pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
+pub use problem::OptimalControlProblem;
 pub use workspace::Workspace;
 
 mod root_finder;

@@ -60,7 +60,7 @@ pub(super) fn advice(c: &Certificate, iterations: usize) -> &'static str {
 }
 
 /// A certificate with nothing computed: the residuals NaN.
-pub(crate) fn unknown_certificate() -> Certificate {
+pub(in crate::bvp) fn unknown_certificate() -> Certificate {
     Certificate {
         stationarity: f64::NAN,
         feasibility: f64::NAN,

@@ -40,7 +40,7 @@ impl<const N: usize> Duals<N> {
     /// Whether these duals fit a problem of `steps` steps with `at_steps` inequalities at
     /// every evaluation point and `at_nodes` at every interior node: the lengths match and
     /// every slack and multiplier is positive and finite.
-    pub(crate) fn fit(&self, steps: usize, at_steps: usize, at_nodes: usize) -> bool {
+    pub(in crate::bvp) fn fit(&self, steps: usize, at_steps: usize, at_nodes: usize) -> bool {
         let (on_steps, on_nodes) = (steps * at_steps, steps.saturating_sub(1) * at_nodes);
         let positive = |v: &[f64]| v.iter().all(|e| *e > 0.0 && e.is_finite());
         self.equalities.len() == steps
@@ -62,7 +62,7 @@ impl<const N: usize> Duals<N> {
     /// Shifts these duals of a plan of `steps` steps one step later, in place
     /// ([`super::Plan::shifted`]): every step's and every interior node's block moved one
     /// forward, the last one repeated.
-    pub(crate) fn shift(&mut self, steps: usize) {
+    pub(in crate::bvp) fn shift(&mut self, steps: usize) {
         let (per_step, per_node) = (
             self.step_slacks.len() / steps.max(1),
             self.node_slacks.len() / steps.saturating_sub(1).max(1),

@@ -3,10 +3,10 @@
 
 use nalgebra::SVector;
 
-pub(crate) mod certificate;
-pub(crate) mod duals;
-pub(crate) mod failure;
-pub(crate) mod violations;
+pub(super) mod certificate;
+pub(super) mod duals;
+pub(super) mod failure;
+pub(super) mod violations;
 
 use super::dynamics::Dynamics;
 use super::guess::Hermite;
@@ -266,7 +266,7 @@ pub struct PlanError<const N: usize, const X: usize> {
 
 impl<const N: usize, const X: usize> PlanError<N, X> {
     /// A failure before the first iterate was formed.
-    pub(crate) fn without_iterate(failure: Failure) -> Self {
+    pub(in crate::bvp) fn without_iterate(failure: Failure) -> Self {
         Self {
             failure,
             last: None,

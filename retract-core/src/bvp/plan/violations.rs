@@ -111,7 +111,7 @@ impl core::fmt::Display for Infeasibility {
 /// [`INTERPOLANT_DIVISIONS`]), $q^{(j)}(t_p) = \sum_{m < k} (a_{pjm} q^{(m)}(0) + b_{pjm}
 /// q^{(m)}(h))$ coordinate by coordinate, with $a_{pjm}$ at index $((p - 1) k + j) 2k + m$
 /// and $b_{pjm}$ $k$ after it. `None` where the interpolation is singular.
-pub(crate) fn interpolant_weights(h: f64, k: usize) -> Option<Vec<f64>> {
+pub(in crate::bvp) fn interpolant_weights(h: f64, k: usize) -> Option<Vec<f64>> {
     // the polynomials of the unit jets: q^(m)(0) = 1 (side 0) or q^(m)(h) = 1 (side 1)
     let unit = |side: usize, m: usize| {
         let mut ends = vec![0.0; 2 * k];

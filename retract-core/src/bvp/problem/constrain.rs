@@ -3,9 +3,9 @@
 //! one, bounds of one variable that exclude each other, equal bounds (an empty interior: an
 //! equality), and fixed boundary data outside a node constraint.
 
-use super::constraints::{ConstraintRef, Inequality, Placement, Source, Variable};
-use super::optimize::OptimalControlProblem;
-use super::plan::violations::{Infeasibility, Location};
+use super::OptimalControlProblem;
+use crate::bvp::constraints::{ConstraintRef, Inequality, Placement, Source, Variable};
+use crate::bvp::plan::violations::{Infeasibility, Location};
 use crate::{JetFunction, VectorJetFunction};
 
 impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
@@ -186,7 +186,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// The first constraint that no point satisfies: a side infinite the wrong way, a lower
     /// side above the upper side of the same constraint or of another bound of the same
     /// variable, or equal sides (no interior: write an equality).
-    pub(super) fn contradiction(&self) -> Option<Infeasibility> {
+    pub(in crate::bvp) fn contradiction(&self) -> Option<Infeasibility> {
         let list = &self.inequalities;
         for lower in list {
             if lower.value.is_infinite() {
@@ -214,7 +214,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 
     /// The first node constraint that the fixed components of the start or the goal violate
     /// (every component fixed: a node constraint there cannot be repaired).
-    pub(super) fn ends_violation(&self) -> Option<Infeasibility> {
+    pub(in crate::bvp) fn ends_violation(&self) -> Option<Infeasibility> {
         let zero = nalgebra::SVector::<f64, N>::zeros();
         let ends = [
             (Location::Start, &self.start, &self.fixed_start),

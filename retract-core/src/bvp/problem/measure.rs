@@ -4,10 +4,10 @@
 
 use nalgebra::SVector;
 
-use super::constraints::{ConstraintKind, ConstraintRef};
-use super::iterate::{Iterate, blocks};
-use super::optimize::OptimalControlProblem;
-use super::plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
+use super::OptimalControlProblem;
+use crate::bvp::constraints::{ConstraintKind, ConstraintRef};
+use crate::bvp::iterate::{Iterate, blocks};
+use crate::bvp::plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 
 /// The running maximum of violations with the constraint that attains it.
 #[derive(Default)]
@@ -35,7 +35,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 {
     /// The violations of `iterate` (jets and top derivatives, the problem's steps) with
     /// `theta`, and the worst constraint at a node or evaluation point.
-    pub(super) fn violations(
+    pub(in crate::bvp) fn violations(
         &self,
         iterate: &Iterate<N, X>,
         theta: f64,

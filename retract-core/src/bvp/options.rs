@@ -1,0 +1,150 @@
+//! How the optimizer solves ([`PlanOptions`]) and where it starts ([`PlanGuess`]).
+
+use std::time::Duration;
+
+use nalgebra::SVector;
+
+use super::curve::Curve;
+use super::plan::Plan;
+
+/// Options of [`OptimalControlProblem::solve`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct PlanOptions {
+    /// The scheme parameter $\theta$ (1/2: midpoint).
+    pub theta: f64,
+    /// Converged when the relative stationarity ([`Certificate::stationarity`](super::Certificate::stationarity)) and the
+    /// constraint violation are both below this.
+    pub tolerance: f64,
+    /// Accepted instead of `tolerance` when the line search has made only rounding-level
+    /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
+    /// acceptable level; the certificate reports the residuals reached.
+    pub acceptable: f64,
+    /// Iteration budget; 3000 by default (IPOPT's): the hard problems of the constrained
+    /// suite need a few hundred to a few thousand iterations (`examples/constrained.rs`).
+    pub max_iterations: usize,
+    /// Wall-time budget, counted from the call to `solve`; `None` for none. The clock is read
+    /// between the phases of an iteration (models, each factorisation of the inertia
+    /// correction, each line-search trial) and every 1024 steps inside the model build and
+    /// the factorisation, so a solve returns [`Failure::TimeLimit`] with the iterate reached
+    /// about one such piece after the budget; the checks of the first guess before the first
+    /// iteration (about 20 ms at 65 536 steps) are not interrupted.
+    pub max_time: Option<Duration>,
+    /// The chord of a step longer than this (max-norm of $x_{i+1} - x_i$) is checked by the
+    /// singularity guard in pieces of at most this length, as
+    /// [`crate::StepOptions::chord_spacing`]; 0.02 by default.
+    pub chord_spacing: f64,
+    /// The most pieces a step's chord is cut into, as
+    /// [`crate::StepOptions::max_chord_pieces`]; 16 by default.
+    pub max_chord_pieces: u32,
+    /// Armijo constant of the line search.
+    pub armijo: f64,
+    /// Step halvings per line search.
+    pub max_backtracks: usize,
+    /// Initial barrier parameter $\mu_0$ of the inequalities, in the units of the transcribed
+    /// problem (IPOPT's `mu_init`, whose default 0.1 it shares): its barrier term is $\mu_0
+    /// \sum \ln s$ over the slacks of every inequality at every node and step.
+    pub initial_barrier: f64,
+    /// Also compute [`Certificate::min_reduced_hessian_eig`](super::Certificate::min_reduced_hessian_eig) (Lanczos on the final
+    /// factorisation, less than one iteration's time); on by default, off in
+    /// [`OptimalControlProblem::solve_real_time`]. The inertia count that proves the reduced
+    /// Hessian positive definite is always done.
+    pub min_eigenvalue: bool,
+    /// Interior sample points per step (0 by default, at most
+    /// [`MAX_INTERIOR_SAMPLES`]): each constraint placed at the nodes (of the jet alone) is
+    /// also imposed at $t_i + \tau h$, $\tau = j / (m + 1)$, $j = 1, \dots, m$, inside every
+    /// step, on the plan's interpolant written in the step's $(x_\theta, u)$ (exact where the
+    /// scheme's equations hold; a sample at the evaluation point itself is skipped). With
+    /// $m = 15$ the samples are the points [`super::Violations::interpolant`] checks, so a
+    /// certified plan's interpolant violation is within the tolerance there. Orders $k \le 4$.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub interior_samples: usize,
+}
+
+/// The most interior samples per step ([`PlanOptions::interior_samples`]).
+pub const MAX_INTERIOR_SAMPLES: usize = 63;
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            theta: 0.5,
+            tolerance: 1e-9,
+            acceptable: 1e-6,
+            max_iterations: 3000,
+            max_time: None,
+            chord_spacing: 0.02,
+            max_chord_pieces: 16,
+            armijo: 1e-4,
+            max_backtracks: 40,
+            initial_barrier: 0.1,
+            min_eigenvalue: true,
+            interior_samples: 0,
+        }
+    }
+}
+
+impl PlanOptions {
+    /// Sets the KKT tolerance.
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+    /// Sets the iteration budget.
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+    /// Sets the wall-time budget.
+    pub fn with_max_time(mut self, max_time: Duration) -> Self {
+        self.max_time = Some(max_time);
+        self
+    }
+    /// Sets $\theta$.
+    pub fn with_theta(mut self, theta: f64) -> Self {
+        self.theta = theta;
+        self
+    }
+    /// Also computes the smallest eigenvalue of the reduced Hessian for the certificate.
+    pub fn with_min_eigenvalue(mut self, min_eigenvalue: bool) -> Self {
+        self.min_eigenvalue = min_eigenvalue;
+        self
+    }
+    /// Imposes the constraints of the jet alone at `samples` interior points of every step
+    /// too ([`Self::interior_samples`]).
+    pub fn with_interior_samples(mut self, samples: usize) -> Self {
+        self.interior_samples = samples;
+        self
+    }
+    /// Sets the chord spacing and the cap on chord pieces of the singularity guard
+    /// ([`Self::chord_spacing`]).
+    pub fn with_chord_check(mut self, spacing: f64, max_pieces: u32) -> Self {
+        self.chord_spacing = spacing;
+        self.max_chord_pieces = max_pieces;
+        self
+    }
+}
+
+/// Where the optimizer starts.
+#[derive(Clone, Copy, Debug)]
+pub enum PlanGuess<'a, const N: usize, const X: usize> {
+    /// The Hermite polynomial of degree $2k-1$ between the boundary jets (for $k = 2$ at rest:
+    /// the smoothstep $q_0 + (q_T - q_0)(3s^2 - 2s^3)$), $u$ its $k$-th derivative at the
+    /// evaluation points.
+    Spline,
+    /// A previous plan with the same number of steps (warm start): its jets and top
+    /// derivatives, and its [`Duals`](super::Duals) where they fit the problem's inequalities (else the
+    /// barrier starts afresh).
+    Plan(&'a Plan<N, X>),
+    /// Jets $x_0, \dots, x_N$ and top derivatives $u_0, \dots, u_{N-1}$ chosen by the caller.
+    Path {
+        /// $x_i = (q, \dots, q^{(k-1)})(t_i)$.
+        x: &'a [SVector<f64, X>],
+        /// $u_i = q^{(k)}$ at the evaluation point of step $i$.
+        u: &'a [SVector<f64, N>],
+    },
+    /// A path $q(t)$ ([`Curve`]: a closure, or waypoints): the library samples the jets
+    /// $x_i = (q, \dots, q^{(k-1)})(t_i)$ and the top derivatives
+    /// $u_i = q^{(k)}((i + \theta) h)$.
+    Curve(&'a Curve<'a, N>),
+}
