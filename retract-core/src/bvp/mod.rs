@@ -77,20 +77,19 @@
 //! ```
 
 mod barrier;
-mod certificate;
 mod constraints;
 mod curve;
 mod dynamics;
 mod extrapolate;
 mod guess;
 mod iterate;
+mod kkt;
 mod options;
 mod plan;
 mod problem;
-mod refine;
-mod riccati;
 mod solve;
 mod sqp;
+mod stack;
 mod workspace;
 
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};

@@ -23,7 +23,7 @@
 //! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
 //! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
 //! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
-//! the reduced Hessian (Lanczos on the inverse, [`super::certificate`]).
+//! the reduced Hessian (Lanczos on the inverse, [`super::kkt::residuals`]).
 
 use std::time::Instant;
 
@@ -229,8 +229,8 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// inequality's linearisation, slack and multiplier.
     fn workspace_bytes(&self) -> usize {
         use core::mem::size_of;
-        let per_step = 3 * size_of::<super::riccati::StageModel<N, X>>()
-            + super::riccati::Riccati::<N, X>::bytes_per_step()
+        let per_step = 3 * size_of::<super::kkt::riccati::StageModel<N, X>>()
+            + super::kkt::riccati::Riccati::<N, X>::bytes_per_step()
             + 8 * size_of::<SVector<f64, X>>()
             + 6 * size_of::<SVector<f64, N>>()
             + 2 * self.inequalities.len()

@@ -8,16 +8,16 @@ use std::time::Instant;
 use nalgebra::{SMatrix, SVector};
 
 use super::barrier::Barrier;
-use super::certificate::{kkt_residuals, min_reduced_eigenvalue};
 use super::constraints::{Inequality, Linearized, flat_hessian, slack_push};
 use super::dynamics::Dynamics;
 use super::iterate::{Iterate, blocks};
+use super::kkt::refine::refine;
+use super::kkt::residuals::{kkt_residuals, min_reduced_eigenvalue};
+use super::kkt::riccati::{Direction, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
 use super::options::PlanOptions;
 use super::plan::duals::Duals;
 use super::plan::{Certificate, Failure, Plan, PlanError};
 use super::problem::OptimalControlProblem;
-use super::refine::refine;
-use super::riccati::{Direction, Riccati, STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
 use super::workspace::Pool;
 use crate::newton::all_finite;
 use crate::{Lagrangian, LiftedSystem};
@@ -199,8 +199,8 @@ where
     /// Gives a subproblem's vectors back to the pool.
     fn give_subproblem(&self, sub: Subproblem<N, X>) {
         let mut pool = self.pool.borrow_mut();
-        sub.riccati.recycle(&mut pool);
-        sub.direction.recycle(&mut pool);
+        sub.riccati.recycle(&mut *pool);
+        sub.direction.recycle(&mut *pool);
         pool.jets.give(sub.momenta);
     }
 
@@ -458,13 +458,13 @@ where
             let clock = (self.deadline(), &mut *pool);
             let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, clock);
             if riccati.interrupted {
-                riccati.recycle(&mut pool);
+                riccati.recycle(&mut *pool);
                 return Err(Failure::TimeLimit);
             }
             if riccati.positive_definite() {
                 return Ok(Some(riccati));
             }
-            riccati.recycle(&mut pool);
+            riccati.recycle(&mut *pool);
             Ok(None)
         };
         // (no correction first; then rho growing until the inertia is right, or a failure)
@@ -712,10 +712,10 @@ where
             pool.pairs.give(filter.into_entries());
         }
         if let Some(direction) = state.full_step {
-            direction.recycle(&mut pool);
+            direction.recycle(&mut *pool);
         }
         if let Some((riccati, _)) = state.kept {
-            riccati.recycle(&mut pool);
+            riccati.recycle(&mut *pool);
         }
     }
 
@@ -741,7 +741,7 @@ where
                 let plan = (rho_last == 0.0)
                     .then(|| self.certify_without_solve(point, &last, iterations))
                     .flatten();
-                last.recycle(&mut self.pool.borrow_mut());
+                last.recycle(&mut *self.pool.borrow_mut());
                 if let Some(plan) = plan {
                     return Ok((plan, true));
                 }
@@ -850,13 +850,13 @@ where
             if alpha == 1.0 && error <= options.tolerance.sqrt() {
                 st.full_step = Some(direction);
             } else {
-                direction.recycle(&mut self.pool.borrow_mut());
+                direction.recycle(&mut *self.pool.borrow_mut());
             }
             // near a solution, one step with this factorisation at the next iterate
             if alpha == 1.0 && rho == 0.0 && !stale && unconstrained && error <= CHORD_ERROR {
                 st.kept = Some((riccati, error));
             } else {
-                riccati.recycle(&mut self.pool.borrow_mut());
+                riccati.recycle(&mut *self.pool.borrow_mut());
             }
         }
     }
@@ -951,7 +951,7 @@ where
         let rho_h = self.dynamics.h * rho;
         let mut pool = self.pool.borrow_mut();
         let stages = &models.stages;
-        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut pool);
+        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut *pool);
         if ill_conditioned {
             let model = (&models.stages[..], &models.terminal);
             for _ in 0..REFINEMENTS {
@@ -1093,7 +1093,7 @@ where
         };
         let result = self.second_order(state, models, exact, certificate);
         if let Some(riccati) = refactored {
-            riccati.recycle(&mut self.pool.borrow_mut());
+            riccati.recycle(&mut *self.pool.borrow_mut());
         }
         result
     }
@@ -1115,7 +1115,7 @@ where
             let definite = shifted.as_ref().is_some_and(|f| f.positive_definite());
             let negative = shifted.map_or(exact.negative, |f| {
                 let negative = f.negative;
-                f.recycle(&mut self.pool.borrow_mut());
+                f.recycle(&mut *self.pool.borrow_mut());
                 negative
             });
             if definite {

@@ -7,43 +7,9 @@ use core::cell::RefCell;
 use nalgebra::SVector;
 
 use super::constraints::Linearized;
+use super::kkt::riccati::{Backward, StageFactor, StageModel, TailFactor, Vectors};
 use super::plan::Plan;
-use super::riccati::{Backward, StageFactor, StageModel, TailFactor};
-
-/// Vectors of one element type, each handed out empty with at least the capacity asked for
-/// and given back when its contents are no longer needed.
-pub(super) struct Stack<T>(Vec<Vec<T>>);
-
-impl<T> Default for Stack<T> {
-    fn default() -> Self {
-        Self(Vec::new())
-    }
-}
-
-impl<T> Stack<T> {
-    /// An empty vector with capacity at least `len`: the smallest kept one that holds it, else
-    /// the largest kept one grown (a new one if none is kept).
-    pub fn take(&mut self, len: usize) -> Vec<T> {
-        let fits = (self.0.iter().enumerate())
-            .filter(|(_, v)| v.capacity() >= len)
-            .min_by_key(|(_, v)| v.capacity());
-        let pick = fits
-            .or_else(|| self.0.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
-            .map(|(i, _)| i);
-        let mut v = pick.map_or_else(Vec::new, |i| self.0.swap_remove(i));
-        v.clear();
-        v.reserve(len);
-        v
-    }
-
-    /// Keeps `v` (emptied) for a later [`Self::take`] (unless it has no capacity).
-    pub fn give(&mut self, mut v: Vec<T>) {
-        if v.capacity() > 0 {
-            v.clear();
-            self.0.push(v);
-        }
-    }
-}
+use super::stack::Stack;
 
 /// The kept vectors of the optimizer, one [`Stack`] per element type.
 #[derive(Default)]
@@ -65,17 +31,17 @@ pub(super) struct Pool<const N: usize, const X: usize> {
 impl<const N: usize, const X: usize> Pool<N, X> {
     /// The number of vectors kept.
     fn kept(&self) -> usize {
-        self.reals.0.len()
-            + self.jets.0.len()
-            + self.tops.0.len()
-            + self.gradients.0.len()
-            + self.stages.0.len()
-            + self.linearized.0.len()
-            + self.factors.0.len()
-            + self.tails.0.len()
-            + self.backward.0.len()
-            + self.pairs.0.len()
-            + self.lanczos.0.len()
+        self.reals.len()
+            + self.jets.len()
+            + self.tops.len()
+            + self.gradients.len()
+            + self.stages.len()
+            + self.linearized.len()
+            + self.factors.len()
+            + self.tails.len()
+            + self.backward.len()
+            + self.pairs.len()
+            + self.lanczos.len()
     }
 
     /// Keeps the vectors of `plan`.
@@ -92,6 +58,27 @@ impl<const N: usize, const X: usize> Pool<N, X> {
         ] {
             self.reals.give(v);
         }
+    }
+}
+
+impl<const N: usize, const X: usize> Vectors<N, X> for Pool<N, X> {
+    fn jets(&mut self) -> &mut Stack<SVector<f64, X>> {
+        &mut self.jets
+    }
+    fn tops(&mut self) -> &mut Stack<SVector<f64, N>> {
+        &mut self.tops
+    }
+    fn factors(&mut self) -> &mut Stack<StageFactor<N, X>> {
+        &mut self.factors
+    }
+    fn tails(&mut self) -> &mut Stack<TailFactor<N, X>> {
+        &mut self.tails
+    }
+    fn backward(&mut self) -> &mut Stack<Backward<N, X>> {
+        &mut self.backward
+    }
+    fn lanczos(&mut self) -> &mut Stack<f64> {
+        &mut self.lanczos
     }
 }
 

@@ -16,8 +16,8 @@ use nalgebra::SVector;
 use super::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::{Iterate, blocks};
+use crate::bvp::kkt::riccati::Direction;
 use crate::bvp::plan::Failure;
-use crate::bvp::riccati::Direction;
 use crate::{Lagrangian, LiftedSystem};
 
 /// IPOPT's constants: $\gamma_\theta$, $\gamma_\varphi$, the switching exponents $s_\theta$,

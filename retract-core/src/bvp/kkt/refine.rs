@@ -10,9 +10,8 @@
 
 use nalgebra::SVector;
 
-use super::dynamics::Dynamics;
-use super::riccati::{Direction, Riccati, StageLinear, StageModel, Terminal};
-use super::workspace::Pool;
+use super::riccati::{Direction, Riccati, StageLinear, StageModel, Terminal, Vectors};
+use crate::bvp::dynamics::Dynamics;
 
 /// The gradient in $(\delta x_i, \delta u_i)$ of the Lagrangian of stage $i$'s model
 /// $\ell_i + y^T (G_x \delta y_x + G_u \delta u + g)$ at `(dx, du)`, with $\rho$ on the
@@ -58,7 +57,7 @@ pub(crate) fn refine<const N: usize, const X: usize>(
     rho: f64,
     r0: &SVector<f64, X>,
     (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
-    (d, pool): (&mut Direction<N, X>, &mut Pool<N, X>),
+    (d, pool): (&mut Direction<N, X>, &mut impl Vectors<N, X>),
 ) {
     let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
     let steps = stages.len();

@@ -33,8 +33,26 @@ use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::dynamics::Dynamics;
-use super::workspace::Pool;
+use crate::bvp::dynamics::Dynamics;
+use crate::bvp::stack::Stack;
+
+/// Where a factorisation, its solves and the eigenvalue of the certificate take their vectors
+/// from and give them back: the solver's workspace, so that a warm re-solve allocates nothing.
+/// One [`Stack`] per element type.
+pub(crate) trait Vectors<const N: usize, const X: usize> {
+    /// Jets: $\delta x$, costates.
+    fn jets(&mut self) -> &mut Stack<SVector<f64, X>>;
+    /// Top derivatives: $\delta u$, stage multipliers.
+    fn tops(&mut self) -> &mut Stack<SVector<f64, N>>;
+    /// The stages' factors.
+    fn factors(&mut self) -> &mut Stack<StageFactor<N, X>>;
+    /// The tail's factors.
+    fn tails(&mut self) -> &mut Stack<TailFactor<N, X>>;
+    /// The backward pass of a solve.
+    fn backward(&mut self) -> &mut Stack<Backward<N, X>>;
+    /// The Lanczos vectors of the certificate's eigenvalue (their own sizes).
+    fn lanczos(&mut self) -> &mut Stack<f64>;
+}
 
 /// One stage's quadratic model: the Hessian blocks and gradient of $h\thinspace L$ in
 /// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
@@ -184,7 +202,7 @@ pub(crate) struct Riccati<const N: usize, const X: usize> {
 }
 
 /// The steps between two looks at the clock in [`Riccati::factor_until`].
-pub(super) const STEPS_PER_CLOCK_CHECK: usize = 1024;
+pub(in crate::bvp) const STEPS_PER_CLOCK_CHECK: usize = 1024;
 
 /// The solution of the quadratic subproblem.
 pub(crate) struct Direction<const N: usize, const X: usize> {
@@ -200,11 +218,11 @@ pub(crate) struct Direction<const N: usize, const X: usize> {
 
 impl<const N: usize, const X: usize> Direction<N, X> {
     /// Gives the direction's vectors back to `pool`.
-    pub fn recycle(self, pool: &mut Pool<N, X>) {
-        pool.jets.give(self.dx);
-        pool.jets.give(self.costate);
-        pool.tops.give(self.du);
-        pool.tops.give(self.multipliers);
+    pub fn recycle(self, pool: &mut impl Vectors<N, X>) {
+        pool.jets().give(self.dx);
+        pool.jets().give(self.costate);
+        pool.tops().give(self.du);
+        pool.tops().give(self.multipliers);
     }
 }
 
@@ -474,7 +492,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         stages: &[StageModel<N, X>],
         rho: f64,
         terminal: &Terminal<X>,
-        pool: &mut Pool<N, X>,
+        pool: &mut impl Vectors<N, X>,
     ) -> Self {
         Self::factor_until(dynamics, stages, rho, terminal, (None, pool))
     }
@@ -486,7 +504,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         stages: &[StageModel<N, X>],
         rho: f64,
         terminal: &Terminal<X>,
-        (deadline, pool): (Option<Instant>, &mut Pool<N, X>),
+        (deadline, pool): (Option<Instant>, &mut impl Vectors<N, X>),
     ) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = stages.len();
@@ -496,8 +514,8 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         }
         let mut sens = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed);
         let free = SMatrix::<f64, X, X>::from_diagonal(&terminal.fixed.map(|f| 1.0 - f));
-        let mut factors = pool.factors.take(steps);
-        let mut tail = pool.tails.take(steps);
+        let mut factors = pool.factors().take(steps);
+        let mut tail = pool.tails().take(steps);
         let mut negative = 0;
         let mut singular = false;
         let mut d = SMatrix::<f64, X, X>::zeros();
@@ -608,9 +626,9 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
     }
 
     /// Gives the factorisation's vectors back to `pool`.
-    pub fn recycle(self, pool: &mut Pool<N, X>) {
-        pool.factors.give(self.stages);
-        pool.tails.give(self.tail);
+    pub fn recycle(self, pool: &mut impl Vectors<N, X>) {
+        pool.factors().give(self.stages);
+        pool.tails().give(self.tail);
     }
 
     /// The factor of step `i`.
@@ -648,7 +666,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         rho: f64,
         r0: &SVector<f64, X>,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
-        pool: &mut Pool<N, X>,
+        pool: &mut impl Vectors<N, X>,
     ) -> Direction<N, X> {
         let theta = dynamics.theta;
         let linear = |i: usize| {
@@ -682,18 +700,18 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         linear: &impl Fn(usize) -> StageLinear<N, X>,
         r0: &SVector<f64, X>,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
-        pool: &mut Pool<N, X>,
+        pool: &mut impl Vectors<N, X>,
     ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let mut backward = pool.backward.take(steps);
+        let mut backward = pool.backward().take(steps);
         let s_start = self.backward(dynamics, linear, (r_end, s_end), &mut backward);
         let mut d = Direction {
-            dx: pool.jets.take(steps + 1),
-            du: pool.tops.take(steps),
-            costate: pool.jets.take(steps),
-            multipliers: pool.tops.take(steps),
+            dx: pool.jets().take(steps + 1),
+            du: pool.tops().take(steps),
+            costate: pool.jets().take(steps),
+            multipliers: pool.tops().take(steps),
         };
         // fixed start components from r0, free ones minimise V_0
         let mut x = r0.component_mul(&self.start_free.map(|f| 1.0 - f));
@@ -742,7 +760,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             d.du.push(u);
             d.dx.push(x);
         }
-        pool.backward.give(backward);
+        pool.backward().give(backward);
         d
     }
 
@@ -849,6 +867,7 @@ pub(crate) struct Backward<const N: usize, const X: usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvp::workspace::Pool;
     use nalgebra::{DMatrix, SymmetricEigen};
 
     /// The Jacobi eigendecomposition of an indefinite symmetric matrix rebuilds it, with
@@ -1048,7 +1067,7 @@ mod tests {
             for v in d.du.iter_mut().chain(d.multipliers.iter_mut()) {
                 *v += SVector::<f64, N>::from_fn(|_, _| perturbation * noise(&mut seed));
             }
-            crate::bvp::refine::refine(
+            crate::bvp::kkt::refine::refine(
                 &riccati,
                 &dynamics,
                 model,
@@ -1181,7 +1200,7 @@ mod tests {
                 let model = (&stages[..], &terminal);
                 let end = (&r_end, &s_end);
                 let pool = &mut Pool::default();
-                crate::bvp::refine::refine(
+                crate::bvp::kkt::refine::refine(
                     &riccati,
                     &dynamics,
                     model,

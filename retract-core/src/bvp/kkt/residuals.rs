@@ -3,9 +3,8 @@
 
 use nalgebra::SVector;
 
-use super::dynamics::Dynamics;
-use super::riccati::{Direction, Riccati, StageLinear, StageModel};
-use super::workspace::Pool;
+use super::riccati::{Direction, Riccati, StageLinear, StageModel, Vectors};
+use crate::bvp::dynamics::Dynamics;
 use crate::newton::max_abs;
 
 /// The multipliers $\mu_i$ of the scheme's $x$-equations
@@ -108,21 +107,21 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
 pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
-    pool: &mut Pool<N, X>,
+    pool: &mut impl Vectors<N, X>,
 ) -> f64 {
     let steps = riccati.steps();
     let dim = (steps - 1) * X + steps * N;
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector
-    let mut seed = pool.lanczos.take(dim);
+    let mut seed = pool.lanczos().take(dim);
     seed.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
-    let mut q = pool.lanczos.take(dim);
+    let mut q = pool.lanczos().take(dim);
     apply_inverse(riccati, dynamics, &seed, &mut q, pool);
-    let (mut q_prev, mut w) = (seed, pool.lanczos.take(dim));
+    let (mut q_prev, mut w) = (seed, pool.lanczos().take(dim));
     q_prev.iter_mut().for_each(|x| *x = 0.0);
     let (mut alphas, mut betas) = (
-        pool.lanczos.take(LANCZOS_STEPS),
-        pool.lanczos.take(LANCZOS_STEPS),
+        pool.lanczos().take(LANCZOS_STEPS),
+        pool.lanczos().take(LANCZOS_STEPS),
     );
     let norm = dot(&q, &q).sqrt();
     let mut largest = f64::NAN;
@@ -154,7 +153,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
         }
     }
     for v in [q, q_prev, w, alphas, betas] {
-        pool.lanczos.give(v);
+        pool.lanczos().give(v);
     }
     1.0 / largest
 }
@@ -169,7 +168,7 @@ fn apply_inverse<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     v: &[f64],
     out: &mut Vec<f64>,
-    pool: &mut Pool<N, X>,
+    pool: &mut impl Vectors<N, X>,
 ) {
     let steps = riccati.steps();
     let inner = (steps - 1) * X;
