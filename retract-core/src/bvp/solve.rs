@@ -1,29 +1,7 @@
-//! The optimizer: SQP on the direct transcription of the lifted-midpoint scheme.
-//!
-//! The boundary-value problem of the scheme is the KKT system of
-//!
-//! $$\min_{x, u}\ J = \sum_{i<N} h\thinspace L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad
-//!   x_{i+1} - x_i = h A x_{\theta,i} + h B u_i, \quad x_0 = a, \quad x_N = b,$$
-//!
-//! with $x_{\theta,i} = (1-\theta) x_i + \theta x_{i+1}$, $A$ the block shift
-//! ($x_j' = x_{j+1}$), $B$ the last block ($x_{k-1}' = u$), and the momenta the multipliers:
-//! $p_{\theta,i} = \theta p_i + (1-\theta) p_{i+1} = \mu_i$, the multiplier of step $i$. The
-//! constraints are linear, so the Hessian of the Lagrangian is the Hessian of $J$, formed from
-//! the generated Hessian of $L$ in $(x, u)$.
-//!
-//! Each iteration solves the quadratic subproblem by a Riccati recursion ([`super::riccati`],
-//! $O(N)$), counts the negative eigenvalues of the reduced Hessian on the way and, while there
-//! are any, adds $h \rho I$ to every stage Hessian (inertia correction as in IPOPT: $\rho$ from
-//! $10^{-4}$, times 8 until the count is 0, a third of the last value at the next iteration),
-//! so every direction descends and iterates are drawn to minima. The step length comes from a
-//! backtracking line search on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$: all constraints),
-//! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
-//! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
-//! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
-//! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
-//! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
-//! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
-//! the reduced Hessian (Lanczos on the inverse, [`super::kkt::residuals`]).
+//! The solve front of [`OptimalControlProblem`]: [`OptimalControlProblem::solve`] and its
+//! variants (in a [`Workspace`], real-time iterations), which check the problem and the
+//! first guess, build the first iterate from the [`PlanGuess`] and run the SQP iteration
+//! ([`super::sqp`]) on it.
 
 use std::time::Instant;
 

@@ -13,7 +13,8 @@
 
 use nalgebra::SVector;
 
-use super::{Models, Sqp};
+use super::filter::Filter;
+use super::state::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::{Iterate, blocks};
 use crate::bvp::kkt::riccati::Direction;
@@ -28,52 +29,6 @@ const S_THETA: f64 = 1.1;
 const S_PHI: f64 = 2.3;
 const DELTA: f64 = 1.0;
 const GAMMA_ALPHA: f64 = 0.05;
-
-/// The filter: pairs $(\theta, \varphi)$ a trial point must not be dominated by, and the
-/// bounds $\theta_{\max} = 10^4 \max(1, \theta_0)$ (no trial point above it) and
-/// $\theta_{\min} = 10^{-4} \max(1, \theta_0)$ (below it, steps that only decrease
-/// $\varphi$ are taken by Armijo's condition) from the violation $\theta_0$ of the first
-/// iterate.
-pub(in crate::bvp) struct Filter {
-    entries: Vec<(f64, f64)>,
-    theta_max: f64,
-    theta_min: f64,
-}
-
-impl Filter {
-    /// An empty filter for a first violation `theta0` (its pairs kept in `entries`).
-    pub fn new(theta0: f64, mut entries: Vec<(f64, f64)>) -> Self {
-        let scale = theta0.max(1.0);
-        entries.clear();
-        Self {
-            entries,
-            theta_max: 1e4 * scale,
-            theta_min: 1e-4 * scale,
-        }
-    }
-
-    /// Its vector of pairs (to keep for a later filter).
-    pub fn into_entries(self) -> Vec<(f64, f64)> {
-        self.entries
-    }
-
-    /// Empties the filter (when $\mu$ changes, the barrier cost changes with it).
-    pub fn reset(&mut self) {
-        self.entries.clear();
-    }
-
-    /// Whether $(\theta, \varphi)$ is dominated by a stored pair or has $\theta \ge
-    /// \theta_{\max}$.
-    fn rejects(&self, theta: f64, phi: f64) -> bool {
-        theta >= self.theta_max || self.entries.iter().any(|(t, p)| theta >= *t && phi >= *p)
-    }
-
-    /// Adds $(\theta, \varphi)$, dropping the pairs it dominates.
-    fn augment(&mut self, theta: f64, phi: f64) {
-        self.entries.retain(|(t, p)| *t < theta || *p < phi);
-        self.entries.push((theta, phi));
-    }
-}
 
 /// An accepted trial point: the iterate, the step length and whether the decrease it was
 /// accepted on is at rounding level.

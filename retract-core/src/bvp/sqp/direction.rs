@@ -1,0 +1,164 @@
+//! The direction phase: the subproblem at the models of an iterate, solved by the Riccati
+//! factorisation with the inertia correction (or, near a solution, the kept factorisation
+//! of the last iterate: a simplified Newton step), refined where the barrier makes it
+//! ill-conditioned, with the multipliers, residuals and errors that go with it.
+
+use super::state::{Models, Sqp, Subproblem};
+use crate::bvp::barrier::Barrier;
+use crate::bvp::kkt::refine::refine;
+use crate::bvp::kkt::riccati::{Riccati, StageModel};
+use crate::bvp::plan::Failure;
+use crate::{Lagrangian, LiftedSystem};
+
+/// The ratio $z / s$ of an inequality above which the subproblem's solution is refined
+/// ([`refine`]), and the number of refinement steps.
+const REFINE_RATIO: f64 = 1e6;
+const REFINEMENTS: usize = 2;
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// The subproblem at `models`. With the factorisation `kept` of the previous iterate
+    /// (whose error was $e_{\rm prev}$), a simplified Newton step: taken if its predicted error
+    /// from here, about $e^2 / e_{\rm prev}$ (the kept factorisation is off by about the last
+    /// step, $e_{\rm prev}$), is below the tolerance. Otherwise, or without `kept`, a new
+    /// inertia-corrected factorisation ([`Self::factor_corrected`], whose failure is
+    /// returned). (A kept factorisation was positive definite without correction, so the
+    /// negative directions reported with it, 0, are those of the previous iterate.)
+    pub(super) fn subproblem(
+        &self,
+        models: &mut Models<N, X>,
+        barrier: &Barrier,
+        kept: Option<(Riccati<N, X>, f64)>,
+        rho_last: f64,
+    ) -> Result<Subproblem<N, X>, Failure> {
+        if let Some((riccati, e_prev)) = kept {
+            let sub = self.solved((models, barrier), riccati, 0.0, true);
+            let tolerance = self.options.tolerance;
+            if sub.error <= tolerance || sub.error * sub.error <= tolerance * e_prev {
+                return Ok(sub);
+            }
+            self.give_subproblem(sub);
+        }
+        let (riccati, rho) = self.factor_corrected(models, barrier, rho_last)?;
+        Ok(self.solved((models, barrier), riccati, rho, false))
+    }
+
+    /// The subproblem solved with the factorisation `riccati` (inertia correction `rho`;
+    /// `stale` if it is the previous iterate's): its direction (refined [`REFINEMENTS`] times
+    /// where an active inequality's barrier Hessian $h z / s \nabla g \nabla g^T$ is
+    /// [`REFINE_RATIO`] above the rest: it costs the solve digits), the multipliers and
+    /// residuals that go with it, and the errors of the problem and of the barrier problem.
+    pub(super) fn solved(
+        &self,
+        (models, barrier): (&Models<N, X>, &Barrier),
+        riccati: Riccati<N, X>,
+        rho: f64,
+        stale: bool,
+    ) -> Subproblem<N, X> {
+        let ill_conditioned =
+            (barrier.z.iter().zip(&barrier.s)).any(|(z, s)| *z > REFINE_RATIO * s);
+        let (r0, end) = (&models.r0, (&models.r_end, &models.terminal_gradient));
+        let rho_h = self.dynamics.h * rho;
+        let mut pool = self.pool.borrow_mut();
+        let stages = &models.stages;
+        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut *pool);
+        if ill_conditioned {
+            let model = (&models.stages[..], &models.terminal);
+            for _ in 0..REFINEMENTS {
+                let d = (&mut direction, &mut *pool);
+                refine(&riccati, &self.dynamics, model, rho_h, r0, end, d);
+            }
+        }
+        // the multipliers of the inequalities that go with the subproblem's solution: the
+        // primal-dual step's, near a solution z + dz = (mu - z ds) / s (with the current z
+        // the residual would measure dz, whose rounding z/s eps |g| swamps it there)
+        let (ds, mut z) = (
+            pool.reals.take(barrier.s.len()),
+            pool.reals.take(barrier.s.len()),
+        );
+        drop(pool);
+        let ds = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta, ds);
+        barrier.predicted(&ds, &mut z);
+        let (momenta, certificate, _) =
+            self.residuals(models, barrier, riccati.negative, &direction, &z);
+        let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
+        let mut pool = self.pool.borrow_mut();
+        pool.reals.give(ds);
+        pool.reals.give(z);
+        let error = certificate.stationarity.max(certificate.feasibility);
+        Subproblem {
+            riccati,
+            rho,
+            stale,
+            direction,
+            momenta,
+            certificate,
+            error,
+            barrier_error,
+        }
+    }
+
+    /// The Riccati factorisation with an inertia correction $\rho$ (scaled by $h$) that makes
+    /// the reduced Hessian positive definite: none if the last iteration needed none (or
+    /// little), else from a third of the `last` one (the correction decays geometrically
+    /// instead of dropping to 0 at a point where the Hessian is barely definite), growing by 8
+    /// (100 from scratch) until the inertia is right; with inequalities the correction shifts
+    /// the eliminated slacks' Hessian too, as IPOPT's ([`Barrier::shift_slacks`]: the stages
+    /// of `models` are left shifted by the correction found, for the solve that follows).
+    /// Fails with [`Failure::Regularization`]
+    /// past $\rho = 10^{40}$, or [`Failure::TimeLimit`] when the budget runs out between
+    /// factorisations.
+    pub(super) fn factor_corrected(
+        &self,
+        models: &mut Models<N, X>,
+        barrier: &Barrier,
+        last: f64,
+    ) -> Result<(Riccati<N, X>, f64), Failure> {
+        let h = self.dynamics.h;
+        // (with inequalities a correction also shifts the eliminated slacks' Hessian: the
+        // unshifted stages are kept from the first correction on, to shift each trial afresh)
+        let mut base: Option<Vec<StageModel<N, X>>> = None;
+        let mut factor = |rho: f64| {
+            let mut pool = self.pool.borrow_mut();
+            if rho > 0.0 && !barrier.s.is_empty() {
+                let base = base.get_or_insert_with(|| {
+                    let mut base = pool.stages.take(models.stages.len());
+                    base.extend_from_slice(&models.stages);
+                    base
+                });
+                models.stages.clone_from_slice(base);
+                barrier.shift_slacks(&mut models.stages, &models.inequalities, rho);
+            }
+            let (stages, end) = (&models.stages, &models.terminal);
+            let clock = (self.deadline(), &mut *pool);
+            let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, clock);
+            if riccati.interrupted {
+                riccati.recycle(&mut *pool);
+                return Err(Failure::TimeLimit);
+            }
+            if riccati.positive_definite() {
+                return Ok(Some(riccati));
+            }
+            riccati.recycle(&mut *pool);
+            Ok(None)
+        };
+        // (no correction first; then rho growing until the inertia is right, or a failure)
+        let mut found = if last < 1e-8 {
+            factor(0.0).map(|r| r.map(|r| (r, 0.0)))
+        } else {
+            Ok(None)
+        };
+        let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
+        while matches!(found, Ok(None)) && rho < 1e40 {
+            found = factor(h * rho).map(|r| r.map(|r| (r, rho)));
+            rho *= if last > 0.0 { 8.0 } else { 100.0 };
+        }
+        if let Some(base) = base {
+            self.pool.borrow_mut().stages.give(base);
+        }
+        found?.ok_or(Failure::Regularization)
+    }
+}

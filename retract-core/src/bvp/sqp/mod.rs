@@ -1,0 +1,326 @@
+//! The optimizer's iteration: SQP on the direct transcription of the lifted-midpoint scheme.
+//!
+//! The boundary-value problem of the scheme is the KKT system of
+//!
+//! $$\min_{x, u}\ J = \sum_{i<N} h\thinspace L(x_{\theta,i}, u_i) \quad \text{s.t.} \quad
+//!   x_{i+1} - x_i = h A x_{\theta,i} + h B u_i, \quad x_0 = a, \quad x_N = b,$$
+//!
+//! with $x_{\theta,i} = (1-\theta) x_i + \theta x_{i+1}$, $A$ the block shift
+//! ($x_j' = x_{j+1}$), $B$ the last block ($x_{k-1}' = u$), and the momenta the multipliers:
+//! $p_{\theta,i} = \theta p_i + (1-\theta) p_{i+1} = \mu_i$, the multiplier of step $i$. The
+//! constraints are linear, so the Hessian of the Lagrangian is the Hessian of $J$, formed from
+//! the generated Hessian of $L$ in $(x, u)$.
+//!
+//! Each iteration solves the quadratic subproblem by a Riccati recursion ([`super::riccati`],
+//! $O(N)$), counts the negative eigenvalues of the reduced Hessian on the way and, while there
+//! are any, adds $h \rho I$ to every stage Hessian (inertia correction as in IPOPT: $\rho$ from
+//! $10^{-4}$, times 8 until the count is 0, a third of the last value at the next iteration),
+//! so every direction descends and iterates are drawn to minima. The step length comes from a
+//! backtracking line search on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$: all constraints),
+//! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
+//! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
+//! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
+//! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
+//! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
+//! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
+//! the reduced Hessian (Lanczos on the inverse, [`super::kkt::residuals`]).
+//!
+//! One iteration runs the phases in turn, each a module of methods of [`Sqp`] (`state`):
+//! `models` (the stage models at the iterate), `direction` (the subproblem: the inertia-
+//! corrected Riccati solve, [`super::kkt`]), `termination` (the KKT error against the
+//! tolerances; at a converged point the second-order check of `second_order` and the plan),
+//! `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the step.
+//! This module holds the loop (`Sqp::run`) and the first barrier. The vectors come from the
+//! workspace's pool, taken once per problem size ([`super::Workspace`]).
+
+use nalgebra::SVector;
+
+use crate::bvp::barrier::Barrier;
+use crate::bvp::constraints::slack_push;
+use crate::bvp::iterate::Iterate;
+use crate::bvp::plan::duals::Duals;
+use crate::bvp::plan::{Failure, Plan, PlanError};
+use crate::{Lagrangian, LiftedSystem};
+
+mod direction;
+mod filter;
+mod line_search;
+mod models;
+mod second_order;
+mod state;
+mod termination;
+
+pub(super) use state::Sqp;
+use state::{State, Subproblem};
+use termination::{Finished, barrier_floor};
+
+/// The error below which a full step's factorisation is kept for a simplified Newton step
+/// at the next iterate.
+const CHORD_ERROR: f64 = 1e-3;
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// The barrier at the first iterate: from the `warm` start's duals if they fit the
+    /// problem's inequalities ([`Barrier::warm`]), else [`Barrier::new`] with $\mu = \mu_0 / h$
+    /// per unit time, $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without
+    /// inequalities; `None` if an inequality is not finite there.
+    fn initial_barrier(
+        &self,
+        iterate: &Iterate<N, X>,
+        warm: Option<&Duals<N>>,
+    ) -> Option<Barrier> {
+        let lin = self.inequalities(iterate);
+        let mut pool = self.pool.borrow_mut();
+        let mut values = pool.reals.take(lin.len());
+        values.extend(lin.iter().map(|c| c.value));
+        pool.linearized.give(lin);
+        let vectors = [0; 3].map(|_| pool.reals.take(values.len()));
+        drop(pool);
+        let layout = (self.at_steps.len(), self.at_nodes.len(), iterate.u.len());
+        let fits = |d: &&Duals<N>| layout.0 + layout.1 > 0 && d.fit(layout.2, layout.0, layout.1);
+        let barrier = if !values.iter().all(|v| v.is_finite()) {
+            None
+        } else if let Some(duals) = warm.filter(fits) {
+            let floor = barrier_floor(self.options.tolerance);
+            Some(Barrier::warm(duals, layout, floor, vectors))
+        } else {
+            Some(self.cold_barrier(&values, layout, vectors))
+        };
+        self.pool.borrow_mut().reals.give(values);
+        barrier
+    }
+
+    /// [`Barrier::new`] for the inequalities' `values` at the first iterate.
+    fn cold_barrier(
+        &self,
+        values: &[f64],
+        layout: (usize, usize, usize),
+        vectors: [Vec<f64>; 3],
+    ) -> Barrier {
+        let mu = if layout.0 + layout.1 > 0 {
+            self.options.initial_barrier / self.dynamics.h
+        } else {
+            0.0
+        };
+        let (steps, nodes) = (slack_push(self.at_steps), slack_push(self.at_nodes));
+        let at_steps = layout.0 * layout.2;
+        let push = |k: usize| {
+            if k < at_steps {
+                steps[k % layout.0]
+            } else {
+                nodes[(k - at_steps) % layout.1]
+            }
+        };
+        Barrier::new((mu, self.dynamics.h), layout, values, push, vectors)
+    }
+
+    /// Iterates from `iterate` until the KKT residuals are below the tolerance with a positive
+    /// definite reduced Hessian (and, with inequalities, the barrier parameter at its floor
+    /// [`barrier_floor`]), or a budget or the line search fails. After a full step from an
+    /// error below $\sqrt{\varepsilon}$ the residuals at the new point are first evaluated
+    /// with the last subproblem's multipliers (the Newton estimates there): if they and the
+    /// inertia of the factorisation at the point certify it, it is returned without solving
+    /// its own subproblem. Without stage constraints, a full step from an error below
+    /// `CHORD_ERROR` keeps its factorisation for the next iterate's subproblem (a simplified
+    /// Newton step, [`Self::subproblem`]); a point is never certified with a kept one.
+    pub(in crate::bvp) fn run(
+        &self,
+        iterate: Iterate<N, X>,
+        warm: Option<&Duals<N>>,
+    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let Some(barrier) = self.initial_barrier(&iterate, warm) else {
+            self.give_iterate(iterate);
+            return Err(PlanError::without_iterate(Failure::NonFinite));
+        };
+        // (the stage equalities' multipliers: a warm start's if they fit and are finite, else
+        // 0; a plan read back from a file may hold any numbers)
+        let finite = |y: &SVector<f64, N>| y.iter().all(|v| v.is_finite());
+        let steps = iterate.u.len();
+        let mut y = self.pool.borrow_mut().tops.take(steps);
+        match warm.map(|duals| &duals.equalities) {
+            Some(given) if given.len() == steps && given.iter().all(finite) => {
+                y.extend_from_slice(given);
+            }
+            _ => y.resize(steps, SVector::zeros()),
+        }
+        let mut state = State {
+            iterate,
+            y,
+            barrier,
+            filter: None,
+            full_step: None,
+            kept: None,
+        };
+        let result = self.iterate_from(&mut state);
+        self.release(state);
+        result
+    }
+
+    /// Gives the vectors of the iteration's `state` back to the pool.
+    fn release(&self, state: State<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(state.iterate.x);
+        pool.tops.give(state.iterate.u);
+        pool.tops.give(state.y);
+        for v in state.barrier.into_vectors() {
+            pool.reals.give(v);
+        }
+        if let Some(filter) = state.filter {
+            pool.pairs.give(filter.into_entries());
+        }
+        if let Some(direction) = state.full_step {
+            direction.recycle(&mut *pool);
+        }
+        if let Some((riccati, _)) = state.kept {
+            riccati.recycle(&mut *pool);
+        }
+    }
+
+    /// The iteration of [`Self::run`] from `st`: the plan and whether it is certified (if
+    /// not, the iterate of a real-time iteration at its iteration limit).
+    fn iterate_from(
+        &self,
+        st: &mut State<N, X>,
+    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let options = &self.options;
+        let count = self.at_steps.len() + self.at_nodes.len();
+        let floor = barrier_floor(options.tolerance);
+        let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        // (the stage constraints' projections change with the iterate: no simplified steps)
+        let unconstrained = count == 0 && self.problem.equalities.is_empty();
+        loop {
+            let done = iterations;
+            let point = (&st.iterate, &st.y[..], &st.barrier);
+            let fail = |failure, cost, certificate, momenta| PlanError {
+                failure,
+                last: Some(Box::new(self.plan(point, cost, done, momenta, certificate))),
+            };
+            // after a full step the last subproblem's multipliers are the Newton estimates
+            // here: if they already certify this point, no subproblem is solved at it
+            if let Some(last) = st.full_step.take() {
+                let plan = (rho_last == 0.0)
+                    .then(|| self.certify_without_solve(point, &last, iterations))
+                    .flatten();
+                last.recycle(&mut *self.pool.borrow_mut());
+                if let Some(plan) = plan {
+                    return Ok((plan, true));
+                }
+            }
+            let mut models = match self.models(&st.iterate, &st.y, &st.barrier) {
+                Ok(models) => models,
+                Err(Failure::TimeLimit) => {
+                    let unknown = super::plan::certificate::unknown_certificate();
+                    return Err(fail(Failure::TimeLimit, f64::NAN, unknown, vec![]));
+                }
+                Err(failure) => return Err(PlanError::without_iterate(failure)),
+            };
+            let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
+                Ok(sub) => sub,
+                Err(failure) => {
+                    let mut partial = super::plan::certificate::unknown_certificate();
+                    partial.feasibility = models.violation_max();
+                    let failure = self.name_infeasibility(failure, &st.iterate);
+                    return Err(fail(failure, models.cost, partial, vec![]));
+                }
+            };
+            rho_last = sub.rho;
+            // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
+            if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
+                st.barrier.decrease(floor, self.dynamics.h);
+                if let Some(filter) = &mut st.filter {
+                    filter.reset();
+                }
+                self.give_models(models);
+                self.give_subproblem(sub);
+                continue;
+            }
+            let complementarity = st.barrier.complementarity().0;
+            // converged, or at the acceptable level with no progress left but rounding
+            let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
+            let mut sub =
+                if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
+                    match self.finish(point, &models, sub, iterations) {
+                        Finished::Plan(plan) => {
+                            self.give_models(models);
+                            return Ok((plan, true));
+                        }
+                        Finished::Failed(failure, certificate, sub) => {
+                            return Err(fail(failure, models.cost, certificate, sub.momenta));
+                        }
+                        Finished::Not(sub) => sub,
+                    }
+                } else {
+                    sub
+                };
+            let out_of_time = self.out_of_time();
+            if iterations == options.max_iterations && self.real_time && !out_of_time {
+                let point = (&st.iterate, &st.y[..], &st.barrier);
+                let momenta = core::mem::take(&mut sub.momenta);
+                let plan = self.plan(point, models.cost, done, momenta, sub.certificate);
+                self.give_models(models);
+                self.give_subproblem(sub);
+                return Ok((plan, false));
+            }
+            if iterations == options.max_iterations || out_of_time {
+                let failure = if out_of_time {
+                    Failure::TimeLimit
+                } else {
+                    Failure::IterationLimit
+                };
+                return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+            }
+            iterations += 1;
+            let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
+            let theta = self.dynamics.theta;
+            let ds = (st.barrier).slack_steps(&models.inequalities, &sub.direction, theta, ds);
+            let (slacks, globals) = ((&st.barrier, &ds[..]), (&mut st.filter, &mut penalty));
+            let searched = (&st.iterate, &models, &sub.direction);
+            let accepted = match self.line_search(searched, slacks, globals) {
+                Ok(accepted) => accepted,
+                Err(Failure::LineSearch) if sub.stale => {
+                    // the simplified direction failed: solve this iterate's own subproblem
+                    iterations -= 1;
+                    self.pool.borrow_mut().reals.give(ds);
+                    self.give_models(models);
+                    self.give_subproblem(sub);
+                    continue;
+                }
+                Err(failure) => {
+                    let failure = self.name_infeasibility(failure, &st.iterate);
+                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                }
+            };
+            let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
+            let (alpha, at_rounding) = self.advance(accepted, (&sub.direction, &ds), state);
+            self.pool.borrow_mut().reals.give(ds);
+            self.give_models(models);
+            stalled = if at_rounding { stalled + 1 } else { 0 };
+            let Subproblem {
+                riccati,
+                rho,
+                stale,
+                direction,
+                momenta,
+                error,
+                ..
+            } = sub;
+            self.pool.borrow_mut().jets.give(momenta);
+            // (worth trying when Newton's quadratic convergence will take the error from here
+            // to below the tolerance)
+            if alpha == 1.0 && error <= options.tolerance.sqrt() {
+                st.full_step = Some(direction);
+            } else {
+                direction.recycle(&mut *self.pool.borrow_mut());
+            }
+            // near a solution, one step with this factorisation at the next iterate
+            if alpha == 1.0 && rho == 0.0 && !stale && unconstrained && error <= CHORD_ERROR {
+                st.kept = Some((riccati, error));
+            } else {
+                riccati.recycle(&mut *self.pool.borrow_mut());
+            }
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! The models phase: the quadratic model of every stage at an iterate (the Hessian of the
+//! Lagrangian with the constraints' curvature and the barrier's terms, the gradient, the
+//! defect, the stage equalities), the cost and the terminal cost, and the inequalities
+//! linearised where they are imposed.
+
+use nalgebra::{SMatrix, SVector};
+
+use super::state::{Models, Sqp};
+use crate::bvp::barrier::Barrier;
+use crate::bvp::constraints::{Linearized, flat_hessian};
+use crate::bvp::iterate::{Iterate, blocks};
+use crate::bvp::kkt::riccati::{STEPS_PER_CLOCK_CHECK, StageModel, Terminal};
+use crate::bvp::plan::Failure;
+use crate::newton::all_finite;
+use crate::{Lagrangian, LiftedSystem};
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h y_g^T g^{\ge}$
+    /// ($y_g$: the multipliers of $g - s = 0$, [`Barrier::y`]),
+    /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
+    /// own terms are added by [`Barrier::add_to_stage`]).
+    #[inline(always)]
+    pub(super) fn stage(
+        &self,
+        iterate: &Iterate<N, X>,
+        i: usize,
+        y: &SVector<f64, N>,
+        barrier: &Barrier,
+    ) -> StageModel<N, X> {
+        let (h, system) = (self.dynamics.h, self.problem.system_at(i));
+        let u = &iterate.u[i];
+        let xt = self.x_theta(iterate, i);
+        let xb = blocks::<N, K, X>(&xt);
+        let g = system.gradient(&xb, u);
+        let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&system.hessian(&xb, u), h);
+        let mut stage = StageModel {
+            hxx,
+            hux,
+            huu,
+            gx: SVector::from_fn(|r, _| h * g.x[r / N][r % N]),
+            gu: g.u * h,
+            defect: self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1],
+            constraints: self.problem.equalities.len(),
+            cx: SMatrix::zeros(),
+            cu: SMatrix::zeros(),
+            value: SVector::zeros(),
+            node: None,
+        };
+        for (j, c) in self.problem.equalities.iter().enumerate() {
+            let grad = c.gradient(&xb, u);
+            stage.value[j] = c.value(&xb, u);
+            for r in 0..X {
+                stage.cx[(j, r)] = grad.x[r / N][r % N];
+            }
+            for a in 0..N {
+                stage.cu[(j, a)] = grad.u[a];
+            }
+            if y[j] != 0.0 {
+                let (cxx, cux, cuu) = flat_hessian::<N, K, X>(&c.hessian(&xb, u), y[j]);
+                hxx += cxx;
+                hux += cux;
+                huu += cuu;
+            }
+        }
+        for (j, c) in self.at_steps.iter().enumerate() {
+            let y = barrier.y[i * barrier.count + j];
+            if let Some((cxx, cux, cuu)) = c.weighted_hessian(&xt, u, -h * y) {
+                hxx += cxx;
+                hux += cux;
+                huu += cuu;
+            }
+        }
+        (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
+        stage.node = self.node_curvature(iterate, i, barrier);
+        stage
+    }
+
+    /// The curvature $-h y \nabla^2 g$ of the inequalities at node `i` (interior nodes
+    /// only), as node terms with a zero gradient; `None` where there are none.
+    pub(super) fn node_curvature(
+        &self,
+        iterate: &Iterate<N, X>,
+        i: usize,
+        barrier: &Barrier,
+    ) -> Option<(SMatrix<f64, X, X>, SVector<f64, X>)> {
+        if self.at_nodes.is_empty() || i == 0 || i >= iterate.u.len() {
+            return None;
+        }
+        let (h, zero) = (self.dynamics.h, SVector::<f64, N>::zeros());
+        let mut hessian = SMatrix::<f64, X, X>::zeros();
+        for (j, c) in self.at_nodes.iter().enumerate() {
+            let y = barrier.y[barrier.node_index(i, j)];
+            if let Some((cxx, _, _)) = c.weighted_hessian(&iterate.x[i], &zero, -h * y) {
+                hessian += cxx;
+            }
+        }
+        Some((hessian, SVector::zeros()))
+    }
+
+    /// Appends the values of the node inequalities at the interior nodes (node-major).
+    pub(super) fn node_values(&self, iterate: &Iterate<N, X>, values: &mut Vec<f64>) {
+        let zero = SVector::<f64, N>::zeros();
+        let steps = iterate.u.len();
+        for x in iterate.x.iter().take(steps).skip(1) {
+            values.extend(self.at_nodes.iter().map(|c| c.value(x, &zero)));
+        }
+    }
+
+    /// The models of every stage with the constraint multipliers `y`; [`Failure::NonFinite`]
+    /// if anything is not finite, [`Failure::TimeLimit`] if the budget runs out (the clock is
+    /// read every [`STEPS_PER_CLOCK_CHECK`] steps).
+    pub(super) fn models(
+        &self,
+        iterate: &Iterate<N, X>,
+        y: &[SVector<f64, N>],
+        barrier: &Barrier,
+    ) -> Result<Models<N, X>, Failure> {
+        let h = self.dynamics.h;
+        let steps = iterate.u.len();
+        let inequalities = self.inequalities(iterate);
+        let (mut stages, mut cost_gradient) = {
+            let mut pool = self.pool.borrow_mut();
+            (pool.stages.take(steps), pool.gradients.take(steps))
+        };
+        let mut cost = 0.0;
+        for (i, u) in iterate.u.iter().enumerate() {
+            if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
+                return Err(Failure::TimeLimit);
+            }
+            let system = self.problem.system_at(i);
+            cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
+            let count = barrier.count;
+            let own = &inequalities[i * count..(i + 1) * count];
+            // (built in place: a stage model is a few hundred bytes)
+            stages.push(self.stage(iterate, i, &y[i], barrier));
+            let stage = stages.last_mut().ok_or(Failure::NonFinite)?;
+            cost_gradient.push((stage.gx, stage.gu));
+            barrier.add_to_stage(stage, i, own, h);
+            if stage.node.is_some() {
+                let from = barrier.node_index(i, 0);
+                barrier.add_to_node(stage, i, &inequalities[from..from + barrier.nodes], h);
+            }
+            let node_finite = stage
+                .node
+                .as_ref()
+                .is_none_or(|node| all_finite(&node.0) & all_finite(&node.1));
+            // each a vectorised sum of 0 * entry (nalgebra's `sum` is one chain of dependent
+            // additions: a fifth of an SQP iteration on the SE(2) scene)
+            let finite = all_finite(&stage.hxx)
+                & all_finite(&stage.hux)
+                & all_finite(&stage.huu)
+                & all_finite(&stage.gx)
+                & all_finite(&stage.gu)
+                & all_finite(&stage.cx)
+                & all_finite(&stage.cu)
+                & all_finite(&stage.value)
+                & node_finite;
+            if !finite {
+                return Err(Failure::NonFinite);
+            }
+        }
+        let r0 = (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start);
+        let last = &iterate.x[iterate.x.len() - 1];
+        let fixed = self.problem.fixed_end;
+        let r_end = (self.problem.goal - last).component_mul(&fixed);
+        let (log, slack_l1) = barrier.current_terms(&inequalities, h);
+        let slack_violation = (slack_l1, barrier.residual(&inequalities));
+        let (phi, terminal_gradient, hessian) = self.terminal_model(last);
+        let cost = cost + phi;
+        let barrier_cost = cost + log;
+        let finite =
+            barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian);
+        if !finite {
+            return Err(Failure::NonFinite);
+        }
+        Ok(Models {
+            stages,
+            cost,
+            barrier_cost,
+            r0,
+            r_end,
+            inequalities,
+            cost_gradient,
+            slack_violation,
+            terminal: Terminal {
+                hessian,
+                fixed,
+                start_fixed: self.problem.fixed_start,
+            },
+            terminal_gradient,
+        })
+    }
+
+    /// $\Phi(x_N)$ (0 without a terminal cost).
+    pub(super) fn terminal_value(&self, last: &SVector<f64, X>) -> f64 {
+        self.problem.terminal_cost.map_or(0.0, |phi| {
+            phi.value(&blocks::<N, K, X>(last), &SVector::zeros())
+        })
+    }
+
+    /// $\Phi(x_N)$, its gradient and its Hessian in $x_N$ (zeros without a terminal cost).
+    pub(super) fn terminal_model(
+        &self,
+        last: &SVector<f64, X>,
+    ) -> (f64, SVector<f64, X>, SMatrix<f64, X, X>) {
+        let Some(phi) = self.problem.terminal_cost else {
+            return (0.0, SVector::zeros(), SMatrix::zeros());
+        };
+        let (x, u) = (blocks::<N, K, X>(last), SVector::<f64, N>::zeros());
+        let g = phi.gradient(&x, &u);
+        let (hxx, _, _) = flat_hessian::<N, K, X>(&phi.hessian(&x, &u), 1.0);
+        let gradient = SVector::from_fn(|r, _| g.x[r / N][r % N]);
+        (phi.value(&x, &u), gradient, hxx)
+    }
+
+    /// Every inequality linearised where it is imposed, in the order of [`Barrier`]: those
+    /// of the steps (step-major), then those of the interior nodes (node-major).
+    pub(super) fn inequalities(&self, iterate: &Iterate<N, X>) -> Vec<Linearized<N, X>> {
+        let steps = iterate.u.len();
+        let count = steps * self.at_steps.len() + steps.saturating_sub(1) * self.at_nodes.len();
+        let mut out = self.pool.borrow_mut().linearized.take(count);
+        if !self.at_steps.is_empty() {
+            for (i, u) in iterate.u.iter().enumerate() {
+                let xt = self.x_theta(iterate, i);
+                out.extend(self.at_steps.iter().map(|c| c.linearize(&xt, u)));
+            }
+        }
+        let zero = SVector::<f64, N>::zeros();
+        for x in iterate.x.iter().take(steps).skip(1) {
+            out.extend(self.at_nodes.iter().map(|c| c.linearize(x, &zero)));
+        }
+        out
+    }
+}

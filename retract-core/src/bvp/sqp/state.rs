@@ -1,0 +1,181 @@
+//! One run of the SQP iteration ([`Sqp`]: the problem, its dynamics, the placed
+//! inequalities, the workspace's pool, the options) and what its phases pass each other: the
+//! models of an iterate ([`Models`]), a solved subproblem ([`Subproblem`]), the state carried
+//! from one iterate to the next ([`State`]); the pool's take and give for them, and the clock.
+
+use std::cell::RefCell;
+use std::time::Instant;
+
+use nalgebra::SVector;
+
+use super::filter::Filter;
+use crate::bvp::barrier::Barrier;
+use crate::bvp::constraints::{Inequality, Linearized};
+use crate::bvp::dynamics::Dynamics;
+use crate::bvp::iterate::Iterate;
+use crate::bvp::kkt::riccati::{Direction, Riccati, StageModel, Terminal};
+use crate::bvp::options::PlanOptions;
+use crate::bvp::plan::{Certificate, Plan};
+use crate::bvp::problem::OptimalControlProblem;
+use crate::bvp::workspace::Pool;
+use crate::{Lagrangian, LiftedSystem};
+
+/// One run of the SQP iteration.
+pub(in crate::bvp) struct Sqp<
+    'p,
+    'a,
+    Sys: ?Sized,
+    const N: usize,
+    const K: usize,
+    const X: usize,
+    const S: usize,
+    const M: usize,
+> {
+    pub problem: &'p OptimalControlProblem<'a, Sys, N, K, X>,
+    pub dynamics: Dynamics<N, X>,
+    pub started: Instant,
+    /// The inequalities placed at the steps' evaluation points.
+    pub at_steps: &'p [Inequality<'a, N, K>],
+    /// The inequalities placed at the nodes (imposed at the interior ones).
+    pub at_nodes: &'p [Inequality<'a, N, K>],
+    /// The vectors kept between iterations and solves.
+    pub pool: &'p RefCell<Pool<N, X>>,
+    /// The options of this run (the problem's, or those of a real-time iteration).
+    pub options: PlanOptions,
+    /// A real-time iteration: the iterate at the iteration limit is a result, not a failure.
+    pub real_time: bool,
+}
+
+/// The models of all stages at one iterate.
+pub(super) struct Models<const N: usize, const X: usize> {
+    pub stages: Vec<StageModel<N, X>>,
+    /// $J$.
+    pub cost: f64,
+    /// $J - h \mu \sum \ln g$.
+    pub barrier_cost: f64,
+    pub r0: SVector<f64, X>,
+    pub r_end: SVector<f64, X>,
+    /// The inequalities at every step (step-major).
+    pub inequalities: Vec<Linearized<N, X>>,
+    /// The gradient of $h L$ alone at every step (the models hold the barrier's too).
+    pub cost_gradient: Vec<(SVector<f64, X>, SVector<f64, N>)>,
+    /// $\sum |g - s|$ and $\max |g - s|$ over the inequalities.
+    pub slack_violation: (f64, f64),
+    /// The end: the terminal cost's Hessian and the fixed components of $x_N$.
+    pub terminal: Terminal<X>,
+    /// $\nabla\Phi(x_N)$ (zero without a terminal cost).
+    pub terminal_gradient: SVector<f64, X>,
+}
+
+/// A solved subproblem: the factorisation used (`stale` if it is the previous iterate's),
+/// its inertia correction, the direction, the momenta and residuals, and the error
+/// $\max$(stationarity, feasibility).
+pub(super) struct Subproblem<const N: usize, const X: usize> {
+    pub riccati: Riccati<N, X>,
+    pub rho: f64,
+    pub stale: bool,
+    pub direction: Direction<N, X>,
+    pub momenta: Vec<SVector<f64, X>>,
+    pub certificate: Certificate,
+    pub error: f64,
+    /// The error of the barrier problem, IPOPT's $E_\mu$ per unit time: the absolute
+    /// stationarity $\sigma \times$ the relative one over $s_d$, the feasibility and $\max |z s
+    /// - \mu|$ over $s_c$ ([`Barrier::error_scales`]); see [`Sqp::barrier_error`].
+    pub barrier_error: f64,
+}
+
+/// What the iteration carries from one iterate to the next.
+pub(super) struct State<const N: usize, const X: usize> {
+    pub iterate: Iterate<N, X>,
+    /// The stage equalities' multipliers.
+    pub y: Vec<SVector<f64, N>>,
+    pub barrier: Barrier,
+    pub filter: Option<Filter>,
+    /// The last direction, after a full step (its multipliers are the Newton estimates at the
+    /// new iterate).
+    pub full_step: Option<Direction<N, X>>,
+    /// A factorisation kept for a simplified Newton step, with the error where it was made.
+    pub kept: Option<(Riccati<N, X>, f64)>,
+}
+
+impl<const N: usize, const X: usize> Models<N, X> {
+    /// $\Vert c\Vert_1$ over defects, stage constraints and boundary data.
+    pub(super) fn violation_l1(&self) -> f64 {
+        self.slack_violation.0
+            + self
+                .stages
+                .iter()
+                .map(|s| s.defect.lp_norm(1) + s.value.lp_norm(1))
+                .sum::<f64>()
+            + self.r0.lp_norm(1)
+            + self.r_end.lp_norm(1)
+    }
+    /// $\Vert c\Vert_\infty$.
+    pub(super) fn violation_max(&self) -> f64 {
+        self.stages
+            .iter()
+            .map(|s| s.defect.amax().max(s.value.amax()))
+            .fold(self.r0.amax().max(self.r_end.amax()), f64::max)
+            .max(self.slack_violation.1)
+    }
+}
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// An empty iterate of `steps` steps, from the pool.
+    pub(super) fn take_iterate(&self, steps: usize) -> Iterate<N, X> {
+        let mut pool = self.pool.borrow_mut();
+        Iterate {
+            x: pool.jets.take(steps + 1),
+            u: pool.tops.take(steps),
+        }
+    }
+
+    /// Gives an iterate's vectors back to the pool.
+    pub(super) fn give_iterate(&self, iterate: Iterate<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(iterate.x);
+        pool.tops.give(iterate.u);
+    }
+
+    /// Gives a plan's vectors back to the pool.
+    pub(super) fn give_plan(&self, plan: Plan<N, X>) {
+        self.pool.borrow_mut().give_plan(plan);
+    }
+
+    /// Gives the models' vectors back to the pool.
+    pub(super) fn give_models(&self, models: Models<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        pool.stages.give(models.stages);
+        pool.linearized.give(models.inequalities);
+        pool.gradients.give(models.cost_gradient);
+    }
+
+    /// Gives a subproblem's vectors back to the pool.
+    pub(super) fn give_subproblem(&self, sub: Subproblem<N, X>) {
+        let mut pool = self.pool.borrow_mut();
+        sub.riccati.recycle(&mut *pool);
+        sub.direction.recycle(&mut *pool);
+        pool.jets.give(sub.momenta);
+    }
+
+    pub(super) fn x_theta(&self, iterate: &Iterate<N, X>, i: usize) -> SVector<f64, X> {
+        let theta = self.dynamics.theta;
+        iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
+    }
+
+    /// When the wall-time budget runs out: the start of the solve plus
+    /// [`super::PlanOptions::max_time`].
+    pub(super) fn deadline(&self) -> Option<Instant> {
+        let budget = self.options.max_time?;
+        self.started.checked_add(budget)
+    }
+
+    /// Whether the wall-time budget ([`Self::deadline`]) has run out.
+    pub(super) fn out_of_time(&self) -> bool {
+        self.deadline().is_some_and(|d| Instant::now() >= d)
+    }
+}

@@ -1,0 +1,268 @@
+//! The termination phase: the KKT residuals and the errors of the problem and of the barrier
+//! problem (the convergence and acceptance tests of the loop compare them with the
+//! tolerances), the end of the iteration at a converged point (the second-order check and
+//! the plan), the certification of a point reached by a full step without a solve of its own,
+//! and the naming of a failure at an infeasible point.
+
+use nalgebra::SVector;
+
+use super::state::{Models, Sqp, Subproblem};
+use crate::bvp::barrier::Barrier;
+use crate::bvp::iterate::Iterate;
+use crate::bvp::kkt::residuals::kkt_residuals;
+use crate::bvp::kkt::riccati::Direction;
+use crate::bvp::plan::duals::Duals;
+use crate::bvp::plan::{Certificate, Failure, Plan};
+use crate::{Lagrangian, LiftedSystem};
+
+/// The smallest barrier parameter, for a KKT tolerance $\varepsilon$: $\varepsilon / 2$ (so
+/// that $z s \approx \mu$ is below the tolerance). Lower, an active inequality's slack
+/// $s = \mu / z$ falls toward the rounding of its constraint's value and the barrier Hessian
+/// $h z / s$ toward $10^{12}$ of the rest: the subproblem's multipliers lose their digits and
+/// the residuals stall.
+pub(super) fn barrier_floor(tolerance: f64) -> f64 {
+    tolerance / 2.0
+}
+
+/// How [`Sqp::finish`] ended: a certified plan, a failed second-order check, or not yet (a
+/// constraint violated beyond the tolerance where it is imposed).
+#[allow(clippy::large_enum_variant)] // (made once per solve, and moved at once)
+pub(super) enum Finished<const N: usize, const X: usize> {
+    Plan(Plan<N, X>),
+    Failed(Failure, Certificate, Subproblem<N, X>),
+    Not(Subproblem<N, X>),
+}
+
+impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
+    Sqp<'_, '_, Sys, N, K, X, S, M>
+where
+    Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
+{
+    /// The certificate's residuals at the iterate of `models` with the multipliers of the
+    /// subproblem solution `direction` ([`kkt_residuals`] with the gradients of $h L - h z^T
+    /// g^{\ge}$, the constraint violation, $\max z g$), its negative directions those of
+    /// `riccati`; the momenta; and the scale $\sigma$ of the relative stationarity (its
+    /// absolute value, per unit time, is $\sigma$ times the relative one).
+    pub(super) fn residuals(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        negative_directions: usize,
+        direction: &Direction<N, X>,
+        z: &[f64],
+    ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
+        let h = self.dynamics.h;
+        // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
+        let mut pool = self.pool.borrow_mut();
+        let with_inequalities = (barrier.at_steps() > 0).then(|| {
+            let mut g = pool.gradients.take(models.cost_gradient.len());
+            g.extend_from_slice(&models.cost_gradient);
+            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, h);
+            g
+        });
+        let gradients = with_inequalities.as_ref().unwrap_or(&models.cost_gradient);
+        let end = (
+            &models.terminal_gradient,
+            &models.terminal.fixed,
+            &models.terminal.start_fixed,
+        );
+        let mut nodes = pool.jets.take(barrier.steps + 1);
+        barrier.node_gradients(&models.inequalities, z, h, &mut nodes);
+        let momenta = pool.jets.take(models.stages.len() + 1);
+        let stages = &models.stages;
+        let (momenta, stationarity, scale) = kkt_residuals(
+            &self.dynamics,
+            stages,
+            gradients,
+            direction,
+            &nodes,
+            end,
+            momenta,
+        );
+        if let Some(g) = with_inequalities {
+            pool.gradients.give(g);
+        }
+        pool.jets.give(nodes);
+        let complementarity = z
+            .iter()
+            .zip(&barrier.s)
+            .fold(0.0_f64, |m, (z, s)| m.max(z * s));
+        let certificate = Certificate {
+            stationarity,
+            feasibility: models.violation_max(),
+            complementarity,
+            negative_directions,
+            min_reduced_hessian_eig: f64::NAN,
+        };
+        (momenta, certificate, scale)
+    }
+
+    /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
+    /// `barrier_error`) at the models' iterate with the subproblem's solution `direction`:
+    /// the smaller of its values with the predicted inequality multipliers `z` and with the
+    /// current ones (the predicted ones are off by the whole dual step when the primal step
+    /// is short). $\infty$ without inequalities or with $\mu$ at its floor (it only decides
+    /// when $\mu$ decreases).
+    pub(super) fn barrier_error(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        direction: &Direction<N, X>,
+        (z, momenta): (&[f64], &[SVector<f64, X>]),
+    ) -> f64 {
+        if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.options.tolerance) {
+            return f64::INFINITY;
+        }
+        let h = self.dynamics.h;
+        let others = direction
+            .multipliers
+            .iter()
+            .map(|y| y.lp_norm(1))
+            .sum::<f64>()
+            + momenta.iter().map(|p| p.lp_norm(1)).sum::<f64>();
+        let count = direction.multipliers.len() * N + momenta.len() * X;
+        let compl = barrier.complementarity().1;
+        let error = |z: &[f64]| {
+            let (momenta, certificate, scale) = self.residuals(models, barrier, 0, direction, z);
+            self.pool.borrow_mut().jets.give(momenta);
+            let (s_d, s_c) = barrier.error_scales(z, h, (others, count));
+            (scale * certificate.stationarity / s_d)
+                .max(certificate.feasibility)
+                .max(compl / s_c)
+        };
+        error(z).min(error(&barrier.z))
+    }
+
+    /// The end of the iteration at a point whose residuals are below the tolerance (or at the
+    /// acceptable level) with the barrier at its floor: the second-order check
+    /// ([`Self::certify`]) and the plan, unless a constraint is violated beyond the tolerance
+    /// where it is imposed (then the iteration goes on with the subproblem `sub`).
+    pub(super) fn finish(
+        &self,
+        point: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        models: &Models<N, X>,
+        mut sub: Subproblem<N, X>,
+        iterations: usize,
+    ) -> Finished<N, X> {
+        let factored = (sub.rho == 0.0 && !sub.stale).then_some(&sub.riccati);
+        match self.certify(point, models, factored, sub.certificate) {
+            Ok(certificate) => {
+                let momenta = core::mem::take(&mut sub.momenta);
+                let mut plan = self.plan(point, models.cost, iterations, momenta, certificate);
+                if plan.violations.imposed() <= self.options.tolerance {
+                    self.give_subproblem(sub);
+                    return Finished::Plan(plan);
+                }
+                sub.momenta = core::mem::take(&mut plan.momenta);
+                self.give_plan(plan);
+                Finished::Not(sub)
+            }
+            Err((failure, certificate)) => Finished::Failed(failure, certificate, sub),
+        }
+    }
+
+    /// The plan at the point reached by a full step, certified with the last subproblem's
+    /// multipliers (the Newton estimates here) instead of a solve of its own: if the residuals
+    /// are below the tolerance with the barrier at its floor and the second-order check
+    /// ([`Self::certify`]) passes; `None` (solve as usual) otherwise.
+    pub(super) fn certify_without_solve(
+        &self,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        last: &Direction<N, X>,
+        iterations: usize,
+    ) -> Option<Plan<N, X>> {
+        let (iterate, y, barrier) = state;
+        let options = &self.options;
+        if barrier.mu > barrier_floor(options.tolerance) {
+            return None;
+        }
+        let models = self.models(iterate, y, barrier).ok()?;
+        let (momenta, certificate, _) = self.residuals(&models, barrier, 0, last, &barrier.z);
+        let certified = (certificate.stationarity.max(certificate.feasibility)
+            <= options.tolerance)
+            .then(|| self.certify(state, &models, None, certificate).ok())
+            .flatten();
+        let cost = models.cost;
+        self.give_models(models);
+        let Some(certificate) = certified else {
+            self.pool.borrow_mut().jets.give(momenta);
+            return None;
+        };
+        let plan = self.plan(state, cost, iterations, momenta, certificate);
+        if plan.violations.imposed() <= options.tolerance {
+            return Some(plan);
+        }
+        self.give_plan(plan);
+        None
+    }
+
+    /// A failure of the inertia correction or the line search at an iterate that violates a
+    /// constraint beyond the tolerance, as [`Failure::StalledInfeasible`] naming the
+    /// constraint violated most (and where); any other failure as it is.
+    pub(super) fn name_infeasibility(&self, failure: Failure, iterate: &Iterate<N, X>) -> Failure {
+        if !matches!(failure, Failure::Regularization | Failure::LineSearch) {
+            return failure;
+        }
+        match self.problem.violations(iterate, self.dynamics.theta) {
+            (violations, Some(worst))
+                if violations.imposed().is_nan()
+                    || violations.imposed() > self.options.tolerance =>
+            {
+                Failure::StalledInfeasible(worst)
+            }
+            _ => failure,
+        }
+    }
+
+    /// The plan at the point `state` (iterate, stage-equality multipliers, barrier).
+    pub(super) fn plan(
+        &self,
+        state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        cost: f64,
+        iterations: usize,
+        momenta: Vec<SVector<f64, X>>,
+        certificate: Certificate,
+    ) -> Plan<N, X> {
+        let (iterate, y, barrier) = state;
+        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        let (step_slacks, node_slacks) = barrier.s.split_at(barrier.at_steps());
+        let (step_multipliers, node_multipliers) = barrier.z.split_at(barrier.at_steps());
+        let mut pool = self.pool.borrow_mut();
+        let mut copy = |v: &[f64]| {
+            let mut out = pool.reals.take(v.len());
+            out.extend_from_slice(v);
+            out
+        };
+        let (step_slacks, step_multipliers) = (copy(step_slacks), copy(step_multipliers));
+        let (node_slacks, node_multipliers) = (copy(node_slacks), copy(node_multipliers));
+        let (mut equalities, mut x, mut u) = (
+            pool.tops.take(y.len()),
+            pool.jets.take(iterate.x.len()),
+            pool.tops.take(iterate.u.len()),
+        );
+        drop(pool);
+        equalities.extend_from_slice(y);
+        x.extend_from_slice(&iterate.x);
+        u.extend_from_slice(&iterate.u);
+        let duals = Duals {
+            equalities,
+            step_slacks,
+            step_multipliers,
+            node_slacks,
+            node_multipliers,
+            barrier: barrier.mu,
+        };
+        Plan {
+            h,
+            theta,
+            x,
+            u,
+            momenta,
+            cost,
+            iterations,
+            certificate,
+            violations: self.problem.violations(iterate, theta).0,
+            duals,
+        }
+    }
+}
