@@ -12,16 +12,39 @@
 //! - [`OptimalControlProblem`] minimises it (SQP with a Riccati KKT solve, inertia
 //!   correction, IPOPT's filter line search, stage equalities and interior-point
 //!   inequalities) and returns only certified local minima ([`Plan`], [`Certificate`]); every
-//!   failure carries the last iterate ([`PlanError`]). Modules: `optimize` (the problem and its
-//!   solve), `plan` (the results: plan, certificate, failures), `duals` (a plan's
-//!   multipliers, for warm starts), `sqp` (the iteration; `sqp::line_search` its filter), `riccati` (the KKT solve and its inertia),
-//!   `constraints` and `barrier` (stage constraints), `certificate` (residuals, momenta,
-//!   curvature), `guess` (the spline guess), `curve` (guesses from a path $q(t)$,
-//!   [`Curve`]), `extrapolate` (Richardson extrapolation), `workspace` (the vectors a solve
-//!   keeps for the next: [`Workspace`], [`OptimalControlProblem::solve_with`], a warm
-//!   re-solve that allocates nothing).
+//!   failure carries the last iterate ([`PlanError`]).
 //! - [`BoundaryValueProblem`] solves the same conditions by Newton's method on their residual
 //!   (`root_finder`): fast where the answer is known to be a minimum, but blind to the cost.
+//!
+//! # Modules
+//! In dependency order: a module imports only modules listed before it, so there is no
+//! import cycle. Inside a folder, `mod.rs` and its files import in one direction only:
+//! `problem/`'s files import the problem from its `mod.rs`; `plan/`'s and `sqp/`'s `mod.rs`
+//! import from their files, which import only their siblings.
+//!
+//! 1. Leaves, importing nothing of the planner: `iterate` (an iterate's jets and top
+//!    derivatives), `guess` (the Hermite spline), `stack` (a stack of kept vectors),
+//!    `dynamics` (the transcription's linear step, with `dynamics/shift.rs`).
+//! 2. `constraints` (the stage constraints: kinds, placement, values and derivatives),
+//!    `curve` (guesses from a path $q(t)$, [`Curve`]), the root finder `root_finder` (with
+//!    `root_finder/condense.rs`).
+//! 3. `plan/`: the results: `mod.rs` ([`Plan`], [`RealTime`], [`PlanError`]),
+//!    `certificate.rs` ([`Certificate`] and the advice of a failure), `failure.rs`
+//!    ([`Failure`]), `duals.rs` ([`Duals`], for warm starts), `violations.rs`
+//!    ([`Violations`], [`Infeasibility`]).
+//! 4. `options` ([`PlanOptions`], [`PlanGuess`]).
+//! 5. `problem/`: the problem ([`OptimalControlProblem`] and its builders in `mod.rs`;
+//!    `constrain.rs` its constraints, `validate.rs` its checks, `measure.rs` an iterate's
+//!    violations).
+//! 6. `kkt/`: the subproblem's linear algebra (`riccati.rs` the factorisation, its inertia
+//!    and solves; `refine.rs`; `residuals.rs` the KKT residuals and the reduced Hessian's
+//!    smallest eigenvalue); it takes its vectors through a trait, not from the workspace.
+//! 7. `barrier` (the interior-point terms of the inequalities), `workspace` (the vectors a
+//!    solve keeps for the next: [`Workspace`], a warm re-solve that allocates nothing).
+//! 8. `sqp/`: the iteration, one module per phase (`models`, `direction`, `line_search` with
+//!    `filter`, `termination`, `second_order`) over `state`, and the loop in `mod.rs`.
+//! 9. `solve` (the solve front: [`OptimalControlProblem::solve`] and its variants, the first
+//!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]).
 //!
 //! # Example
 //! The hand-written disc system of [`crate::models`] (with `retract`, a `#[higher_order_lagrangian]`

@@ -11,7 +11,7 @@
 //! constraints are linear, so the Hessian of the Lagrangian is the Hessian of $J$, formed from
 //! the generated Hessian of $L$ in $(x, u)$.
 //!
-//! Each iteration solves the quadratic subproblem by a Riccati recursion ([`super::riccati`],
+//! Each iteration solves the quadratic subproblem by a Riccati recursion ([`super::kkt::riccati`],
 //! $O(N)$), counts the negative eigenvalues of the reduced Hessian on the way and, while there
 //! are any, adds $h \rho I$ to every stage Hessian (inertia correction as in IPOPT: $\rho$ from
 //! $10^{-4}$, times 8 until the count is 0, a third of the last value at the next iteration),
@@ -25,13 +25,16 @@
 //! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
 //! the reduced Hessian (Lanczos on the inverse, [`super::kkt::residuals`]).
 //!
-//! One iteration runs the phases in turn, each a module of methods of [`Sqp`] (`state`):
-//! `models` (the stage models at the iterate), `direction` (the subproblem: the inertia-
-//! corrected Riccati solve, [`super::kkt`]), `termination` (the KKT error against the
-//! tolerances; at a converged point the second-order check of `second_order` and the plan),
-//! `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the step.
-//! This module holds the loop (`Sqp::run`) and the first barrier. The vectors come from the
-//! workspace's pool, taken once per problem size ([`super::Workspace`]).
+//! One iteration runs the phases in turn, each a module of methods of [`Sqp`] (`state.rs`
+//! holds it and what the phases pass each other): `models` (the stage models at the
+//! iterate), `direction` (the subproblem: the inertia-corrected Riccati solve of
+//! [`super::kkt`]), `termination` (the KKT and barrier errors, which the loop tests against
+//! the tolerances; at a converged point the second-order check of `second_order` and the
+//! plan), `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
+//! step. A phase calls only the phases before it in the order `models`, `second_order`,
+//! `termination`, `direction`, `line_search`; this module holds the loop ([`Sqp::run`]) and
+//! the first barrier, and calls them all. The vectors come from the workspace's pool, kept
+//! from one solve to the next ([`super::Workspace`]).
 
 use nalgebra::SVector;
 
@@ -67,11 +70,7 @@ where
     /// problem's inequalities ([`Barrier::warm`]), else [`Barrier::new`] with $\mu = \mu_0 / h$
     /// per unit time, $\mu_0$ = [`super::PlanOptions::initial_barrier`], and $\mu = 0$ without
     /// inequalities; `None` if an inequality is not finite there.
-    fn initial_barrier(
-        &self,
-        iterate: &Iterate<N, X>,
-        warm: Option<&Duals<N>>,
-    ) -> Option<Barrier> {
+    fn initial_barrier(&self, iterate: &Iterate<N, X>, warm: Option<&Duals<N>>) -> Option<Barrier> {
         let lin = self.inequalities(iterate);
         let mut pool = self.pool.borrow_mut();
         let mut values = pool.reals.take(lin.len());
@@ -181,10 +180,7 @@ where
 
     /// The iteration of [`Self::run`] from `st`: the plan and whether it is certified (if
     /// not, the iterate of a real-time iteration at its iteration limit).
-    fn iterate_from(
-        &self,
-        st: &mut State<N, X>,
-    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+    fn iterate_from(&self, st: &mut State<N, X>) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
         let options = &self.options;
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
