@@ -30,13 +30,13 @@
 
 mod condense;
 
-use nalgebra::SVector;
+use nalgebra::{DMatrix, DVector, SVector};
 
 use super::guess::Hermite;
 use crate::banded::BandMatrix;
 use crate::newton::lane_sum;
 use crate::{Error, LiftedSystem, ReducedScheme};
-use condense::{Linearized, ReducedStepMap, StepMap, condensed_direction, general_step_map};
+use condense::{Linearized, ReducedStepMap, StepMap, general_step_map};
 
 /// Options of the boundary-value solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -896,6 +896,62 @@ where
         name: "parameters",
         requirement: "continuation needs at least one parameter value",
     })
+}
+
+/// The condensed Newton direction.
+///
+/// Eliminating $\delta w_i = \Phi_i \delta z_i + c_i$ step by step leaves the recursion
+/// $\delta z_{i+1} = \Phi^z_i \delta z_i + c^z_i$ ($z$ rows), with $\delta x_0 = -(x_0 - a)$ known and
+/// $\delta p_0 = \xi$ free: $\delta z_i = Z_i \xi + \zeta_i$, and $\xi$ solves the $nk \times nk$
+/// system $[Z_N]_x \xi = -(x_N - b) - [\zeta_N]_x$. One pass forms each step's map (into its slot
+/// of `maps`, one per step) and advances $Z_i$ and $\zeta_i$ with it; a second recovers
+/// $\delta z_i$ and $\delta u_i$. Cost $O(N\thinspace nk\thinspace S M)$, no banded matrix. Writes
+/// the direction at `v` (residual `r`) into `delta`; `false` if a step map or the end system is
+/// singular or the direction is not finite (checked once, on `delta`).
+fn condensed_direction<Sys, const S: usize, const M: usize>(
+    problem: &BoundaryValueProblem<'_, Sys, S, M>,
+    v: &[f64],
+    r: &[f64],
+    delta: &mut [f64],
+    linearize: StepMap<'_, S, M>,
+    maps: &mut [Linearized<S, M>],
+) -> bool
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
+    let layout = problem.layout();
+    let (nk, steps) = (layout.nk, problem.steps);
+    // the sensitivity Z_i (nk columns) and the offset zeta_i, advanced as each map is formed
+    let mut sensitivity: Vec<SVector<f64, S>> = (0..nk)
+        .map(|j| SVector::from_fn(|row, _| if row == nk + j { 1.0 } else { 0.0 }))
+        .collect();
+    let mut zeta = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { 0.0 });
+    for (i, map) in maps.iter_mut().enumerate().take(steps) {
+        let f = SVector::<f64, M>::from_column_slice(&r[layout.row(i)..layout.row(i) + M]);
+        if !linearize(&problem.state(v, i), &problem.unknowns(v, i), &f, map) {
+            return false;
+        }
+        for column in &mut sensitivity {
+            *column = map.linear_z(column);
+        }
+        zeta = map.affine(&zeta).fixed_rows::<S>(0).into_owned();
+    }
+    let end = layout.row(steps);
+    let lhs = DMatrix::<f64>::from_fn(nk, nk, |row, j| sensitivity[j][row]);
+    let rhs = DVector::<f64>::from_fn(nk, |row, _| -r[end + row] - zeta[row]);
+    let Some(xi) = lhs.lu().solve(&rhs) else {
+        return false;
+    };
+    // second sweep: delta z_i and delta u_i
+    let mut dz = SVector::<f64, S>::from_fn(|row, _| if row < nk { -r[row] } else { xi[row - nk] });
+    delta[layout.z(0)..layout.z(0) + S].copy_from_slice(dz.as_slice());
+    for (i, map) in maps.iter().enumerate().take(steps) {
+        let dw = map.affine(&dz);
+        delta[layout.z(i + 1)..layout.z(i + 1) + S].copy_from_slice(&dw.as_slice()[..S]);
+        delta[layout.u(i)..layout.u(i) + M - S].copy_from_slice(&dw.as_slice()[S..]);
+        dz = dw.fixed_rows::<S>(0).into_owned();
+    }
+    all_finite(delta)
 }
 
 #[cfg(test)]
