@@ -24,7 +24,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::constraints::Linearized;
-use super::kkt::riccati::{Direction, StageModel};
+use super::kkt::model::StageModel;
+use super::kkt::riccati::Direction;
 
 /// The smallest slack of a warm start ([`Barrier::warm`]).
 pub(super) const WARM_SLACK_PUSH: f64 = 1e-3;

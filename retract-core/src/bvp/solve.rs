@@ -207,7 +207,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// inequality's linearisation, slack and multiplier.
     fn workspace_bytes(&self) -> usize {
         use core::mem::size_of;
-        let per_step = 3 * size_of::<super::kkt::riccati::StageModel<N, X>>()
+        let per_step = 3 * size_of::<super::kkt::model::StageModel<N, X>>()
             + super::kkt::riccati::Riccati::<N, X>::bytes_per_step()
             + 8 * size_of::<SVector<f64, X>>()
             + 6 * size_of::<SVector<f64, N>>()

@@ -7,7 +7,8 @@ use core::cell::RefCell;
 use nalgebra::SVector;
 
 use super::constraints::Linearized;
-use super::kkt::riccati::{Backward, StageFactor, StageModel, TailFactor, Vectors};
+use super::kkt::model::StageModel;
+use super::kkt::riccati::{Backward, StageFactor, TailFactor, Vectors};
 use super::plan::Plan;
 use super::stack::Stack;
 

@@ -10,7 +10,8 @@
 
 use nalgebra::SVector;
 
-use super::riccati::{Direction, Riccati, StageLinear, StageModel, Terminal, Vectors};
+use super::model::{StageLinear, StageModel, Terminal};
+use super::riccati::{Direction, Riccati, Vectors};
 use crate::bvp::dynamics::Dynamics;
 
 /// The gradient in $(\delta x_i, \delta u_i)$ of the Lagrangian of stage $i$'s model

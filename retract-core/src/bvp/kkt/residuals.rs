@@ -3,7 +3,8 @@
 
 use nalgebra::SVector;
 
-use super::riccati::{Direction, Riccati, StageLinear, StageModel, Vectors};
+use super::model::{StageLinear, StageModel};
+use super::riccati::{Direction, Riccati, Vectors};
 use crate::bvp::dynamics::Dynamics;
 use crate::newton::max_abs;
 

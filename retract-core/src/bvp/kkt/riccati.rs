@@ -33,6 +33,8 @@ use std::time::Instant;
 
 use nalgebra::{SMatrix, SVector};
 
+use super::model::{StageLinear, StageModel, Terminal};
+use super::pivots::invert_counting;
 use crate::bvp::dynamics::Dynamics;
 use crate::bvp::stack::Stack;
 
@@ -53,31 +55,6 @@ pub(crate) trait Vectors<const N: usize, const X: usize> {
     /// The Lanczos vectors of the certificate's eigenvalue (their own sizes).
     fn lanczos(&mut self) -> &mut Stack<f64>;
 }
-
-/// One stage's quadratic model: the Hessian blocks and gradient of $h\thinspace L$ in
-/// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
-/// defect $c_i$, and the stage's equality constraints $g(y) = 0$: `constraints` rows of
-/// `cx` $= \partial g/\partial x_\theta$, `cu` $= \partial g/\partial u$ and `value` $= g$.
-#[derive(Clone, Debug)]
-pub(crate) struct StageModel<const N: usize, const X: usize> {
-    pub hxx: SMatrix<f64, X, X>,
-    /// $\partial^2 / \partial u \partial x_\theta$ ($N \times X$).
-    pub hux: SMatrix<f64, N, X>,
-    pub huu: SMatrix<f64, N, N>,
-    pub gx: SVector<f64, X>,
-    pub gu: SVector<f64, N>,
-    pub defect: SVector<f64, X>,
-    pub constraints: usize,
-    pub cx: SMatrix<f64, N, X>,
-    pub cu: SMatrix<f64, N, N>,
-    pub value: SVector<f64, N>,
-    /// Terms of the node $x_i$ itself (the barrier of the inequalities placed at the node):
-    /// their Hessian and gradient in $\delta x_i$, added to $Q_{xx}$ and $q_x$.
-    pub node: Option<NodeTerms<X>>,
-}
-
-/// The Hessian and gradient in $\delta x_i$ of terms of a node $x_i$ itself.
-pub(crate) type NodeTerms<const X: usize> = (SMatrix<f64, X, X>, SVector<f64, X>);
 
 /// The stage constraints in the Riccati variables: with $\delta y = (E \delta x + \theta \bar B
 /// \delta u + \theta c, \delta u)$ the linearisation is $C_x \delta x + C_u \delta u + c_0 = 0$,
@@ -226,137 +203,6 @@ impl<const N: usize, const X: usize> Direction<N, X> {
     }
 }
 
-/// The linear data of one stage of a subproblem: the gradient $(l_x, l_u)$ in
-/// $(\delta x_i, \delta u_i)$, the defect $c_i$ and the constraint offset $c_0$.
-pub(crate) struct StageLinear<const N: usize, const X: usize> {
-    pub lx: SVector<f64, X>,
-    pub lu: SVector<f64, N>,
-    pub defect: SVector<f64, X>,
-    pub constraint: SVector<f64, N>,
-}
-
-/// Inverts a symmetric matrix and counts its negative eigenvalues; `None` if (nearly)
-/// singular or not finite. An $L D L^T$ factorisation without pivoting first (a congruence, so
-/// by Sylvester's law the signs of the pivots are those of the eigenvalues), the
-/// eigendecomposition when a pivot is too small for that to be reliable.
-#[inline]
-fn invert_counting<const D: usize>(m: SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
-    ldlt_inverse(&m).or_else(|| invert_by_eigen(&m))
-}
-
-/// The fallback of [`invert_counting`]: the inverse and the negative eigenvalues from the
-/// symmetric eigendecomposition; `None` if an eigenvalue is below $10^{-13}$ of the largest
-/// in magnitude or a value is not finite.
-#[cold]
-#[inline(never)]
-fn invert_by_eigen<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
-    if !m.iter().all(|v| v.is_finite()) {
-        return None;
-    }
-    let (eigenvalues, vectors) = jacobi_eigen(m);
-    let scale = eigenvalues.amax().max(f64::MIN_POSITIVE);
-    if eigenvalues
-        .iter()
-        .any(|l| l.abs() <= 1e-13 * scale || !l.is_finite())
-    {
-        return None;
-    }
-    let negative = eigenvalues.iter().filter(|l| **l < 0.0).count();
-    let inv_diag = SMatrix::<f64, D, D>::from_diagonal(&eigenvalues.map(|l| 1.0 / l));
-    Some((vectors * inv_diag * vectors.transpose(), negative))
-}
-
-/// The eigenvalues and eigenvectors (columns) of the symmetric matrix `m` by cyclic Jacobi
-/// rotations ($A \leftarrow P^T A P$ with $\tan\phi = \mathrm{sgn}(\vartheta) / (|\vartheta| +
-/// \sqrt{\vartheta^2 + 1})$, $\vartheta = (a_{qq} - a_{pp}) / 2 a_{pq}$, zeroing $a_{pq}$), until
-/// the off-diagonal part is below $10^{-15}$ of the whole (at most 64 sweeps).
-fn jacobi_eigen<const D: usize>(m: &SMatrix<f64, D, D>) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
-    let mut a = (m + m.transpose()) * 0.5;
-    let mut v = SMatrix::<f64, D, D>::identity();
-    let total = a.norm_squared();
-    for _ in 0..64 {
-        let diagonal: f64 = (0..D).map(|i| a[(i, i)] * a[(i, i)]).sum();
-        if total - diagonal <= 1e-30 * total {
-            break;
-        }
-        for p in 0..D {
-            for q in p + 1..D {
-                let apq = a[(p, q)];
-                if apq == 0.0 {
-                    continue;
-                }
-                let theta = (a[(q, q)] - a[(p, p)]) / (2.0 * apq);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                let rotate = |x: f64, y: f64| (c * x - s * y, s * x + c * y);
-                for k in 0..D {
-                    (a[(k, p)], a[(k, q)]) = rotate(a[(k, p)], a[(k, q)]);
-                }
-                for k in 0..D {
-                    (a[(p, k)], a[(q, k)]) = rotate(a[(p, k)], a[(q, k)]);
-                }
-                for k in 0..D {
-                    (v[(k, p)], v[(k, q)]) = rotate(v[(k, p)], v[(k, q)]);
-                }
-            }
-        }
-    }
-    (a.diagonal(), v)
-}
-
-/// $M^{-1}$ and the number of negative pivots of $M = L D L^T$ ($L$ unit lower triangular),
-/// or `None` if a pivot is below $10^{-10}$ of the largest diagonal entry in magnitude or a
-/// value is not finite.
-#[inline]
-fn ldlt_inverse<const D: usize>(m: &SMatrix<f64, D, D>) -> Option<(SMatrix<f64, D, D>, usize)> {
-    let scale = (0..D).fold(0.0_f64, |s, i| s.max(m[(i, i)].abs()));
-    let mut l = SMatrix::<f64, D, D>::identity();
-    let mut d = [0.0_f64; D];
-    // the pivots' reciprocals: one division per pivot
-    let mut d_inv = [0.0_f64; D];
-    for j in 0..D {
-        let mut pivot = m[(j, j)];
-        for k in 0..j {
-            pivot -= l[(j, k)] * l[(j, k)] * d[k];
-        }
-        // (a NaN pivot fails the comparison too)
-        if pivot.abs().partial_cmp(&(1e-10 * scale)) != Some(core::cmp::Ordering::Greater) {
-            return None;
-        }
-        d[j] = pivot;
-        d_inv[j] = 1.0 / pivot;
-        for i in j + 1..D {
-            let mut v = m[(i, j)];
-            for k in 0..j {
-                v -= l[(i, k)] * l[(j, k)] * d[k];
-            }
-            l[(i, j)] = v * d_inv[j];
-        }
-    }
-    // M^{-1} = L^{-T} D^{-1} L^{-1}, column by column
-    let mut inv = SMatrix::<f64, D, D>::zeros();
-    for c in 0..D {
-        let mut y = [0.0_f64; D];
-        for i in 0..D {
-            let mut v = if i == c { 1.0 } else { 0.0 };
-            for k in 0..i {
-                v -= l[(i, k)] * y[k];
-            }
-            y[i] = v;
-        }
-        for i in (0..D).rev() {
-            let mut v = y[i] * d_inv[i];
-            for k in i + 1..D {
-                v -= l[(k, i)] * inv[(k, c)];
-            }
-            inv[(i, c)] = v;
-        }
-    }
-    let negative = d.iter().filter(|p| **p < 0.0).count();
-    inv.iter().all(|v| v.is_finite()).then_some((inv, negative))
-}
-
 /// One stage of the backward pass from $P_{i+1}$ and $S_{i+1}$:
 /// $Q_{xx} = E^T H_{xx} E + \bar A^T P \bar A$, $Q_{ux} = (\theta \bar B^T H_{xx} + H_{ux}) E +
 /// \bar B^T P \bar A$, $Q_{uu}$ likewise, and the gains. Without constraints
@@ -440,33 +286,6 @@ fn terminal_inverse<const X: usize>(d: &SMatrix<f64, X, X>) -> Option<(SMatrix<f
     let (_, negative) = invert_counting((d + d.transpose()) * 0.5)?;
     let inv = crate::linalg::solve(d, &SMatrix::identity())?;
     Some((inv, negative))
-}
-
-/// The ends of the horizon: the Hessian of the terminal cost $\Phi(x_N)$ (the cost-to-go
-/// $P_N$), which components of $x_N$ the goal fixes (1) or leaves free (0), and likewise of
-/// $x_0$ for the start.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Terminal<const X: usize> {
-    pub hessian: SMatrix<f64, X, X>,
-    pub fixed: SVector<f64, X>,
-    pub start_fixed: SVector<f64, X>,
-}
-
-impl<const X: usize> Terminal<X> {
-    /// A goal fixing all of $x_N$, no terminal cost.
-    #[cfg(test)]
-    pub fn fixed_end() -> Self {
-        Self {
-            hessian: SMatrix::zeros(),
-            fixed: SVector::repeat(1.0),
-            start_fixed: SVector::repeat(1.0),
-        }
-    }
-
-    /// The number of fixed components (rows of the terminal constraint).
-    fn rows(&self) -> usize {
-        self.fixed.iter().filter(|f| **f != 0.0).count()
-    }
 }
 
 /// The largest condition number $\Vert D\Vert_{\max} \Vert D^{-1}\Vert_{\max}$ at which a tail's terminal
@@ -866,6 +685,7 @@ pub(crate) struct Backward<const N: usize, const X: usize> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::pivots::{invert_by_eigen, jacobi_eigen};
     use super::*;
     use crate::bvp::workspace::Pool;
     use nalgebra::{DMatrix, SymmetricEigen};

@@ -5,8 +5,9 @@
 
 use super::state::{Models, Sqp, Subproblem};
 use crate::bvp::barrier::Barrier;
+use crate::bvp::kkt::model::StageModel;
 use crate::bvp::kkt::refine::refine;
-use crate::bvp::kkt::riccati::{Riccati, StageModel};
+use crate::bvp::kkt::riccati::Riccati;
 use crate::bvp::plan::Failure;
 use crate::{Lagrangian, LiftedSystem};
 

@@ -8,8 +8,9 @@ use nalgebra::SVector;
 use super::state::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::Iterate;
+use crate::bvp::kkt::model::StageModel;
 use crate::bvp::kkt::residuals::min_reduced_eigenvalue;
-use crate::bvp::kkt::riccati::{Riccati, StageModel};
+use crate::bvp::kkt::riccati::Riccati;
 use crate::bvp::plan::{Certificate, Failure};
 use crate::{Lagrangian, LiftedSystem};
 
