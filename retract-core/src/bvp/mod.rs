@@ -36,9 +36,10 @@
 //! 5. `problem/`: the problem ([`OptimalControlProblem`] and its builders in `mod.rs`;
 //!    `constrain.rs` its constraints, `validate.rs` its checks, `measure.rs` an iterate's
 //!    violations).
-//! 6. `kkt/`: the subproblem's linear algebra (`riccati.rs` the factorisation, its inertia
-//!    and solves; `refine.rs`; `residuals.rs` the KKT residuals and the reduced Hessian's
-//!    smallest eigenvalue); it takes its vectors through a trait, not from the workspace.
+//! 6. `kkt/`: the subproblem's linear algebra (`model.rs` its data, `pivots.rs` the small
+//!    dense inverses with their inertia, `riccati.rs` the factorisation, its inertia and
+//!    solves; `refine.rs`; `residuals.rs` the KKT residuals and the reduced Hessian's smallest
+//!    eigenvalue); it takes its vectors through a trait, not from the workspace.
 //! 7. `barrier` (the interior-point terms of the inequalities), `workspace` (the vectors a
 //!    solve keeps for the next: [`Workspace`], a warm re-solve that allocates nothing).
 //! 8. `sqp/`: the iteration, one module per phase (`models`, `direction`, `line_search` with
