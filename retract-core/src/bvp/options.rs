@@ -7,7 +7,7 @@ use nalgebra::SVector;
 use super::curve::Curve;
 use super::plan::Plan;
 
-/// Options of [`OptimalControlProblem::solve`].
+/// Options of [`OptimalControlProblem::solve`](crate::bvp::OptimalControlProblem::solve).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -27,7 +27,7 @@ pub struct PlanOptions {
     /// Wall-time budget, counted from the call to `solve`; `None` for none. The clock is read
     /// between the phases of an iteration (models, each factorisation of the inertia
     /// correction, each line-search trial) and every 1024 steps inside the model build and
-    /// the factorisation, so a solve returns [`Failure::TimeLimit`] with the iterate reached
+    /// the factorisation, so a solve returns [`Failure::TimeLimit`](crate::bvp::Failure::TimeLimit) with the iterate reached
     /// about one such piece after the budget; the checks of the first guess before the first
     /// iteration (about 20 ms at 65 536 steps) are not interrupted.
     pub max_time: Option<Duration>,
@@ -48,7 +48,7 @@ pub struct PlanOptions {
     pub initial_barrier: f64,
     /// Also compute [`Certificate::min_reduced_hessian_eig`](super::Certificate::min_reduced_hessian_eig) (Lanczos on the final
     /// factorisation, less than one iteration's time); on by default, off in
-    /// [`OptimalControlProblem::solve_real_time`]. The inertia count that proves the reduced
+    /// [`OptimalControlProblem::solve_real_time`](crate::bvp::OptimalControlProblem::solve_real_time). The inertia count that proves the reduced
     /// Hessian positive definite is always done.
     pub min_eigenvalue: bool,
     /// Interior sample points per step (0 by default, at most

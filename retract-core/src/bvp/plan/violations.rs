@@ -17,7 +17,7 @@ pub const INTERPOLANT_DIVISIONS: usize = 16;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Violations {
-    /// At the nodes $x_i$, over the constraints placed there ([`super::Placement`]).
+    /// At the nodes $x_i$, over the constraints placed there ([`crate::bvp::Placement`]).
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub nodes: f64,
     /// At the steps' evaluation points $(x_{\theta,i}, u_i)$, over the constraints placed

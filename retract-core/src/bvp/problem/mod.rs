@@ -20,7 +20,7 @@ mod validate;
 /// scheme from the jet $a$ to the jet $b$ in time $T$ with $N$ steps.
 ///
 /// `N` is the dimension $n$, `K` the order $k$ and `X` $= nk$ the length of a jet; `S` and
-/// `M` are those of the system's [`LiftedSystem`] (used for its singularity guard).
+/// `M` are those of the system's [`LiftedSystem`](crate::LiftedSystem) (used for its singularity guard).
 pub struct OptimalControlProblem<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize> {
     pub(in crate::bvp) system: &'a Sys,
     /// One system per step ([`Self::with_stage_systems`]), else `system` at every step.
@@ -128,7 +128,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// tracking cost $\tfrac12|q - r(t_{\theta,i})|^2$, a moving obstacle), one per step
     /// (checked by [`Self::solve`]). The system given to [`Self::new`] stays the one of the
     /// boundary checks. For a receding horizon, shift the systems with the plan
-    /// ([`Plan::shifted`]): build them for the new window. Not with
+    /// ([`Plan::shifted`](crate::bvp::Plan::shifted)): build them for the new window. Not with
     /// [`Self::solve_extrapolated`] (the number of steps changes there).
     pub fn with_stage_systems(mut self, systems: &'a [&'a Sys]) -> Self {
         self.stage_systems = Some(systems);
