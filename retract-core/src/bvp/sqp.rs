@@ -40,6 +40,10 @@ fn barrier_floor(tolerance: f64) -> f64 {
 const REFINE_RATIO: f64 = 1e6;
 const REFINEMENTS: usize = 2;
 
+/// Consecutive iterations at which the goal stays out of the subproblems' reach
+/// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`].
+const UNREACHABLE_ITERATIONS: usize = 5;
+
 /// The penalty weights of the active inequalities in the second-order check
 /// ([`Sqp::certify`]), relative to the largest entry of the stage Hessians (and to
 /// $|\nabla g|^2$), tried in turn.
@@ -723,6 +727,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        let mut unreachable = 0;
         // (the stage constraints' projections change with the iterate: no simplified steps)
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
@@ -761,6 +766,14 @@ where
                 }
             };
             rho_last = sub.rho;
+            match self.unreachable_goal(&models, &sub) {
+                Some((component, miss)) if unreachable + 1 >= UNREACHABLE_ITERATIONS => {
+                    let failure = Failure::UnreachableGoal { component, miss };
+                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                }
+                Some(_) => unreachable += 1,
+                None => unreachable = 0,
+            }
             // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
             if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
                 st.barrier.decrease(floor, self.dynamics.h);
@@ -856,6 +869,26 @@ where
                 riccati.recycle(&mut self.pool.borrow_mut());
             }
         }
+    }
+
+    /// The goal's component whose miss the subproblem cannot reduce, and that miss: where the
+    /// terminal pivot needed the $\delta_c$ shift (the goal and the stage equalities are
+    /// dependent) and the step's linearised miss $|r_N - \delta x_N|$ of a fixed component
+    /// is above [`super::PlanOptions::acceptable`] and at least half of its miss $|r_N|$ now
+    /// (to first order no step reaches it: a point of local infeasibility of the goal).
+    fn unreachable_goal(
+        &self,
+        models: &Models<N, X>,
+        sub: &Subproblem<N, X>,
+    ) -> Option<(usize, f64)> {
+        if !sub.riccati.regularized {
+            return None;
+        }
+        let last = sub.direction.dx.last()?;
+        let predicted = (models.r_end - last).component_mul(&self.problem.fixed_end);
+        let component = predicted.iamax();
+        let (after, now) = (predicted[component].abs(), models.r_end[component].abs());
+        (after > self.options.acceptable && after >= 0.5 * now).then_some((component, now))
     }
 
     /// The end of the iteration at a point whose residuals are below the tolerance (or at the
