@@ -11,6 +11,7 @@ mod attitude_slew;
 mod budgets;
 mod bvp;
 mod car;
+mod degenerate;
 mod extrapolate;
 mod free_end;
 mod inequalities;

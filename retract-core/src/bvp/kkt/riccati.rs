@@ -171,6 +171,11 @@ pub(crate) struct Riccati<const N: usize, const X: usize> {
     eliminated_at_start: bool,
     /// Negative eigenvalues of the reduced Hessian.
     pub negative: usize,
+    /// The terminal pivot was singular and was shifted by $-\delta_c$ (the goal's fixed
+    /// components and the stage equalities are dependent: [`regularized_inverse`]); the
+    /// direction then meets the goal only in the least-squares sense along the dependent
+    /// components.
+    pub regularized: bool,
     /// A pivot was singular (or non-finite), or a stage constraint rank-deficient in $u$.
     pub singular: bool,
     /// The deadline of [`Self::factor_until`] passed before the factorisation was complete
@@ -288,6 +293,33 @@ fn terminal_inverse<const X: usize>(d: &SMatrix<f64, X, X>) -> Option<(SMatrix<f
     Some((inv, negative))
 }
 
+/// The relative size of the regularisation $\delta_c$ of a singular terminal pivot
+/// ([`regularized_inverse`]).
+const DELTA_C: f64 = 1e-8;
+
+/// The inverse and negative eigenvalues of the whole horizon's terminal pivot, and whether it
+/// was shifted: $\tilde D = D + I_{\rm free}$, or where
+/// that is singular (fixed components of $x_N$ the stages cannot move independently: the
+/// goal and the stage equalities are dependent), $\tilde D - \delta_c I_{\rm fixed}$ with
+/// $\delta_c = $ [`DELTA_C`] $\max(\Vert D \Vert_{\max}, 1)$: IPOPT's $-\delta_c I$ block
+/// on the constraints' multipliers. $D$ is negative definite on the fixed block where the
+/// reduced Hessian is positive definite, so the shift keeps the inertia and makes the pivot
+/// invertible; the terminal condition then holds in the least-squares sense along the
+/// dependent directions (exactly where the data are consistent).
+fn regularized_inverse<const X: usize>(
+    d: &SMatrix<f64, X, X>,
+    free: &SMatrix<f64, X, X>,
+    fixed: &SVector<f64, X>,
+) -> Option<(SMatrix<f64, X, X>, usize, bool)> {
+    let pivot = d + free;
+    if let Some((inverse, negative)) = terminal_inverse(&pivot) {
+        return Some((inverse, negative, false));
+    }
+    let delta_c = DELTA_C * d.amax().max(1.0);
+    let shifted = pivot - SMatrix::<f64, X, X>::from_diagonal(fixed) * delta_c;
+    terminal_inverse(&shifted).map(|(inverse, negative)| (inverse, negative, true))
+}
+
 /// The largest condition number $\Vert D\Vert_{\max} \Vert D^{-1}\Vert_{\max}$ at which a tail's terminal
 /// system is eliminated before the first step (a longer tail is better conditioned).
 const TAIL_CONDITION: f64 = 1e6;
@@ -391,20 +423,23 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let free_start = start_free.iter().any(|f| *f != 0.0);
         // with free start components the tail spanning the horizon is eliminated at x_0 too
         let eliminated_at_start = eliminated.is_none() && free_start;
-        let d_inv = eliminated.unwrap_or_else(|| match terminal_inverse(&(d + free)) {
-            Some((d_inv, neg_d)) => {
-                negative += neg_d;
-                if free_start {
-                    let p_new = p - sens * d_inv * sens.transpose();
-                    p = (p_new + p_new.transpose()) * 0.5;
+        let mut regularized = false;
+        let d_inv =
+            eliminated.unwrap_or_else(|| match regularized_inverse(&d, &free, &terminal.fixed) {
+                Some((d_inv, neg_d, shifted)) => {
+                    regularized = shifted;
+                    negative += neg_d;
+                    if free_start {
+                        let p_new = p - sens * d_inv * sens.transpose();
+                        p = (p_new + p_new.transpose()) * 0.5;
+                    }
+                    d_inv
                 }
-                d_inv
-            }
-            None => {
-                singular = true;
-                SMatrix::zeros()
-            }
-        });
+                None => {
+                    singular = true;
+                    SMatrix::zeros()
+                }
+            });
         // the free start components minimise V_0: the pivot P_0 on them (I elsewhere)
         let start_inverse = if free_start {
             let fixed_part = SMatrix::<f64, X, X>::from_diagonal(&terminal.start_fixed);
@@ -434,6 +469,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             p_start: p,
             eliminated_at_start,
             negative: negative.saturating_sub(terminal.rows()),
+            regularized,
             singular: singular || interrupted,
             interrupted,
         }

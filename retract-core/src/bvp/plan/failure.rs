@@ -38,6 +38,18 @@ pub enum Failure {
     /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
     /// preferred.
     StalledInfeasible(Infeasibility),
+    /// The goal cannot be reached: its fixed component `component` depends on the stage
+    /// equalities and the dynamics alone (they leave it no control), and at the last iterate
+    /// no step reduces its miss `miss` $= |x_N - \text{goal}|$ to first order, for several
+    /// iterations (a point of local infeasibility). The goal contradicts the equalities:
+    /// free that component ([`crate::bvp::OptimalControlProblem::with_free_end`]) or change
+    /// the goal or the equalities.
+    UnreachableGoal {
+        /// The component of $x_N$.
+        component: usize,
+        /// Its miss at the last iterate.
+        miss: f64,
+    },
     /// The KKT conditions hold but the reduced Hessian has negative curvature: a saddle, not
     /// a minimum. (With 0 negative directions: the second-order check could not be made,
     /// the stage constraints being dependent at the point. A reduced Hessian that is only
@@ -86,6 +98,13 @@ impl core::fmt::Display for Failure {
                 "stalled at an infeasible point: {infeasibility}; check that the constraints \
                  can hold together there, or start from a guess that satisfies them (around \
                  an obstacle, not through it)"
+            ),
+            Failure::UnreachableGoal { component, miss } => write!(
+                f,
+                "the goal cannot be reached: its component {component} is left without control \
+                 by the stage equalities and the dynamics, and no step reduces its miss \
+                 {miss:e}; free that component (with_free_end) or make the goal consistent \
+                 with the equalities"
             ),
             Failure::NotAMinimum {
                 negative_directions: 0,

@@ -61,6 +61,10 @@ use termination::{Finished, barrier_floor};
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
 
+/// Consecutive iterations at which the goal stays out of the subproblems' reach
+/// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`].
+const UNREACHABLE_ITERATIONS: usize = 5;
+
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
 where
@@ -185,6 +189,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        let mut unreachable = 0;
         // (the stage constraints' projections change with the iterate: no simplified steps)
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
@@ -223,6 +228,14 @@ where
                 }
             };
             rho_last = sub.rho;
+            match self.unreachable_goal(&models, &sub) {
+                Some((component, miss)) if unreachable + 1 >= UNREACHABLE_ITERATIONS => {
+                    let failure = Failure::UnreachableGoal { component, miss };
+                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                }
+                Some(_) => unreachable += 1,
+                None => unreachable = 0,
+            }
             // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
             if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
                 st.barrier.decrease(floor, self.dynamics.h);

@@ -133,6 +133,26 @@ where
         error(z).min(error(&barrier.z))
     }
 
+    /// The goal's component whose miss the subproblem cannot reduce, and that miss: where the
+    /// terminal pivot needed the $\delta_c$ shift (the goal and the stage equalities are
+    /// dependent) and the step's linearised miss $|r_N - \delta x_N|$ of a fixed component
+    /// is above [`crate::bvp::PlanOptions::acceptable`] and at least half of its miss $|r_N|$
+    /// now (to first order no step reaches it: a point of local infeasibility of the goal).
+    pub(super) fn unreachable_goal(
+        &self,
+        models: &Models<N, X>,
+        sub: &Subproblem<N, X>,
+    ) -> Option<(usize, f64)> {
+        if !sub.riccati.regularized {
+            return None;
+        }
+        let last = sub.direction.dx.last()?;
+        let predicted = (models.r_end - last).component_mul(&self.problem.fixed_end);
+        let component = predicted.iamax();
+        let (after, now) = (predicted[component].abs(), models.r_end[component].abs());
+        (after > self.options.acceptable && after >= 0.5 * now).then_some((component, now))
+    }
+
     /// The end of the iteration at a point whose residuals are below the tolerance (or at the
     /// acceptable level) with the barrier at its floor: the second-order check
     /// ([`Self::certify`]) and the plan, unless a constraint is violated beyond the tolerance
