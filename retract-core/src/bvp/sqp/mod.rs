@@ -15,9 +15,10 @@
 //! $O(N)$), counts the negative eigenvalues of the reduced Hessian on the way and, while there
 //! are any, adds $h \rho I$ to every stage Hessian (inertia correction as in IPOPT: $\rho$ from
 //! $10^{-4}$, times 8 until the count is 0, a third of the last value at the next iteration),
-//! so every direction descends and iterates are drawn to minima. The step length comes from a
-//! backtracking line search on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$: all constraints),
-//! $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
+//! so every direction descends and iterates are drawn to minima. The step length comes from
+//! IPOPT's filter line search on the barrier cost and the constraint violation, and where the
+//! filter finds no step, from backtracking on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$:
+//! all constraints), $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
 //! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
 //! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
 //! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
