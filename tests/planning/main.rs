@@ -14,6 +14,7 @@ mod car;
 mod extrapolate;
 mod free_end;
 mod inequalities;
+mod mechanical;
 mod mpc;
 mod optimize;
 mod placement;
