@@ -122,8 +122,12 @@ pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
 ///
 /// while the components tau_c of the coordinates no actuator drives must vanish: the stage
 /// equalities `unactuated_torques()` (each a `retract::TorqueComponent`, a `JetFunction`),
-/// handed to the problem by `with_equalities`. A runnable example is in the docs of
-/// `retract`, which re-exports this attribute.
+/// handed to the problem by `with_equalities`. For plant simulation, `plant()` is l itself as
+/// a system of order 1 (the type `<Type>Plant`) and `input_force(&u)` the generalized force
+/// B u of an input on the actuated coordinates: `retract::forced::forced_step(&plant, &z0,
+/// &system.input_force(&u), h, &options)` is the forced midpoint rule (discrete
+/// Lagrange-d'Alembert), with the typed errors of every step. A runnable example is in the
+/// docs of `retract`, which re-exports this attribute.
 ///
 /// The arguments are q and q' (`[f64; N]`, or `f64` for N = 1), then the parameters; the body
 /// follows the rules of `#[higher_order_lagrangian]` (helpers included). Options:

@@ -229,3 +229,50 @@ fn the_cart_pole_swing_up_from_its_energy_is_the_hand_written_plan() {
     assert!(cost_gap <= 1e-10, "cost: {cost_gap:e}");
     assert!(state_gap <= 1e-9, "states: {state_gap:e}");
 }
+
+/// The largest |H(z_i) - H(z_0) - W_i| along the forced midpoint path of the double pendulum
+/// over t in [0, 2] in `steps` steps, W_i the work of the input f = B u along the discrete
+/// path, sum over the steps of f . (q_{j+1} - q_j), u at each step's midpoint time.
+fn energy_balance_error(steps: usize) -> f64 {
+    use retract::LiftedSystem;
+    use retract::forced::forced_step;
+    let system = DoublePendulumEnergy::new(1.0, 1.0, 1.0, 1.0, 9.81);
+    let plant = system.plant();
+    let h = 2.0 / steps as f64;
+    let mut z = plant.legendre(&SVector::from([0.5, -0.3, 0.0, 0.0]));
+    let start = plant.hamiltonian(&z).unwrap();
+    let (mut work, mut worst) = (0.0, 0.0f64);
+    for i in 0..steps {
+        let t = (i as f64 + 0.5) * h;
+        let force = system.input_force(&SVector::from([(3.0 * t).sin(), 2.0 * (2.0 * t).cos()]));
+        let (next, _) = forced_step(&plant, &z, &force, h, &Default::default()).unwrap();
+        work += force.dot(&(next.fixed_rows::<2>(0) - z.fixed_rows::<2>(0)));
+        z = next;
+        let balance = plant.hamiltonian(&z).unwrap() - start - work;
+        worst = worst.max(balance.abs());
+    }
+    worst
+}
+
+/// Plant simulation from the energy: the change of energy along the forced midpoint path is
+/// the work of the input up to O(h^2) (observed order 2); the unforced step is symplectic.
+#[test]
+fn the_plant_balances_energy_and_work_at_order_2() {
+    let errors: Vec<f64> = [50, 100, 200, 400]
+        .into_iter()
+        .map(energy_balance_error)
+        .collect();
+    let orders: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect();
+    println!("energy balance errors {errors:?}, observed orders {orders:?}");
+    for order in &orders {
+        assert!((order - 2.0).abs() < 0.2, "orders {orders:?} ({errors:?})");
+    }
+    let plant = CartPoleEnergy::new(1.0, 0.3, 0.5, 9.81).plant();
+    let z0 = SVector::from([0.2, 2.5, 0.3, -0.4]);
+    let error =
+        retract::diagnostics::symplecticity_error(&plant, &z0, 0.05, &Default::default()).unwrap();
+    assert!(error < 1e-12, "symplecticity {error:e}");
+    // the input of the cart-pole drives the cart only
+    let force = CartPoleEnergy::new(1.0, 0.3, 0.5, 9.81).input_force(&SVector::from([2.0]));
+    assert_eq!(force, SVector::from([2.0, 0.0]));
+}

@@ -3,8 +3,9 @@
 //! lowered as a Lagrangian of order 1; the mechanics pass derives its Euler-Lagrange
 //! operator tau (`mechanics::euler_lagrange`), the optimal-control Lagrangian of order 2,
 //! L = R/2 sum tau_a^2 over the actuated coordinates, and the mechanics of L as
-//! `#[higher_order_lagrangian]` would; the emission is L's system (`emit::system_items`)
-//! and the inverse dynamics with the unactuated components of tau (`emit::mechanical`).
+//! `#[higher_order_lagrangian]` would, and those of l itself for the plant; the emission is
+//! L's system and l's plant (`emit::system_items`) and the inverse dynamics with the
+//! unactuated components of tau (`emit::mechanical`).
 
 use proc_macro2::{Span, TokenStream};
 use syn::ItemFn;
@@ -49,13 +50,53 @@ struct Lowered {
     guards: Vec<Guard>,
 }
 
-/// The order-2 system: its signature, the mechanics of L, its guards, the reduced step;
-/// with tau and the actuated coordinates.
-struct Derived {
+/// A system to emit: its signature, its mechanics, its guards, the reduced step.
+struct System {
     sig: Signature,
     mech: Mechanics,
     guards: Vec<(Guard, [Id; 3])>,
     reduced: Option<Reduced>,
+}
+
+impl System {
+    /// The mechanics of the Lagrangian `root` of signature `sig` (a constant singular
+    /// d2L/du2 is accepted for the optimal-control Lagrangian), or why there are none.
+    fn build(
+        graph: &mut Graph,
+        sig: Signature,
+        root: Id,
+        guards: Vec<Guard>,
+    ) -> Result<Self, mechanics::Degenerate> {
+        let (n, k) = (sig.dim, sig.order);
+        let mech = mechanics::build_with(graph, root, n, k, k == 2)?;
+        let guards = mechanics::guards_at_step_points(graph, guards, &sig);
+        let reduced = mechanics::reduce(graph, &mech.gradient, &mech.hessian, n, k);
+        Ok(System {
+            sig,
+            mech,
+            guards,
+            reduced,
+        })
+    }
+
+    /// Its items (`emit::system_items`), and its emission context for more.
+    fn emission<'a>(&'a self, function: &'a ItemFn, graph: &'a Graph) -> Emission<'a> {
+        Emission::new(
+            function,
+            &self.sig,
+            graph,
+            &self.mech,
+            &self.guards,
+            self.reduced.as_ref(),
+        )
+    }
+}
+
+/// The optimal-control system of order 2 and the plant of order 1, with tau and the
+/// actuated coordinates.
+struct Derived {
+    system: System,
+    plant: System,
     euler_lagrange: EulerLagrange,
     actuated: Vec<usize>,
 }
@@ -105,36 +146,37 @@ impl Passes for MechanicalPasses {
             .map_err(|reason| not_mechanical(sig, reason))?;
         let cost =
             euler_lagrange::effort(graph, &euler_lagrange.tau, &actuated, self.actuation.weight);
-        let sig = order_two(sig);
-        let mech = mechanics::build_with(graph, cost, n, 2, true).map_err(|_| {
-            syn::Error::new(
-                sig.jet[1].span(),
-                "the actuated rows of the mass matrix vanish: no actuator moves the system",
-            )
-        })?;
-        let guards = mechanics::guards_at_step_points(graph, lowered.guards, &sig);
-        let reduced = mechanics::reduce(graph, &mech.gradient, &mech.hessian, n, 2);
+        let dq = sig.jet[1].span();
+        let system =
+            System::build(graph, order_two(sig), cost, lowered.guards.clone()).map_err(|_| {
+                syn::Error::new(
+                    dq,
+                    "the actuated rows of the mass matrix vanish: no actuator moves the system",
+                )
+            })?;
+        let plant = System::build(graph, plant_signature(sig), lowered.root, lowered.guards)
+            .map_err(|_| not_mechanical(sig, NotMechanical::Singular))?;
         Ok(Derived {
-            sig,
-            mech,
-            guards,
-            reduced,
+            system,
+            plant,
             euler_lagrange,
             actuated,
         })
     }
 
     fn emit(&self, function: &ItemFn, _: &Signature, graph: &Graph, d: Derived) -> TokenStream {
-        let emission = Emission::new(
-            function,
-            &d.sig,
-            graph,
-            &d.mech,
-            &d.guards,
-            d.reduced.as_ref(),
+        let (emission, plant) = (
+            d.system.emission(function, graph),
+            d.plant.emission(function, graph),
         );
         let mut out = system_items(&emission);
-        out.extend(mechanical_impl(&emission, &d.euler_lagrange, &d.actuated));
+        out.extend(system_items(&plant));
+        out.extend(mechanical_impl(
+            &emission,
+            &plant,
+            &d.euler_lagrange,
+            &d.actuated,
+        ));
         out
     }
 }
@@ -146,6 +188,15 @@ fn order_two(sig: &Signature) -> Signature {
     Signature {
         order: 2,
         jet,
+        ..sig.clone()
+    }
+}
+
+/// The signature of the plant: `sig` (of l, order 1) with the type `<Type>Plant`.
+fn plant_signature(sig: &Signature) -> Signature {
+    let name = &sig.type_name;
+    Signature {
+        type_name: syn::Ident::new(&format!("{name}Plant"), name.span()),
         ..sig.clone()
     }
 }
@@ -192,6 +243,10 @@ mod tests {
         let out = expand("actuated = [1], weight = 2.0", "", ENERGY).unwrap();
         for item in [
             "struct Cart;",
+            "struct CartPlant;",
+            "pub fn plant(",
+            "pub fn input_force(",
+            "Lagrangian<2, 1> for CartPlant",
             "pub fn tau(",
             "pub fn mass_matrix(",
             "pub fn unactuated_torques(",

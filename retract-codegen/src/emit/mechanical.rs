@@ -17,10 +17,12 @@ use crate::mechanics::euler_lagrange::EulerLagrange;
 /// Euler-Lagrange operator `el` and the actuated coordinates `actuated`.
 pub(crate) fn mechanical_impl(
     e: &Emission<'_>,
+    plant: &Emission<'_>,
     el: &EulerLagrange,
     actuated: &[usize],
 ) -> TokenStream {
     let mut out = inherent(e, el, actuated);
+    out.extend(plant_methods(e, plant, actuated));
     out.extend(mechanical_system_impl(e, el, actuated));
     out
 }
@@ -98,6 +100,48 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenSt
             #[must_use]
             pub fn unactuated_torques(&self) -> [#core::TorqueComponent<'_, Self>; #u_len] {
                 [#(#components),*]
+            }
+        }
+    }
+}
+
+/// `impl Type { plant, input_force }`: the plant with the same parameters, and the
+/// generalized force B u of an input u on the actuated coordinates.
+fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, actuated: &[usize]) -> TokenStream {
+    let (na, vec_n, vec_n_path, allow) = (&e.na, &e.vec_n, &e.vec_n_path, &e.allow);
+    let ParamTokens {
+        generics, ty_full, ..
+    } = &e.params;
+    let (plant_ty, plant_name) = (&plant.params.ty_full, &plant.sig.type_name);
+    let fields = e.sig.params.iter().map(|p| {
+        let name = &p.name;
+        quote!(#name: self.#name)
+    });
+    let a_len = index(actuated.len());
+    let sets = actuated.iter().enumerate().map(|(i, &a)| {
+        let (i, a) = (index(i), index(a));
+        quote!(__out[#a] = u[#i];)
+    });
+    quote! {
+        #[automatically_derived]
+        #allow
+        impl #generics #ty_full {
+            /// The plant: the Lagrangian l(q, q') of order 1 with these parameters, for plant
+            /// simulation under an input u by the forced midpoint rule (discrete
+            /// Lagrange-d'Alembert), `retract::forced::forced_step(&system.plant(), &z0,
+            /// &system.input_force(&u), h, &options)`.
+            #[must_use]
+            pub fn plant(&self) -> #plant_ty {
+                #plant_name { #(#fields),* }
+            }
+
+            /// The generalized force B u of the input u: u_i on the i-th actuated coordinate
+            /// (`ACTUATED`), zero on the others.
+            #[must_use]
+            pub fn input_force(&self, u: &#na::SVector<f64, #a_len>) -> #vec_n {
+                let mut __out = #vec_n_path::zeros();
+                #(#sets)*
+                __out
             }
         }
     }
