@@ -136,6 +136,46 @@ pub use retract_macros::helper;
 #[doc(inline)]
 pub use retract_macros::discretization_map;
 
+/// A runnable example: the cart-pole written as its energy, its inverse dynamics, and the
+/// swing-up posed with the pole unactuated.
+///
+/// ```
+/// use retract::nalgebra::SVector;
+/// use retract::{Lagrangian, OptimalControlProblem, mechanical_system};
+///
+/// /// Cart x, pole angle th from the downward vertical: l = T - V.
+/// #[mechanical_system(actuated = [0])]
+/// fn cart_pole(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
+///     let kinetic = 0.5 * (mc + mp) * dq[0] * dq[0]
+///         + mp * l * q[1].cos() * dq[0] * dq[1]
+///         + 0.5 * mp * l * l * dq[1] * dq[1];
+///     kinetic + mp * g * l * q[1].cos()
+/// }
+///
+/// let system = CartPole::new(1.0, 0.3, 0.5, 9.81);
+/// let (q, dq, ddq) = (SVector::from([0.0, 0.4]), SVector::from([0.1, -0.2]), SVector::from([1.0, 2.0]));
+/// // the pole's torque: mp l cos(th) x'' + mp l^2 th'' + mp g l sin(th)
+/// let pole = 0.15 * 0.4f64.cos() + 0.075 * 2.0 + 0.15 * 9.81 * 0.4f64.sin();
+/// assert!((system.tau(&q, &dq, &ddq)[1] - pole).abs() < 1e-14);
+/// assert!((system.mass_matrix(&q, &dq)[(1, 1)] - 0.075).abs() < 1e-15);
+/// // the cost is 1/2 tau_0^2, the pole's torque an equality
+/// let cart = system.tau(&q, &dq, &ddq)[0];
+/// assert!((system.lagrangian(&[q, dq], &ddq) - 0.5 * cart * cart).abs() < 1e-14);
+/// let passive = system.unactuated_torques();
+/// let problem = OptimalControlProblem::new(&system, &[0.0; 4], &[0.0, 0.5, 0.0, 0.0], 1.0, 50)
+///     .with_equalities(&passive);
+/// # let _ = problem;
+/// // the plant: one forced midpoint step under the cart force u = 2
+/// let plant = system.plant();
+/// let z0 = retract::LiftedSystem::legendre(&plant, &SVector::from([0.0, 0.4, 0.0, 0.0]));
+/// let force = system.input_force(&SVector::from([2.0]));
+/// let (z1, _) = retract::forced::forced_step(&plant, &z0, &force, 0.01, &Default::default())?;
+/// assert!(z1[0] > 0.0); // the cart moves forward
+/// # Ok::<(), retract::Error>(())
+/// ```
+#[doc(inline)]
+pub use retract_macros::mechanical_system;
+
 #[doc(hidden)]
 pub mod __private {
     pub use retract_core;

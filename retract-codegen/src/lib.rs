@@ -1,5 +1,5 @@
-//! The expansions behind `#[higher_order_lagrangian]`, `#[jet_function]` and
-//! `#[discretization_map]`, as ordinary functions over `proc_macro2` tokens so that they can be
+//! The expansions behind `#[higher_order_lagrangian]`, `#[jet_function]`,
+//! `#[discretization_map]` and `#[mechanical_system]`, as ordinary functions over `proc_macro2` tokens so that they can be
 //! unit-tested, fuzzed and benchmarked.
 //!
 //! It reads a Lagrangian written as a plain Rust function, differentiates it symbolically and
@@ -7,7 +7,7 @@
 //! stages run:
 //!
 //! - `attribute`: the entry points, one module per attribute (`lagrangian`, `jet_function`,
-//!   `map`, `helper` with the re-entry of an attribute that names helpers);
+//!   `map`, `mechanical`, `helper` with the re-entry of an attribute that names helpers);
 //! - `front`: the attribute's options and the signature (`signature`: order, dimension,
 //!   parameters, space), the body lowered to the expression graph (`lower`);
 //! - `ir`: the hash-consed expression graph (`graph`) and its differentiation (`diff`);
@@ -41,3 +41,4 @@ pub use attribute::helper::expand_helper;
 pub use attribute::jet_function::{expand_jet_function, try_expand_jet_function};
 pub use attribute::lagrangian::{ExpansionStats, expand, expansion_stats, try_expand};
 pub use attribute::map::{expand_discretization_map, try_expand_discretization_map};
+pub use attribute::mechanical::{expand_mechanical_system, try_expand_mechanical_system};

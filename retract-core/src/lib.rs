@@ -20,7 +20,8 @@
 //! - the interface: [`Lagrangian`] and [`LiftedSystem`], what a system provides
 //!   ([`system`]); [`state`](mod@state): typed derivative data ([`Jet`]) and states
 //!   ([`State`]), built by the Legendre map and read by name ($q^{(j)}$, $p_j$, $u$); the
-//!   [`Error`] of every failure;
+//!   [`Error`] of every failure; [`mechanical`]: a system written as its energy $T - V$
+//!   (`#[mechanical_system]`), its Euler-Lagrange operator's components as stage equalities;
 //! - [`numeric`]: the kernels, [`numeric::newton`] (damped Newton), [`numeric::linalg`] (dense
 //!   LU), the banded LU, [`numeric::taylor`] (Taylor and dual numbers) and
 //!   [`numeric::special`] (Stumpff functions);
@@ -66,6 +67,7 @@
 pub mod bvp;
 mod error;
 pub mod manifold;
+pub mod mechanical;
 pub mod models;
 pub mod numeric;
 #[cfg(feature = "std")]
@@ -98,6 +100,7 @@ pub mod __private {
     pub use crate::manifold::se3::Se3System;
     pub use crate::manifold::so3::So3System;
     pub use crate::manifold::sphere::SphereSystem;
+    pub use crate::mechanical::MechanicalSystem;
     pub use crate::numeric::linalg::solve;
     pub use crate::numeric::special::stumpff;
     pub use crate::scheme::lifted::{hamiltonian, legendre, predictor, step_cost, vector_field};
@@ -121,6 +124,7 @@ pub use bvp::{
 };
 pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
+pub use mechanical::{MechanicalSystem, TorqueComponent};
 pub use newton::NewtonOptions;
 pub use reduced::{ClosedForm, ReducedFactors, ReducedScheme, ReducedStepper};
 pub use state::{Jet, State};

@@ -1,5 +1,6 @@
 //! The attributes of `retract`: `#[higher_order_lagrangian]` (a Lagrangian into an
-//! integrator and an optimal-control cost), `#[jet_function]` (a function of the jet into a
+//! integrator and an optimal-control cost), `#[mechanical_system]` (an energy T - V into its
+//! inverse dynamics and an optimal-control problem), `#[jet_function]` (a function of the jet into a
 //! constraint), `#[discretization_map]` (a discretization map into its lift) and `#[helper]`
 //! (a function shared by them). The expansions live in `retract-codegen`.
 #![forbid(unsafe_code)]
@@ -99,6 +100,45 @@ pub fn jet_function(attr: TokenStream, item: TokenStream) -> TokenStream {
 #[proc_macro_attribute]
 pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand_discretization_map(attr.into(), item.into()).into()
+}
+
+/// Turns a mechanical Lagrangian l(q, q') = T - V written as a Rust function into its
+/// inverse dynamics and an optimal-control problem of order 2, differentiated at compile
+/// time: with D the total time derivative,
+///
+/// ```text
+/// tau(q, q', q'') = D dl/dq' - dl/dq = M(q, q') q'' + d2l/dq'dq q' - dl/dq,   M = d2l/dq'2
+/// ```
+///
+/// is the generalized force the motion needs. The generated type (named after the function in
+/// UpperCamelCase, or `name = ...`; the parameters are its public fields, as for
+/// `#[higher_order_lagrangian]`) has the methods `tau(&q, &dq, &ddq)` and
+/// `mass_matrix(&q, &dq)`, and is itself the optimal-control Lagrangian of order 2
+/// (`retract::Lagrangian<n, 2>`, `LiftedSystem`, for `retract::OptimalControlProblem`)
+///
+/// ```text
+/// L(q, q', q'') = R/2 sum_a tau_a^2   over the actuated coordinates a,
+/// ```
+///
+/// while the components tau_c of the coordinates no actuator drives must vanish: the stage
+/// equalities `unactuated_torques()` (each a `retract::TorqueComponent`, a `JetFunction`),
+/// handed to the problem by `with_equalities`. For plant simulation, `plant()` is l itself as
+/// a system of order 1 (the type `<Type>Plant`) and `input_force(&u)` the generalized force
+/// B u of an input on the actuated coordinates: `retract::forced::forced_step(&plant, &z0,
+/// &system.input_force(&u), h, &options)` is the forced midpoint rule (discrete
+/// Lagrange-d'Alembert), with the typed errors of every step. A runnable example is in the
+/// docs of `retract`, which re-exports this attribute.
+///
+/// The arguments are q and q' (`[f64; N]`, or `f64` for N = 1), then the parameters; the body
+/// follows the rules of `#[higher_order_lagrangian]` (helpers included). Options:
+/// `actuated = [i, ...]` (the actuated coordinates, indices of q; all of them by default),
+/// `weight = R` (a positive literal, 1 by default), `name = TypeName`, `guard = false`,
+/// `helpers = [...]`, `order = 1` (the only order). Errors at the span: an order other than 1
+/// or an argument that looks like q'' (`ddq`), an actuated index out of range or repeated, a
+/// Lagrangian without kinetic energy, linear in q', or with a constant singular mass matrix.
+#[proc_macro_attribute]
+pub fn mechanical_system(attr: TokenStream, item: TokenStream) -> TokenStream {
+    retract_codegen::expand_mechanical_system(attr.into(), item.into()).into()
 }
 
 /// Marks a helper function that Lagrangians and stage constraints of the same crate may call:

@@ -15,6 +15,7 @@ mod degenerate;
 mod extrapolate;
 mod free_end;
 mod inequalities;
+mod mechanical;
 mod mpc;
 mod optimize;
 mod placement;

@@ -1,6 +1,6 @@
-//! Compile-time behaviour of `#[higher_order_lagrangian]`: every mistake in `tests/ui/fail`,
-//! sorted by topic (`signature`, `syntax`, `expressions`, `helpers`, `outputs`, `maps`,
-//! `manifolds`, `legendre`), is an error at its span with the message in the `.stderr` beside
+//! Compile-time behaviour of the attributes: every mistake in `tests/ui/fail`, sorted by topic
+//! (`signature`, `syntax`, `expressions`, `helpers`, `outputs`, `maps`, `manifolds`,
+//! `legendre`, `mechanical`), is an error at its span with the message in the `.stderr` beside
 //! it; every file in `tests/ui/pass` compiles and runs. Refresh the messages with
 //! `TRYBUILD=overwrite`.
 

@@ -9,13 +9,8 @@ use syn::ItemFn;
 
 use super::helper;
 use crate::charts;
-use crate::emit::Emission;
-use crate::emit::lagrangian::lagrangian_impl;
-use crate::emit::lifted::lifted_system_impl;
 use crate::emit::outputs::outputs_impl;
-use crate::emit::reduced::reduced_scheme_impl;
-use crate::emit::separable::separable_impl;
-use crate::emit::ty::type_and_constructor;
+use crate::emit::{Emission, system_items};
 use crate::front::lower::{Guard, Lower, Output, without_output_marks};
 use crate::front::signature::{Attribute, Signature, Space};
 use crate::ir::graph::{Graph, Id};
@@ -139,18 +134,7 @@ impl Passes for LagrangianPasses<'_> {
         let mech = mechanics::build(graph, lowered.root, sig.dim, sig.order);
         self.stats.graph_nodes = graph.len();
         let mech = mech.map_err(|reason| degenerate(sig, reason))?;
-        let guards: Vec<(Guard, [Id; 3])> = if sig.guard {
-            lowered
-                .guards
-                .into_iter()
-                .map(|guard| {
-                    let points = mechanics::at_step_points(graph, guard.node, sig.dim, sig.order);
-                    (guard, points)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let guards = mechanics::guards_at_step_points(graph, lowered.guards, sig);
         let flat: Vec<Vec<Id>> = mech.hessian.clone();
         let reduced = mechanics::reduce(graph, &mech.gradient, &flat, sig.dim, sig.order);
         self.stats.graph_nodes = graph.len();
@@ -172,7 +156,7 @@ impl Passes for LagrangianPasses<'_> {
             &d.guards,
             d.reduced.as_ref(),
         );
-        let mut out = generate(&emission);
+        let mut out = system_items(&emission);
         out.extend(outputs_impl(&emission, &d.outputs));
         out
     }
@@ -221,20 +205,6 @@ fn in_chart(
         .map(|(guard, &node)| Guard { node, ..guard })
         .collect();
     (sig, composed[0], guards)
-}
-
-/// The generated items, in order: the function and its type (`emit::ty`), the `Lagrangian`
-/// impl (`emit::lagrangian`), the `LiftedSystem` impl with its domain check (`emit::lifted`,
-/// `emit::domain`), where the step reduces, the `ReducedScheme` impl (`emit::reduced`) and,
-/// where L = c/2 |u|^2 + V(q), the `Separable` impl (`emit::separable`);
-/// then the methods of the named outputs (`emit::outputs`).
-fn generate(e: &Emission<'_>) -> TokenStream {
-    let mut out = type_and_constructor(e);
-    out.extend(lagrangian_impl(e));
-    out.extend(lifted_system_impl(e));
-    out.extend(reduced_scheme_impl(e));
-    out.extend(separable_impl(e));
-    out
 }
 
 #[cfg(test)]

@@ -121,12 +121,30 @@ pub(crate) fn callable(function: &ItemFn) -> ItemFn {
     function
 }
 
-/// The annotated function, re-emitted (`callable`), the parameter struct of `sig` documented
-/// by `doc`, and its inherent impl: the constants `consts`, then the constructor `new`
-/// documented by `new_doc` (a doc comment). Shared by the Lagrangian (`emit::ty`) and
-/// `#[jet_function]`.
+/// The annotated function, re-emitted (`callable`), then [`type_items`]. Shared by the
+/// Lagrangian (`emit::ty`), `#[jet_function]` and `#[discretization_map]`.
 pub(crate) fn function_and_type(
     function: &ItemFn,
+    sig: &Signature,
+    params: &ParamTokens,
+    doc: &str,
+    consts: TokenStream,
+    new_doc: TokenStream,
+) -> TokenStream {
+    let callable = callable(function);
+    let items = type_items(&function.vis, sig, params, doc, consts, new_doc);
+    quote! {
+        #callable
+
+        #items
+    }
+}
+
+/// The parameter struct of `sig` with visibility `vis`, documented by `doc`, and its
+/// inherent impl: the constants `consts`, then the constructor `new` documented by `new_doc`
+/// (a doc comment).
+pub(crate) fn type_items(
+    vis: &syn::Visibility,
     sig: &Signature,
     params: &ParamTokens,
     doc: &str,
@@ -140,8 +158,7 @@ pub(crate) fn function_and_type(
         ctor_args,
         field_names,
     } = params;
-    let (vis, ty) = (&function.vis, &sig.type_name);
-    let function = callable(function);
+    let ty = &sig.type_name;
     // without parameters a unit struct, usable as a value by its name alone
     let body = if fields.is_empty() {
         quote!(;)
@@ -149,8 +166,6 @@ pub(crate) fn function_and_type(
         quote!({ #(#fields,)* })
     };
     quote! {
-        #function
-
         #[doc = #doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
         #vis struct #ty #generics #body

@@ -9,7 +9,9 @@
 //! - `reduced`: the `ReducedScheme` impl, where the Hessian of L depends on a few jet
 //!   components only;
 //! - `separable`: the `Separable` impl, where L = c/2 |u|^2 + V(q) (explicit splitting);
-//! - `outputs`: a method per named output (`#[output] let`) of the Lagrangian.
+//! - `outputs`: a method per named output (`#[output] let`) of the Lagrangian;
+//! - `mechanical`: for `#[mechanical_system]`, the inverse dynamics, the mass matrix and the
+//!   unactuated components of tau (`retract_core::MechanicalSystem`).
 //!
 //! `map` emits the items of `#[discretization_map]` (its own type and `DiscretizationMap`
 //! impl, from the stages `mechanics::lift` and `mechanics::map_conditions`).
@@ -36,6 +38,7 @@ pub(crate) mod helpers;
 pub(crate) mod lagrangian;
 pub(crate) mod lifted;
 pub(crate) mod map;
+pub(crate) mod mechanical;
 pub(crate) mod outputs;
 pub(crate) mod reduced;
 pub(crate) mod scalar;
@@ -208,4 +211,17 @@ impl<'a> Emission<'a> {
 /// The jet inside the methods of the scheme: not read there.
 fn no_jet(_: u8, _: u32) -> TokenStream {
     quote!(::core::f64::NAN)
+}
+
+/// The items of a system, in order: the function and its type (`ty`), the `Lagrangian` impl
+/// (`lagrangian`), the `LiftedSystem` impl with its domain check (`lifted`, `domain`), where
+/// the step reduces, the `ReducedScheme` impl (`reduced`) and, where L = c/2 |u|^2 + V(q),
+/// the `Separable` impl (`separable`).
+pub(crate) fn system_items(e: &Emission<'_>) -> TokenStream {
+    let mut out = ty::type_and_constructor(e);
+    out.extend(lagrangian::lagrangian_impl(e));
+    out.extend(lifted::lifted_system_impl(e));
+    out.extend(reduced::reduced_scheme_impl(e));
+    out.extend(separable::separable_impl(e));
+    out
 }

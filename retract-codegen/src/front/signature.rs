@@ -55,6 +55,9 @@ pub enum Attribute {
     JetFunction,
     /// `#[discretization_map]`: a map (q, v) -> (R1, R2), lifted to T^(k-1)Q.
     Map,
+    /// `#[mechanical_system]`: a mechanical Lagrangian l(q, q') = T - V into its
+    /// Euler-Lagrange operator and the optimal-control Lagrangian of order 2.
+    Mechanical,
 }
 
 impl Attribute {
@@ -64,13 +67,14 @@ impl Attribute {
             Attribute::Lagrangian => "higher_order_lagrangian",
             Attribute::JetFunction => "jet_function",
             Attribute::Map => "discretization_map",
+            Attribute::Mechanical => "mechanical_system",
         }
     }
 
     /// A message written for a Lagrangian, reworded for the function this attribute takes.
     pub fn reword(self, msg: String) -> String {
         match self {
-            Attribute::Lagrangian => msg,
+            Attribute::Lagrangian | Attribute::Mechanical => msg,
             Attribute::JetFunction => msg.replace("Lagrangian", "jet function"),
             Attribute::Map => msg.replace("Lagrangian", "discretization map"),
         }
@@ -220,13 +224,27 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             // (read by `helper::helper_names`; here only skipped)
             let _: syn::Expr = meta.value()?.parse()?;
             Ok(())
-        } else if meta.path.is_ident("guard") && attribute == Attribute::Lagrangian {
+        } else if attribute == Attribute::Mechanical
+            && crate::front::actuation::OPTIONS
+                .iter()
+                .any(|name| meta.path.is_ident(name))
+        {
+            // (read by `front::actuation`; here only skipped)
+            let _: syn::Expr = meta.value()?.parse()?;
+            Ok(())
+        } else if meta.path.is_ident("guard")
+            && matches!(attribute, Attribute::Lagrangian | Attribute::Mechanical)
+        {
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
-        } else if let Some(space) = [Space::Sphere, Space::So3, Space::Se3]
-            .into_iter()
-            .find(|space| meta.path.is_ident(space.option()) && attribute != Attribute::Map)
+        } else if let Some(space) =
+            [Space::Sphere, Space::So3, Space::Se3]
+                .into_iter()
+                .find(|space| {
+                    meta.path.is_ident(space.option())
+                        && !matches!(attribute, Attribute::Map | Attribute::Mechanical)
+                })
         {
             if let Some((other, _)) = options.space.filter(|(other, _)| *other != space) {
                 return Err(meta.error(format!(
@@ -245,6 +263,11 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             Err(meta.error(
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
                  `check = false`",
+            ))
+        } else if attribute == Attribute::Mechanical {
+            Err(meta.error(
+                "unsupported option; supported: `actuated = [i, ...]`, `weight = R`, \
+                 `name = TypeName`, `guard = false`, `helpers = [...]`, `order = 1`",
             ))
         } else if attribute == Attribute::Lagrangian {
             Err(meta.error(
@@ -736,6 +759,23 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         list: Vec::new(),
     };
 
+    let options = match (attribute, options.order) {
+        (Attribute::Mechanical, Some((order, span))) if order != 1 => {
+            return Err(syn::Error::new(
+                span,
+                format!(
+                    "a mechanical Lagrangian l(q, q') = T - V is of order 1, not {order}: the \
+                     attribute derives the terms in q'' (the mass matrix) itself; write \
+                     `order = 1` or leave the order out"
+                ),
+            ));
+        }
+        (Attribute::Mechanical, None) => Options {
+            order: Some((1, Span::call_site())),
+            ..options
+        },
+        _ => options,
+    };
     let Some((order, order_span)) = options.order else {
         return Err(syn::Error::new(
             Span::call_site(),

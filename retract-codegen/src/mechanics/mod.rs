@@ -2,12 +2,15 @@
 //! Ostrogradsky momenta, the Legendre inversion when L is quadratic in u, and the residual
 //! and Jacobians of the lifted theta-scheme (formulas in `retract_core::LiftedSystem`).
 
+pub(crate) mod euler_lagrange;
 pub(crate) mod lift;
 pub(crate) mod map_conditions;
 pub(crate) mod separable;
 
 use std::collections::HashMap;
 
+use crate::front::lower::Guard;
+use crate::front::signature::Signature;
 use crate::ir::diff::{Differentiator, substitute, total_derivative};
 use crate::ir::graph::{Graph, Id, Var};
 
@@ -86,6 +89,19 @@ pub fn derivatives(
 
 /// Builds the mechanics of L = `lagrangian` of order k on R^n.
 pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechanics, Degenerate> {
+    build_with(g, lagrangian, n, k, false)
+}
+
+/// [`build`], where `singular_allowed` accepts a constant singular A = d2L/du2 (no Legendre
+/// inverse then): an optimal-control cost whose singular directions the stage equalities
+/// fix, as the effort of an underactuated mechanical system.
+pub fn build_with(
+    g: &mut Graph,
+    lagrangian: Id,
+    n: usize,
+    k: usize,
+    singular_allowed: bool,
+) -> Result<Mechanics, Degenerate> {
     let (mut d, gradient, hessian) = derivatives(g, lagrangian, n, k);
 
     // Degeneracy in the top derivative.
@@ -111,7 +127,10 @@ pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechan
         }
     }
 
-    let legendre_inverse = legendre_inverse(g, &mut d, &a, &gradient[top..], n, k)?;
+    let legendre_inverse = match legendre_inverse(g, &mut d, &a, &gradient[top..], n, k) {
+        Err(Degenerate::Singular) if singular_allowed => None,
+        other => other?,
+    };
     let (residual, jacobian, jacobian_initial) = scheme(g, &mut d, &gradient, n, k);
     Ok(Mechanics {
         lagrangian,
@@ -164,7 +183,7 @@ fn legendre_inverse(
 }
 
 /// Gauss-Jordan inverse with partial pivoting; `None` if singular or not finite.
-fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
+pub(crate) fn invert(a: &[f64], n: usize) -> Option<Vec<f64>> {
     if a.iter().any(|v| !v.is_finite()) {
         return None;
     }
@@ -663,6 +682,25 @@ pub fn at_step_points(g: &mut Graph, node: Id, n: usize, k: usize) -> [Id; 3] {
         }
     };
     [0, 1, 2].map(|which| substitute(g, node, &point(which), &mut HashMap::new()))
+}
+
+/// Each of `guards` with its expression at the three points of a step ([`at_step_points`]),
+/// for the system of signature `sig`; none where `sig` turns the guard off.
+pub fn guards_at_step_points(
+    g: &mut Graph,
+    guards: Vec<Guard>,
+    sig: &Signature,
+) -> Vec<(Guard, [Id; 3])> {
+    if !sig.guard {
+        return Vec::new();
+    }
+    guards
+        .into_iter()
+        .map(|guard| {
+            let points = at_step_points(g, guard.node, sig.dim, sig.order);
+            (guard, points)
+        })
+        .collect()
 }
 
 #[cfg(test)]

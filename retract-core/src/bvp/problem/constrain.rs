@@ -19,6 +19,16 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         self
     }
 
+    /// Adds each of `constraints` as an equality ([`Self::with_equality`]): e.g. the
+    /// unactuated components of a mechanical system's Euler-Lagrange operator
+    /// (`unactuated_torques()` of a `#[mechanical_system]` type).
+    pub fn with_equalities<C: JetFunction<N, K> + Sync>(mut self, constraints: &'a [C]) -> Self {
+        for constraint in constraints {
+            self.equalities.push(constraint);
+        }
+        self
+    }
+
     /// Adds the inequality $g \ge 0$ (obstacle clearance, a keep-out cone, a torque limit
     /// $\tau_{\max} - \tau \ge 0$) where it belongs: a $g$ of the jet alone at every node and
     /// every step's evaluation point, one that involves $u$ at the evaluation points

@@ -1,0 +1,63 @@
+//! The cart-pole from its energy to a certified swing-up: the Lagrangian T - V written once,
+//! `#[mechanical_system]` derives the inverse dynamics tau(q, q', q''), the minimum-force cost
+//! 1/2 F^2 on the cart (the actuated coordinate) and the pole's equality tau_pole = 0; the
+//! optimizer plans the rest-to-rest swing-up of the swing-up suite (`../shared/BENCHMARKS.md`:
+//! mc = 1, mp = 0.3, l = 0.5, T = 2, N = 200) and certifies it. One line:
+//! `cartpole-energy T=<T> N=<N> J=<J> iterations=<n> time_ms=<t> min_reduced_hessian_eig=<e>
+//! max_pole_torque=<tau>`.
+//!
+//! Run: `cargo run --release --example cartpole_energy`.
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use retract::nalgebra::SVector;
+use retract::{OptimalControlProblem, PlanGuess, PlanOptions, mechanical_system};
+
+/// Cart position x and pole angle th from the downward vertical, pole mass mp at length l:
+/// l = T - V, the cart driven, the pole free.
+#[mechanical_system(actuated = [0])]
+fn cart_pole(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
+    let kinetic = 0.5 * (mc + mp) * dq[0] * dq[0]
+        + mp * l * q[1].cos() * dq[0] * dq[1]
+        + 0.5 * mp * l * l * dq[1] * dq[1];
+    let potential = -mp * g * l * q[1].cos();
+    kinetic - potential
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let (t_end, steps) = (2.0, 200);
+    let system = CartPole::new(1.0, 0.3, 0.5, 9.81);
+    let passive = system.unactuated_torques();
+    let options = PlanOptions::default().with_min_eigenvalue(true);
+    let start = Instant::now();
+    let plan = OptimalControlProblem::new(&system, &[0.0; 4], &[0.0, PI, 0.0, 0.0], t_end, steps)
+        .with_equalities(&passive)
+        .with_options(options)
+        .solve(PlanGuess::Spline)?;
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    // the pole's torque at every step's midpoint, from the generated inverse dynamics
+    let max_pole_torque = (0..steps)
+        .map(|i| {
+            let x = (plan.x[i] + plan.x[i + 1]) * 0.5;
+            let (q, dq) = (SVector::from([x[0], x[1]]), SVector::from([x[2], x[3]]));
+            system.tau(&q, &dq, &plan.u[i])[1].abs()
+        })
+        .fold(0.0, f64::max);
+    if plan.certificate.negative_directions != 0 {
+        return Err("the plan is not a certified minimum".into());
+    }
+    println!(
+        "cartpole-energy T={t_end} N={steps} J={:.6} iterations={} time_ms={ms:.1} \
+         min_reduced_hessian_eig={:.3e} max_pole_torque={max_pole_torque:.1e}",
+        plan.cost, plan.iterations, plan.certificate.min_reduced_hessian_eig
+    );
+    Ok(())
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,112 @@
+//! The options of `#[mechanical_system]` beyond the signature's: which coordinates the
+//! actuators drive (`actuated = [i, ...]`, all of them by default) and the weight R of the
+//! effort 1/2 R |tau_actuated|^2 (`weight = R`, 1 by default), each error at its span.
+
+use proc_macro2::{Span, TokenStream};
+use syn::spanned::Spanned;
+
+use crate::util::combine;
+
+/// The options this module reads (`front::signature` skips them).
+pub(crate) const OPTIONS: [&str; 2] = ["actuated", "weight"];
+
+/// The actuation of a mechanical system, as written.
+pub(crate) struct Actuation {
+    /// The actuated coordinates with the span of each index; `None`: all of them.
+    pub actuated: Option<Vec<(usize, Span)>>,
+    /// R > 0.
+    pub weight: f64,
+}
+
+impl Actuation {
+    /// The actuated coordinates of a system of dimension `n`, ascending, or the errors at the
+    /// indices out of range or repeated.
+    pub fn coordinates(&self, n: usize) -> syn::Result<Vec<usize>> {
+        let Some(list) = &self.actuated else {
+            return Ok((0..n).collect());
+        };
+        let mut errors = Vec::new();
+        let mut seen = vec![false; n];
+        for &(i, span) in list {
+            if i >= n {
+                errors.push(syn::Error::new(
+                    span,
+                    format!(
+                        "actuated coordinate {i} out of range: q has {n} coordinates, \
+                         0..={}",
+                        n.saturating_sub(1)
+                    ),
+                ));
+            } else if std::mem::replace(&mut seen[i], true) {
+                errors.push(syn::Error::new(
+                    span,
+                    format!("coordinate {i} is listed twice in `actuated`"),
+                ));
+            }
+        }
+        match combine(errors) {
+            Some(e) => Err(e),
+            None => Ok((0..n).filter(|&i| seen[i]).collect()),
+        }
+    }
+}
+
+/// Reads `actuated` and `weight` from the attribute's options, skipping the others.
+pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
+    let mut out = Actuation {
+        actuated: None,
+        weight: 1.0,
+    };
+    let parser = syn::meta::parser(|meta| {
+        if meta.path.is_ident("actuated") {
+            let list: syn::ExprArray = meta.value()?.parse()?;
+            if list.elems.is_empty() {
+                return Err(syn::Error::new(
+                    list.span(),
+                    "`actuated` lists at least one coordinate (an index of q)",
+                ));
+            }
+            let indices = list.elems.iter().map(|e| match e {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(i),
+                    ..
+                }) => Ok((i.base10_parse::<usize>()?, i.span())),
+                other => Err(syn::Error::new(
+                    other.span(),
+                    "`actuated` lists the indices of q as integer literals: `actuated = [0, 2]`",
+                )),
+            });
+            out.actuated = Some(indices.collect::<syn::Result<_>>()?);
+        } else if meta.path.is_ident("weight") {
+            let value: syn::Expr = meta.value()?.parse()?;
+            let weight = match &value {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Float(f),
+                    ..
+                }) => f.base10_parse::<f64>().ok(),
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(i),
+                    ..
+                }) => i.base10_parse::<f64>().ok(),
+                _ => None,
+            };
+            out.weight = weight
+                .filter(|w| w.is_finite() && *w > 0.0)
+                .ok_or_else(|| {
+                    syn::Error::new(
+                        value.span(),
+                        "`weight` is the effort's weight R, a positive finite number literal: \
+                     `weight = 0.5`",
+                    )
+                })?;
+        } else {
+            // (the signature's options, checked by `front::signature`)
+            if meta.input.peek(syn::Token![=]) {
+                let _: syn::Expr = meta.value()?.parse()?;
+            }
+        }
+        Ok(())
+    });
+    syn::parse::Parser::parse2(parser, attr)?;
+    Ok(out)
+}
