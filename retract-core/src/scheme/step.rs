@@ -95,9 +95,10 @@ pub struct StepOptions {
     /// $z_0$ understate the exchange. Switch it on for a smooth mechanical system at
     /// $\theta = 1/2$ that may be driven faster than its step resolves (a plant under
     /// disturbances).
+    #[cfg_attr(feature = "serde", serde(default = "energy_tolerance_by_default"))]
     #[cfg_attr(
-        feature = "serde",
-        serde(with = "crate::serde_float", default = "energy_tolerance_by_default")
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
     )]
     pub energy_tolerance: f64,
 }
