@@ -183,6 +183,17 @@ pub enum Error {
         /// max-norm of the residual at the last accepted iterate.
         residual_norm: f64,
     },
+    /// A converged step's energy balance is off by more than its tolerance
+    /// ([`StepOptions::energy_tolerance`](crate::StepOptions::energy_tolerance)): the root
+    /// continues a step too long to resolve the motion (a fast rotation over a few radians,
+    /// landing at another energy), not the motion itself.
+    UnresolvedStep {
+        /// $|H(z_1) - H(z_0) - W|$, the energy the step created ($W$: the work of a force).
+        energy_error: f64,
+        /// The energy the step exchanged, $E = \sum_i |p_i'||\Delta x_i| + |x_i'||\Delta p_i|$
+        /// (derivatives at $z_0$).
+        exchanged: f64,
+    },
     /// A boundary-value solution passes through obstacle `obstacle`: its clearance at state
     /// `step` is `clearance` < 0 (or NaN).
     ThroughObstacle {
@@ -449,6 +460,15 @@ impl fmt::Display for Error {
                  {residual_norm:e}): reduce the step size (or allow step halving) or raise the \
                  iteration cap"
             ),
+            Error::UnresolvedStep {
+                energy_error,
+                exchanged,
+            } => write!(
+                f,
+                "the step changed the energy by {energy_error:e}, more than its tolerance \
+                 allows against the {exchanged:e} it exchanged: the step is too long for the \
+                 motion; reduce the step size (or allow step halving)"
+            ),
             Error::LineSearchFailed {
                 iteration,
                 residual_norm,
@@ -593,6 +613,13 @@ mod tests {
                 vec!["line search", "iteration 4", "step size"],
             ),
             (
+                Error::UnresolvedStep {
+                    energy_error: 2.1e3,
+                    exchanged: 8.9e3,
+                },
+                vec!["energy", "2.1e3", "8.9e3", "step size"],
+            ),
+            (
                 Error::ThroughObstacle {
                     obstacle: 1,
                     step: 17,
@@ -723,7 +750,9 @@ mod tests {
             let message = error.to_string();
             let step = matches!(
                 error,
-                Error::NoConvergence { .. } | Error::LineSearchFailed { .. }
+                Error::NoConvergence { .. }
+                    | Error::LineSearchFailed { .. }
+                    | Error::UnresolvedStep { .. }
             );
             assert_eq!(
                 message.contains("step halving") || message.contains("reduce the step size"),

@@ -369,4 +369,54 @@ mod tests {
             Err(Error::NonFinite { .. })
         ));
     }
+
+    /// A jet or a state read from JSON holds finite numbers only (JSON has no NaN), but
+    /// hostile ones: each is refused by its use (the Legendre map, a step), never turned
+    /// into a non-finite state.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn hostile_jets_and_states_from_json_are_refused_on_use() {
+        let system = PlanarBarrier {
+            tau: 0.3,
+            radius: 1.0,
+            mass: 2.0,
+        };
+        let jet = Jet::<2, 2>::new(&[[2.0, 0.5], [1.0, -0.5], [0.2, 0.4], [0.1, -0.3]]).unwrap();
+        let valid_jet = serde_json::to_value(jet).unwrap();
+        let state = State::from_jet(&system, &jet).unwrap();
+        let valid_state = serde_json::to_value(state).unwrap();
+        assert_eq!(
+            serde_json::from_value::<State<2, 2>>(valid_state.clone()).unwrap(),
+            state
+        );
+        // q'' = 1e308: the momentum m q'' overflows
+        let mut value = valid_jet.clone();
+        value["upper"][0][0] = 1e308.into();
+        let read: Jet<2, 2> = serde_json::from_value(value).unwrap();
+        assert!(State::from_jet(&system, &read).is_err());
+        // NaN and infinity do not read (serde_json refuses them)
+        for bad in ["NaN", "1e400"] {
+            let text = valid_jet.to_string().replacen("2.0", bad, 1);
+            assert!(serde_json::from_str::<Jet<2, 2>>(&text).is_err(), "{bad}");
+        }
+        // a state of huge numbers steps to an error or to a finite state, never to NaN
+        let options = StepOptions::default();
+        for (block, j, value) in [
+            ("x", 0, 1e308),
+            ("x", 1, 1e308),
+            ("p", 1, -1e308),
+            ("p", 0, 1e200),
+        ] {
+            let mut edited = valid_state.clone();
+            edited[block][j][0] = value.into();
+            let read: State<2, 2> = serde_json::from_value(edited).unwrap();
+            if let Ok((next, _)) = read.step(&system, 0.01, &options) {
+                let z: SVector<f64, 8> = next.to_vector();
+                assert!(
+                    z.iter().all(|v| v.is_finite()),
+                    "{block}{j} = {value:e}: {z}"
+                );
+            }
+        }
+    }
 }

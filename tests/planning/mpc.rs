@@ -53,3 +53,53 @@ fn the_loop_swings_up_and_holds() {
         summary.converged
     );
 }
+
+/// A kick of (20, -20) to the plant's momenta spins it at about 140 rad/s: one control period
+/// (h = 0.02, about 2.8 rad) converges to a root at twice the energy (a step too long for the
+/// motion). The energy check (tolerance 0.05) refuses that step, and a trajectory that may
+/// halve resolves it to within 2 % of the energy 16 substeps reach.
+#[test]
+fn a_kicked_plant_step_is_refused_and_halving_resolves_it() {
+    use retract::forced::forced_step;
+    use retract::{Error, LiftedSystem, StepOptions, step, trajectory};
+    let (_, plant) = pendulum::models();
+    let energy = |z: &SVector<f64, 4>| plant.hamiltonian(z).expect("energy");
+    let z0 = SVector::from([0.5, 0.0, 20.0, -20.0]);
+    let h = pendulum::HORIZON / pendulum::STEPS as f64;
+    let checked = StepOptions::default().with_energy_tolerance(0.05);
+    // 16 substeps, each accepted by the check
+    let mut fine = z0;
+    for _ in 0..16 {
+        fine = step(&plant, &fine, h / 16.0, &checked).expect("resolved").0;
+    }
+    let reference = energy(&fine);
+    assert!((reference - energy(&z0)).abs() < 0.01 * reference);
+    // without the check (the default), the root of the whole period is at twice the energy
+    let unchecked = StepOptions::default();
+    let far = step(&plant, &z0, h, &unchecked).expect("converges").0;
+    assert!(energy(&far) > 1.8 * reference, "{}", energy(&far));
+    // with it, refused, with and without a force
+    let refused = |result: Result<(SVector<f64, 4>, retract::StepReport), Error>| match result {
+        Err(Error::UnresolvedStep {
+            energy_error,
+            exchanged,
+        }) => energy_error > 0.2 * exchanged && energy_error > 0.5 * reference,
+        _ => false,
+    };
+    assert!(refused(step(&plant, &z0, h, &checked)));
+    assert!(refused(forced_step(
+        &plant,
+        &z0,
+        &SVector::from([1.0, -1.0]),
+        h,
+        &checked
+    )));
+    // halved until resolved: 2^m pieces, the energy within 2 % of the reference
+    let run = trajectory(&plant, &z0, h, 1, &checked.with_max_halvings(8)).expect("halved");
+    let (halvings, end) = (run.reports[0].halvings, energy(&run.states[1]));
+    assert!((2..=4).contains(&halvings), "{halvings}");
+    assert!(
+        (end - reference).abs() < 0.02 * reference,
+        "{end} against {reference}"
+    );
+}

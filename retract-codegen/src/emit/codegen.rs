@@ -325,11 +325,13 @@ impl Emitter<'_> {
             }
         }
         // children first; binding a node that is not absorbed changes no chain
+        let mut nest = vec![0; len];
         for i in 0..len {
             if absorbed[i] || !emitted[i] {
                 continue;
             }
             let id = Id(i as u32);
+            nest[i] = self.bind_deep_operands(id, &nest, &mut ops);
             let (latency, depth) = self.estimate(id);
             self.latency[i] = latency;
             self.depth[i] = depth;
@@ -337,6 +339,42 @@ impl Emitter<'_> {
                 self.inline[i] = false;
             }
         }
+    }
+
+    /// Binds to its own `let` each inlined operand of `id` (its children, or the operands
+    /// of the chain it heads) whose value [`Emitter::reference`] would reach through
+    /// `MAX_DEPTH` or more inlined levels (`nest`, per node), or, for a chain, that is nested
+    /// more deeply than a merge allows (see [`merged_depth`]); returns the levels of `id`.
+    /// So the emitter's recursion through inlined values stays within `MAX_DEPTH` levels:
+    /// the nesting of the code alone does not bound it, since a chain's long parts are cut
+    /// into `let`s after their operands are built (the derivatives of a long product are
+    /// sums and products nested in turn as deep as the product is long).
+    fn bind_deep_operands(&mut self, id: Id, nest: &[u32], ops: &mut Vec<(Operand, bool)>) -> u32 {
+        ops.clear();
+        let kind = self.head(id, false);
+        match kind {
+            Some(kind) => self.operands(id, kind, false, ops, |_| {}),
+            None => ops.extend(
+                children(self.g.node(id))
+                    .into_iter()
+                    .map(|c| (Operand::Node(c), false)),
+            ),
+        }
+        let mut levels = 0;
+        for &(op, _) in ops.iter() {
+            let Operand::Node(c) = op else { continue };
+            let i = c.0 as usize;
+            if !self.inline[i] || is_leaf(self.g.node(c)) {
+                continue;
+            }
+            let too_deep = kind.is_some() && self.reference_depth(c, false) > MAX_DEPTH - 2;
+            if too_deep || nest[i] >= MAX_DEPTH {
+                self.inline[i] = false;
+            } else {
+                levels = levels.max(nest[i]);
+            }
+        }
+        levels + 1
     }
 
     /// The chain `id` heads, if it is a sum or a product (a function-level `Neg` heads the

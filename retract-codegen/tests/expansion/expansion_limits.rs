@@ -257,3 +257,25 @@ fn brackets_nested_past_the_limit_are_one_error() {
         assert!(e.is_ok(), "{what} 250: {e:?}");
     }
 }
+
+#[test]
+fn chains_of_five_thousand_operations_expand_with_bounded_nesting() {
+    // the derivatives of a long product are sums and products nested in turn as deep as the
+    // product is long; the emitter followed them by recursion before cutting the code at its
+    // nesting limit, and 5000 factors overflowed rustc's stack
+    let chain = |op: &str, m: usize| vec!["q[0]"; m].join(op);
+    for op in [" * ", " / ", " + ", " - "] {
+        linear(op, 1250, |m| chain(op, m));
+        let item = format!(
+            "fn l(q: [f64; 2], dq: [f64; 2]) -> f64 {{ 0.5 * (dq[0] * dq[0] + dq[1] * dq[1]) + {} }}",
+            chain(op, 5000)
+        );
+        let depth =
+            on_rustc_stack(move || paren_depth(expand("order = 1", &item).expect("expands")));
+        assert!(depth <= 66, "{op}: nesting {depth}");
+    }
+    // the binary functions, chained as methods
+    for call in [".hypot(q[1])", ".powf(2.5)", ".atan2(q[1])"] {
+        linear(call, 250, |m| format!("q[0]{}", call.repeat(m)));
+    }
+}

@@ -536,14 +536,18 @@ fn check_case(case: &Case, seed: u64, index: usize) -> (bool, ExpansionStats) {
 fn run(seed: u64) -> (usize, usize) {
     let cases = cases();
     let mut rng = Rng(seed);
-    let mut slowest = std::time::Duration::ZERO;
+    let (mut slowest, mut slowest_case, mut over_10s) = (std::time::Duration::ZERO, 0, 0);
     let (mut expanded, mut nodes, mut largest, mut ratio) = (0, 0, 0, 0.0_f64);
     for i in 0..cases {
         let smooth = rng.chance(0.2);
         let case = generate(&mut rng, smooth, &format!("l{i}"));
         let start = std::time::Instant::now();
         let (ok, stats) = check_case(&case, seed, i);
-        slowest = slowest.max(start.elapsed());
+        let elapsed = start.elapsed();
+        if elapsed > slowest {
+            (slowest, slowest_case) = (elapsed, i);
+        }
+        over_10s += usize::from(elapsed.as_secs() >= 10);
         expanded += usize::from(ok);
         nodes += stats.graph_nodes;
         largest = largest.max(stats.graph_nodes);
@@ -554,7 +558,7 @@ fn run(seed: u64) -> (usize, usize) {
     println!(
         "seed {seed:#x}: {cases} cases, {expanded} expanded, {nodes} graph nodes in all, \
          largest {largest}, at most {ratio:.2} nodes per lowered node and Hessian entry, \
-         slowest case {slowest:?}"
+         slowest case {slowest:?} (case {slowest_case}), {over_10s} cases over 10 s"
     );
     assert!(
         nodes <= NODES_PER_RUN * cases / CASES,

@@ -179,6 +179,26 @@ impl Chart {
         Matrix3::from_columns(&[self.centre, self.e1, self.e2])
     }
 
+    /// Whether this is a chart (one read back from a file, or written field by field, holds
+    /// whatever vectors it was given; [`Self::at`] makes only charts): its frame
+    /// $(c, e_1, e_2)$ orthonormal to $10^{-12}$ (NaN fails). [`SphereState::validate`] runs
+    /// it.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `chart`.
+    pub fn validate(&self) -> Result<(), Error> {
+        let f = self.frame();
+        let gram = f.transpose() * f - Matrix3::identity();
+        if gram.iter().all(|g| g.abs() <= ON_SPHERE) {
+            Ok(())
+        } else {
+            Err(Error::InvalidArgument {
+                name: "chart",
+                requirement: "its frame (c, e1, e2) must be orthonormal to 1e-12",
+            })
+        }
+    }
+
     /// $E = [e_1\ e_2]$.
     fn basis(&self) -> Matrix3x2<f64> {
         Matrix3x2::from_columns(&[self.e1, self.e2])
@@ -349,14 +369,7 @@ impl<const K: usize, const S: usize> SphereState<K, S> {
     /// [`Error::InvalidArgument`] named `chart` for a frame that is not orthonormal, named
     /// `state` for a point off the unit sphere; [`Error::NonFinite`] for a non-finite $z$.
     pub fn validate(&self) -> Result<(), Error> {
-        let f = self.chart.frame();
-        let gram = f.transpose() * f - Matrix3::identity();
-        if !gram.iter().all(|g| g.abs() <= ON_SPHERE) {
-            return Err(Error::InvalidArgument {
-                name: "chart",
-                requirement: "its frame (c, e1, e2) must be orthonormal to 1e-12",
-            });
-        }
+        self.chart.validate()?;
         if !self.z.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFinite {
                 iteration: 0,
@@ -614,6 +627,56 @@ mod tests {
         for j in 0..2 {
             let fd = (hi[j] - lo[j]) / (2.0 * e);
             assert!((fd - mid[j + 1]).amax() < 1e-7, "{j}");
+        }
+    }
+
+    /// A chart or a state read from hostile JSON fails its validation, which the steps run.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn a_hostile_chart_or_state_from_json_fails_its_validation() {
+        type Edit = fn(&mut serde_json::Value);
+        let chart = Chart::at(&Vector3::new(1.0, 2.0, -2.0)).unwrap();
+        let state = SphereState::<1, 4> {
+            chart,
+            z: SVector::from([0.1, -0.2, 0.3, 0.4]),
+        };
+        let valid = serde_json::to_value(state).unwrap();
+        let back: SphereState<1, 4> = serde_json::from_value(valid.clone()).unwrap();
+        assert!(back.validate().is_ok() && back.chart.validate().is_ok());
+        let edits: [(&str, Edit, &str); 5] = [
+            ("e1 scaled", |v| v["chart"]["e1"][0] = 0.9.into(), "chart"),
+            (
+                "e2 = e1",
+                |v| v["chart"]["e2"] = v["chart"]["e1"].clone(),
+                "chart",
+            ),
+            (
+                "a zero centre",
+                |v| v["chart"]["centre"] = serde_json::json!([0.0, 0.0, 0.0]),
+                "chart",
+            ),
+            (
+                "a huge centre",
+                |v| v["chart"]["centre"][2] = 1e308.into(),
+                "chart",
+            ),
+            (
+                "y = 1e200 (the point overflows)",
+                |v| v["z"][0] = 1e200.into(),
+                "state",
+            ),
+        ];
+        for (what, edit, name) in edits {
+            let mut value = valid.clone();
+            edit(&mut value);
+            let read: SphereState<1, 4> = serde_json::from_value(value)
+                .unwrap_or_else(|e| panic!("{what}: the JSON reads ({e})"));
+            let result = read.validate();
+            assert!(
+                matches!(result, Err(Error::InvalidArgument { name: n, .. }) if n == name),
+                "{what}: {result:?}"
+            );
+            assert_eq!(read.chart.validate().is_err(), name == "chart", "{what}");
         }
     }
 

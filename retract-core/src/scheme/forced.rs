@@ -14,7 +14,7 @@
 
 use nalgebra::SVector;
 
-use crate::scheme::step::{StepOptions, StepReport, name_parameter, solve_offset};
+use crate::scheme::step::{StepOptions, StepReport, check_energy, name_parameter, solve_offset};
 use crate::{Error, LiftedSystem};
 
 /// One step $z_0 \mapsto z_1$ of the theta-scheme under the force `force` $= f$ (module
@@ -40,6 +40,10 @@ use crate::{Error, LiftedSystem};
 /// }
 /// # Ok::<(), retract_core::Error>(())
 /// ```
+///
+/// The energy check of [`StepOptions::energy_tolerance`] (off by default) counts the work of
+/// the force,
+/// $W = f \cdot (q_1 - q_0)$.
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] for a force that is not finite, and those of
@@ -70,9 +74,11 @@ where
     // the momentum equation of q: rows S/2 .. S/2 + N of the residual
     let mut offset = SVector::<f64, M>::zeros();
     offset.fixed_rows_mut::<N>(S / 2).copy_from(&(force * h));
-    let solved = system
-        .predictor(z0, h, options.theta)
-        .and_then(|guess| solve_offset(system, z0, guess, h, options, Some(&offset)));
+    let solved = system.predictor(z0, h, options.theta).and_then(|guess| {
+        let (w, report) = solve_offset(system, z0, guess, h, options, Some(&offset))?;
+        check_energy(system, z0, &guess, &w, h, options, Some(&offset))?;
+        Ok((w, report))
+    });
     let (w, report) = solved.map_err(|e| name_parameter(system, e))?;
     Ok((system.state(&w), report))
 }
