@@ -508,6 +508,22 @@ impl fmt::Display for Error {
             Error::InvalidArgument { name, requirement } => {
                 write!(f, "invalid argument `{name}`: {requirement}")
             }
+            Error::InitialStateOutsideDomain { .. } => outside_domain(f, "initial state", self),
+            Error::StartOutsideDomain { .. } => outside_domain(f, "start", self),
+            Error::GoalOutsideDomain { .. } => outside_domain(f, "goal", self),
+            Error::BoundaryValueNoConvergence { .. }
+            | Error::BoundaryValueLineSearchFailed { .. }
+            | Error::BoundariesSeparated { .. }
+            | Error::BoundaryInObstacle { .. } => self.fmt_boundary_value(f),
+        }
+    }
+}
+
+impl Error {
+    /// The messages of the boundary-value failures (the root finder's and the ends'), for
+    /// [`fmt::Display`].
+    fn fmt_boundary_value(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
             Error::BoundaryValueNoConvergence {
                 iterations,
                 residual_norm,
@@ -531,9 +547,6 @@ impl fmt::Display for Error {
                  problem with bvp::continuation, e.g. a larger barrier weight), or use the \
                  optimizer (OptimalControlProblem), whose line search follows the cost"
             ),
-            Error::InitialStateOutsideDomain { .. } => outside_domain(f, "initial state", self),
-            Error::StartOutsideDomain { .. } => outside_domain(f, "start", self),
-            Error::GoalOutsideDomain { .. } => outside_domain(f, "goal", self),
             Error::BoundariesSeparated {
                 expression, kind, ..
             } => {
@@ -562,6 +575,8 @@ impl fmt::Display for Error {
                  guess can fix it (a solution begins at the start and ends at the goal): move \
                  the {end} out of the obstacle"
             ),
+            // (only the variants above reach here)
+            _ => write!(f, "{self:?}"),
         }
     }
 }

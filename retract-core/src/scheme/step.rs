@@ -1069,7 +1069,8 @@ fn locate_crossing_with<const S: usize>(
     0.5 * (inside + outside)
 }
 
-#[cfg(all(test, feature = "serde"))]
+#[cfg(test)]
+#[cfg(feature = "serde")]
 mod tests {
     use super::StepOptions;
 
@@ -1088,7 +1089,8 @@ mod tests {
     }
 }
 
-#[cfg(all(test, feature = "std"))]
+#[cfg(test)]
+#[cfg(feature = "std")]
 mod halving {
     use nalgebra::SVector;
 
@@ -1144,7 +1146,8 @@ mod halving {
 }
 
 /// Options and trajectories read from hostile JSON are refused on use.
-#[cfg(all(test, feature = "serde", feature = "std"))]
+#[cfg(test)]
+#[cfg(all(feature = "serde", feature = "std"))]
 mod hostile_json {
     use nalgebra::SVector;
 
