@@ -605,3 +605,39 @@ fn a_warm_start_is_certified_at_the_returned_point() {
     let worst = scheme_residual(&system, &warm);
     assert!(worst < 1e-9, "scheme residual {worst:e}");
 }
+
+/// Second-order corrections (on by default) against none, on the cart-pole swing-ups whose
+/// pole-torque equality curves: both reach the same certified minimum, and the corrections
+/// cost no iterations overall (they replace halvings of steps that the curvature of the
+/// equality would have cut).
+#[test]
+fn second_order_corrections_keep_the_minimum_and_save_iterations() {
+    let mut counts = [0, 0];
+    for t_end in [2.0, 3.0, 4.0] {
+        let solve = |corrections: usize| {
+            let options = PlanOptions::default().with_second_order_corrections(corrections);
+            let steps = (25.0 * t_end) as usize;
+            OptimalControlProblem::new(&CartPole::new(), &[0.0; 4], &UPRIGHT, t_end, steps)
+                .with_equality(&PoleTorque::new())
+                .with_options(options)
+                .solve(PlanGuess::Spline)
+                .unwrap()
+        };
+        let (with, without) = (solve(4), solve(0));
+        for plan in [&with, &without] {
+            assert_eq!(plan.certificate.negative_directions, 0);
+            assert!(plan.certificate.stationarity <= 1e-9);
+        }
+        let gap = (with.cost - without.cost).abs() / without.cost;
+        assert!(
+            gap <= 1e-8,
+            "T = {t_end}: {} against {}",
+            with.cost,
+            without.cost
+        );
+        counts[0] += with.iterations;
+        counts[1] += without.iterations;
+    }
+    eprintln!("iterations with and without corrections: {counts:?}");
+    assert!(counts[0] <= counts[1], "iterations {counts:?}");
+}

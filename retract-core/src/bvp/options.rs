@@ -60,6 +60,19 @@ pub struct PlanOptions {
     /// certified plan's interpolant violation is within the tolerance there. Orders $k \le 4$.
     #[cfg_attr(feature = "serde", serde(default))]
     pub interior_samples: usize,
+    /// The most second-order corrections per line search (IPOPT's `max_soc`, 4 by
+    /// default; 0 for none): where the full step is rejected and raises the constraint
+    /// violation, the step is recomputed with the same factorisation for the accumulated
+    /// residual of the nonlinear constraints ($c_{\rm soc} = \alpha c(x) + c(x + \alpha
+    /// d)$), as long as each correction lowers the violation by the factor 0.99.
+    #[cfg_attr(feature = "serde", serde(default = "default_corrections"))]
+    pub second_order_corrections: usize,
+}
+
+/// IPOPT's `max_soc`, [`PlanOptions::second_order_corrections`]'s default.
+#[cfg(feature = "serde")]
+fn default_corrections() -> usize {
+    PlanOptions::default().second_order_corrections
 }
 
 /// The most interior samples per step ([`PlanOptions::interior_samples`]).
@@ -80,6 +93,7 @@ impl Default for PlanOptions {
             initial_barrier: 0.1,
             min_eigenvalue: true,
             interior_samples: 0,
+            second_order_corrections: 4,
         }
     }
 }
@@ -114,6 +128,12 @@ impl PlanOptions {
     /// too ([`Self::interior_samples`]).
     pub fn with_interior_samples(mut self, samples: usize) -> Self {
         self.interior_samples = samples;
+        self
+    }
+    /// Sets the most second-order corrections per line search
+    /// ([`Self::second_order_corrections`]; 0 turns them off).
+    pub fn with_second_order_corrections(mut self, corrections: usize) -> Self {
+        self.second_order_corrections = corrections;
         self
     }
     /// Sets the chord spacing and the cap on chord pieces of the singularity guard

@@ -13,11 +13,12 @@
 
 use nalgebra::SVector;
 
+use super::correction::Corrected;
 use super::filter::Filter;
 use super::state::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::{Iterate, blocks};
-use crate::bvp::kkt::riccati::Direction;
+use crate::bvp::kkt::riccati::{Direction, Riccati};
 use crate::bvp::plan::Failure;
 use crate::{Lagrangian, LiftedSystem};
 
@@ -30,13 +31,25 @@ const S_PHI: f64 = 2.3;
 const DELTA: f64 = 1.0;
 const GAMMA_ALPHA: f64 = 0.05;
 
-/// An accepted trial point: the iterate, the step length and whether the decrease it was
-/// accepted on is at rounding level.
+/// An accepted trial point: the iterate, the step length, whether the decrease it was
+/// accepted on is at rounding level, and the corrected step it was taken along, if a
+/// second-order correction was accepted.
 pub(super) struct Accepted<const N: usize, const X: usize> {
     pub trial: Iterate<N, X>,
     pub alpha: f64,
     pub at_rounding: bool,
+    pub corrected: Option<Corrected<N, X>>,
 }
+
+/// The subproblem a line search searches along: the iterate, its models, the direction and,
+/// unless it is a kept one, the factorisation with its inertia correction $h \rho$ (for
+/// second-order corrections).
+pub(super) type Searched<'s, const N: usize, const X: usize> = (
+    &'s Iterate<N, X>,
+    &'s Models<N, X>,
+    &'s Direction<N, X>,
+    Option<(&'s Riccati<N, X>, f64)>,
+);
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
@@ -126,7 +139,7 @@ where
     /// The point $\alpha$ along the direction and its $(\varphi, \theta)$
     /// ([`Self::merit_parts`]); `None` for these if the point leaves the system's domain or a
     /// value is not finite.
-    fn trial(
+    pub(super) fn trial(
         &self,
         iterate: &Iterate<N, X>,
         direction: &Direction<N, X>,
@@ -156,24 +169,34 @@ where
         (trial, parts)
     }
 
-    /// Moves to the `accepted` point along `direction` with slack steps `ds`: the iterate;
-    /// the slacks and the multipliers $z$ by its step length; the stage equalities'
-    /// multipliers `y` toward the direction's by the same primal step length. Returns the
-    /// step length and whether the decrease was at rounding level.
+    /// Moves to the `accepted` point along `direction` with slack steps `ds` (or along its
+    /// corrected step): the iterate; the slacks and the multipliers $z$ by its step length;
+    /// the stage equalities' multipliers `y` toward the direction's by the same primal step
+    /// length. Returns the step length, whether the decrease was at rounding level and
+    /// whether the step was the direction itself (not a correction).
     pub(super) fn advance(
         &self,
-        accepted: Accepted<N, X>,
+        mut accepted: Accepted<N, X>,
         (direction, ds): (&Direction<N, X>, &[f64]),
         (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
-    ) -> (f64, bool) {
+    ) -> (f64, bool, bool) {
         let alpha = accepted.alpha;
+        let corrected = accepted.corrected.take();
+        let (direction, ds) = match &corrected {
+            Some(c) => (&c.direction, &c.ds[..]),
+            None => (direction, ds),
+        };
         let left = core::mem::replace(iterate, accepted.trial);
         self.give_iterate(left);
         barrier.update(ds, alpha);
         for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
             *yi += (target - *yi) * alpha;
         }
-        (alpha, accepted.at_rounding)
+        let plain = corrected.is_none();
+        if let Some(c) = corrected {
+            self.give_corrected(c);
+        }
+        (alpha, accepted.at_rounding, plain)
     }
 
     /// The line search: [`Self::filter_search`] with `filter` (made at the first call from
@@ -181,14 +204,14 @@ where
     /// `penalty`.
     pub(super) fn line_search(
         &self,
-        (iterate, models, direction): (&Iterate<N, X>, &Models<N, X>, &Direction<N, X>),
+        searched: Searched<'_, N, X>,
         slacks: (&Barrier, &[f64]),
         (filter, penalty): (&mut Option<Filter>, &mut f64),
     ) -> Result<Accepted<N, X>, Failure> {
+        let (iterate, models, direction, _) = searched;
         let filter = filter.get_or_insert_with(|| {
             Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
         });
-        let searched = (iterate, models, direction);
         match self.filter_search(searched, slacks, filter)? {
             Some(accepted) => Ok(accepted),
             None => self.penalty_search(iterate, models, direction, slacks, penalty),
@@ -200,10 +223,12 @@ where
     /// \gamma_\alpha \min(\gamma_\theta, \gamma_\varphi \theta / (-\nabla\varphi^T d), \delta
     /// \theta^{s_\theta} / (-\nabla\varphi^T d)^{s_\varphi})$ (or after
     /// [`crate::bvp::PlanOptions::max_backtracks`] halvings); [`Failure::TimeLimit`] if the
-    /// budget runs out between trials.
+    /// budget runs out between trials. Where the first trial is rejected and does not reduce
+    /// $\theta$, second-order corrections are tried before halving
+    /// ([`Self::second_order_correction`], with the subproblem's factorisation).
     fn filter_search(
         &self,
-        (iterate, models, direction): (&Iterate<N, X>, &Models<N, X>, &Direction<N, X>),
+        (iterate, models, direction, factor): Searched<'_, N, X>,
         (barrier, ds): (&Barrier, &[f64]),
         filter: &mut Filter,
     ) -> Result<Option<Accepted<N, X>>, Failure> {
@@ -225,8 +250,9 @@ where
         } else {
             GAMMA_ALPHA * GAMMA_THETA
         };
+        let current = (theta, phi, slope, noise);
         let mut alpha = barrier.max_step(ds);
-        for _ in 0..=options.max_backtracks {
+        for l in 0..=options.max_backtracks {
             if alpha < alpha_min && !at_rounding {
                 break;
             }
@@ -234,35 +260,64 @@ where
                 return Err(Failure::TimeLimit);
             }
             let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
-            let Some((phi_t, theta_t)) = parts.filter(|(p, t)| !filter.rejects(*t, *p)) else {
-                self.give_iterate(trial);
-                alpha *= 0.5;
-                continue;
-            };
-            let switching =
-                slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
-            let accept = if theta <= filter.theta_min && switching {
-                phi_t <= phi + options.armijo * alpha * slope + noise
-            } else if theta_t <= (1.0 - GAMMA_THETA) * theta
-                || phi_t <= phi - GAMMA_PHI * theta + noise
-            {
-                filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
-                true
-            } else {
-                false
-            };
-            if accept {
-                let accepted = Accepted {
+            let mut accepts = |t: f64, p: f64| self.filter_accepts(filter, current, (t, p), alpha);
+            if parts.is_some_and(|(phi_t, theta_t)| accepts(theta_t, phi_t)) {
+                let (corrected, trial) = (None, trial);
+                return Ok(Some(Accepted {
                     trial,
                     alpha,
                     at_rounding,
-                };
-                return Ok(Some(accepted));
+                    corrected,
+                }));
+            }
+            if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
+                && theta_t >= theta
+                && options.second_order_corrections > 0
+            {
+                let at = (iterate, models);
+                let first = (barrier, ds, alpha);
+                let soc = self.second_order_correction(at, factor, first, &trial, &mut accepts);
+                if let Some((corrected_trial, alpha_soc, step)) = soc {
+                    self.give_iterate(trial);
+                    return Ok(Some(Accepted {
+                        trial: corrected_trial,
+                        alpha: alpha_soc,
+                        at_rounding,
+                        corrected: Some(step),
+                    }));
+                }
             }
             self.give_iterate(trial);
             alpha *= 0.5;
         }
         Ok(None)
+    }
+
+    /// Whether the filter accepts a trial point $(\theta_t, \varphi_t)$ at step length
+    /// `alpha` from the `current` $(\theta, \varphi, \nabla\varphi^T d$, rounding of
+    /// $\varphi)$: not dominated by the filter and, if $\theta \le \theta_{\min}$ and the
+    /// switching condition holds, Armijo's condition on $\varphi$, else a decrease of
+    /// $\theta$ or $\varphi$ (the filter is then augmented).
+    fn filter_accepts(
+        &self,
+        filter: &mut Filter,
+        (theta, phi, slope, noise): (f64, f64, f64, f64),
+        (theta_t, phi_t): (f64, f64),
+        alpha: f64,
+    ) -> bool {
+        if filter.rejects(theta_t, phi_t) {
+            return false;
+        }
+        let switching = slope < 0.0 && alpha * (-slope).powf(S_PHI) > DELTA * theta.powf(S_THETA);
+        if theta <= filter.theta_min && switching {
+            phi_t <= phi + self.options.armijo * alpha * slope + noise
+        } else if theta_t <= (1.0 - GAMMA_THETA) * theta || phi_t <= phi - GAMMA_PHI * theta + noise
+        {
+            filter.augment((1.0 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta);
+            true
+        } else {
+            false
+        }
     }
 
     /// Backtracking on $\varphi + \pi \Vert c\Vert_1$ along the direction (where the filter finds no
@@ -322,6 +377,7 @@ where
                     trial,
                     alpha,
                     at_rounding: -descent <= noise,
+                    corrected: None,
                 });
             }
             self.give_iterate(trial);
