@@ -47,6 +47,7 @@ use crate::bvp::plan::{Failure, Plan, PlanError};
 use crate::{Lagrangian, LiftedSystem};
 
 mod direction;
+mod feedback;
 mod filter;
 mod line_search;
 mod models;
@@ -54,6 +55,7 @@ mod second_order;
 mod state;
 mod termination;
 
+pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
 use state::{State, Subproblem};
 use termination::{Finished, barrier_floor};
