@@ -217,7 +217,7 @@ fn a_real_time_iteration_period_allocates_nothing() {
             if period >= 5 {
                 counted += allocations() - before;
             }
-            assert!(!applied.failed && !failed, "{mode:?}, period {period}");
+            assert!(!applied.failed() && !failed, "{mode:?}, period {period}");
             largest = largest.max(deviation(&jet));
         }
         assert_eq!(counted, 0, "{mode:?}: allocations in 95 periods");

@@ -16,7 +16,9 @@ use std::time::Instant;
 
 use crate::pendulum::{HORIZON, Plant, STEPS, UprightCost, plant_step, upright_models};
 use retract::LiftedSystem;
-use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, RealTimeIteration, Workspace};
+use retract::bvp::{
+    OptimalControlProblem, Plan, PlanGuess, PlanOptions, RealTimeIteration, Workspace,
+};
 use retract::nalgebra::SVector;
 
 /// The upright rest state.
@@ -63,7 +65,10 @@ pub fn first_torque(
 }
 
 /// A receding-horizon controller of the benchmark: one problem, its real-time iteration and
-/// the last full plan, in one workspace.
+/// the last full plan, in one workspace. Every period says how its torque was chosen
+/// ([`Status`]): a re-plan that is not converged is never applied silently, a failed one
+/// falls back to the previous plan shifted by a period, and the applied torque is clamped to
+/// the torque limit ([`Self::with_torque_limit`]; none by default, as in the benchmark).
 pub struct Controller<'m> {
     model: &'m UprightCost,
     problem: OptimalControlProblem<'m, UprightCost, 2, 2, 4>,
@@ -73,17 +78,53 @@ pub struct Controller<'m> {
     workspace: Workspace<2, 4>,
     /// The measured jet of the last period.
     start: [f64; 4],
+    /// |tau_a| <= limit for the applied torque.
+    limit: f64,
+}
+
+/// The Newton step of a real-time iteration below which its iterate counts as converged
+/// (the iterate it started from solved the problem for the measured start to this size).
+pub const CONVERGED_STEP: f64 = 1e-6;
+
+/// Where a period's torque came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The re-plan of this period (converged or not: [`Status::converged`]).
+    Replan,
+    /// The re-plan failed (or gave no finite torque): the previous plan shifted by a period.
+    Shifted,
+}
+
+/// How a period's torque was chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Status {
+    /// Whether the re-plan converged: a full solve certified its plan, or a real-time
+    /// iteration's Newton step was below [`CONVERGED_STEP`] (its last step, with two).
+    pub converged: bool,
+    /// The plan the torque is read from.
+    pub source: Source,
+    /// Whether the torque was clamped to the limit.
+    pub clamped: bool,
 }
 
 /// What one period's re-plan gave.
 #[derive(Clone, Copy, Debug)]
 pub struct Period {
-    /// The torque to apply.
+    /// The torque to apply (within the limit, finite).
     pub tau: [f64; 2],
+    /// The torque of the plan before clamping.
+    pub planned: [f64; 2],
     /// The time from the measured state to the torque (us).
     pub feedback_us: f64,
-    /// Whether a phase failed (the torque is then the shifted iterate's).
-    pub failed: bool,
+    /// How the torque was chosen.
+    pub status: Status,
+}
+
+impl Period {
+    /// Whether the re-plan failed (the torque is the shifted plan's).
+    pub fn failed(&self) -> bool {
+        self.status.source == Source::Shifted
+    }
 }
 
 impl<'m> Controller<'m> {
@@ -105,21 +146,43 @@ impl<'m> Controller<'m> {
             plan,
             workspace,
             start: UPRIGHT,
+            limit: f64::INFINITY,
         })
+    }
+
+    /// The controller with a wall-time budget for each solve or preparation
+    /// ([`PlanOptions::with_max_time`]; a solve that runs out of it fails and its period
+    /// falls back to the shifted plan).
+    pub fn with_time_budget(mut self, budget: std::time::Duration) -> Self {
+        let options = PlanOptions::default().with_max_time(budget);
+        self.problem = OptimalControlProblem::new(self.model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS)
+            .with_options(options);
+        self
+    }
+
+    /// The controller with the applied torque clamped to |tau_a| <= `limit`.
+    pub fn with_torque_limit(mut self, limit: f64) -> Self {
+        self.limit = limit;
+        self
     }
 
     /// The re-plan from the measured jet `jet`, up to the torque to apply.
     pub fn control(&mut self, jet: &[f64; 4]) -> Period {
         let started = Instant::now();
         self.start = *jet;
-        let failed = match self.mode {
+        // the fallback: the torque of the plan shifted at the last preparation
+        let shifted = self.torque();
+        let (replanned, converged) = match self.mode {
             Mode::Rti(iterations) => {
-                let mut failed = self.problem.feedback(&mut self.rti, jet).is_err();
+                let mut fed = self.problem.feedback(&mut self.rti, jet);
+                let replanned = fed.is_ok();
                 for _ in 1..iterations {
-                    failed |= self.problem.prepare(&mut self.rti).is_err()
-                        || self.problem.feedback(&mut self.rti, jet).is_err();
+                    if fed.is_ok() && self.problem.prepare(&mut self.rti).is_ok() {
+                        fed = self.problem.feedback(&mut self.rti, jet);
+                    }
                 }
-                failed
+                let converged = fed.is_ok_and(|f| f.step <= CONVERGED_STEP);
+                (replanned, converged)
             }
             Mode::Full => {
                 self.problem.set_start(jet);
@@ -131,17 +194,35 @@ impl<'m> Controller<'m> {
                     Ok(next) => {
                         self.workspace
                             .recycle(std::mem::replace(&mut self.plan, next));
-                        false
+                        (true, true)
                     }
-                    Err(_) => true,
+                    Err(_) => (false, false),
                 }
             }
         };
-        let tau = self.torque();
+        let planned = if replanned { self.torque() } else { shifted };
+        let finite = planned.iter().all(|t| t.is_finite());
+        let source = if replanned && finite {
+            Source::Replan
+        } else {
+            Source::Shifted
+        };
+        let chosen = match source {
+            Source::Replan => planned,
+            // (a shifted plan without a finite torque: none)
+            Source::Shifted if shifted.iter().all(|t| t.is_finite()) => shifted,
+            Source::Shifted => [0.0; 2],
+        };
+        let tau = chosen.map(|t| t.clamp(-self.limit, self.limit));
         Period {
             tau,
+            planned,
             feedback_us: started.elapsed().as_secs_f64() * 1e6,
-            failed,
+            status: Status {
+                converged: converged && source == Source::Replan,
+                source,
+                clamped: tau != chosen,
+            },
         }
     }
 
@@ -160,15 +241,22 @@ impl<'m> Controller<'m> {
     }
 
     /// The preparation for the next period (real-time iterations: the iterate shifted and its
-    /// subproblem prepared); whether it failed.
+    /// subproblem prepared); whether it failed. A failed preparation starts the real-time
+    /// iteration again from the spline between the last measured jet and the goal.
     pub fn prepare(&mut self) -> bool {
-        match self.mode {
-            Mode::Rti(_) => {
-                self.rti.shift();
-                self.problem.prepare(&mut self.rti).is_err()
-            }
-            Mode::Full => false,
+        let Mode::Rti(_) = self.mode else {
+            return false;
+        };
+        self.rti.shift();
+        if self.problem.prepare(&mut self.rti).is_ok() {
+            return false;
         }
+        self.problem.set_start(&self.start);
+        if let Ok(rti) = self.problem.real_time_iteration(PlanGuess::Spline) {
+            self.rti = rti;
+            let _ = self.problem.prepare(&mut self.rti);
+        }
+        true
     }
 }
 
@@ -233,7 +321,7 @@ pub fn run(kick: f64, mode: Mode) -> Result<Outcome, Box<dyn std::error::Error>>
         let prepare_failed = controller.prepare();
         out.replan_us.push(started.elapsed().as_secs_f64() * 1e6);
         out.feedback_us.push(applied.feedback_us);
-        out.failures += usize::from(applied.failed || prepare_failed);
+        out.failures += usize::from(applied.failed() || prepare_failed);
         let tau = applied.tau;
         out.max_torque = out.max_torque.max(tau[0].abs()).max(tau[1].abs());
         (z, jet) = plant_step(&plant, &z, &jet, tau)?;

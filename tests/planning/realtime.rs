@@ -86,3 +86,91 @@ fn the_real_time_iteration_refuses_what_it_cannot_do() {
         "{error}"
     );
 }
+
+/// The plant's step of a control period in `pieces` forced-midpoint steps under the held
+/// torque `tau` (a plant spun at 50 rad/s turns about a radian a period).
+fn plant_pieces(
+    plant: &crate::pendulum::Plant,
+    z: &retract::nalgebra::SVector<f64, 4>,
+    tau: [f64; 2],
+    pieces: usize,
+) -> (retract::nalgebra::SVector<f64, 4>, [f64; 4]) {
+    use retract::nalgebra::SVector;
+    use retract::{Lagrangian, StepOptions, forced::forced_step};
+    let h = HORIZON / STEPS as f64 / pieces as f64;
+    let mut z = *z;
+    for _ in 0..pieces {
+        z = forced_step(plant, &z, &SVector::from(tau), h, &StepOptions::default())
+            .expect("plant step")
+            .0;
+    }
+    let q = SVector::<f64, 2>::from([z[0], z[1]]);
+    let p = SVector::<f64, 2>::from([z[2], z[3]]);
+    let dq = plant
+        .top_derivative(&[q], &p, &SVector::zeros())
+        .expect("velocity");
+    (z, [q[0], q[1], dq[0], dq[1]])
+}
+
+/// 1000 re-plans of the benchmark's controller with its torque limited to 50, the plant's
+/// velocity kicked every 50 periods by (+k, -k) with k rising to 50 rad/s (signs
+/// alternating): every applied torque is finite and within the limit, the plan's torque
+/// clamped exactly when it is outside; a period whose re-plan failed applies the shifted
+/// plan's torque and says so, and is never counted converged. Both with one real-time
+/// and two real-time iterations a period and with full solves (each within 2 ms, as a
+/// controller's deadline); the kicks make real work (unconverged re-plans and clamped torques
+/// are reported).
+#[test]
+fn no_torque_outside_the_limit_and_no_unconverged_plan_unreported() {
+    use crate::upright::{Controller, Mode, Source};
+    use retract::LiftedSystem;
+    let (model, plant) = upright_models();
+    let limit = 50.0;
+    for mode in [Mode::Rti(1), Mode::Rti(2), Mode::Full] {
+        let mut controller = Controller::new(&model, mode)
+            .expect("upright")
+            .with_time_budget(std::time::Duration::from_millis(2))
+            .with_torque_limit(limit);
+        let mut jet = UPRIGHT;
+        let mut z = plant.legendre(&retract::nalgebra::SVector::from(jet));
+        let (mut unconverged, mut clamped, mut shifted) = (0, 0, 0);
+        for period in 0..1000 {
+            if period % 50 == 25 {
+                let k =
+                    2.5 * (period / 50 + 1) as f64 * if period % 100 == 25 { 1.0 } else { -1.0 };
+                jet[2] += k;
+                jet[3] -= k;
+                z = plant.legendre(&retract::nalgebra::SVector::from(jet));
+            }
+            let expected_shifted = controller.torque();
+            let applied = controller.control(&jet);
+            controller.prepare();
+            let status = applied.status;
+            assert!(
+                applied
+                    .tau
+                    .iter()
+                    .all(|t| t.is_finite() && t.abs() <= limit),
+                "{mode:?}, period {period}: {applied:?}"
+            );
+            let chosen = if status.source == Source::Shifted {
+                assert!(!status.converged, "{mode:?}, period {period}");
+                shifted += 1;
+                expected_shifted
+            } else {
+                applied.planned
+            };
+            let clamp = chosen.map(|t| t.clamp(-limit, limit));
+            assert_eq!(applied.tau, clamp, "{mode:?}, period {period}");
+            assert_eq!(status.clamped, clamp != chosen, "{mode:?}, period {period}");
+            unconverged += usize::from(!status.converged);
+            clamped += usize::from(status.clamped);
+            (z, jet) = plant_pieces(&plant, &z, applied.tau, 8);
+        }
+        eprintln!("{mode:?}: {unconverged} unconverged, {clamped} clamped, {shifted} shifted");
+        assert!(
+            unconverged > 0 && clamped > 0,
+            "{mode:?}: {unconverged} {clamped}"
+        );
+    }
+}
