@@ -174,3 +174,67 @@ fn no_torque_outside_the_limit_and_no_unconverged_plan_unreported() {
         );
     }
 }
+
+/// The derivative of a plan with respect to its start (`start_sensitivity`, from the KKT
+/// factorisation at the solution) against central differences of solves from starts moved by
+/// +-1e-4 along a direction, at a plan away from the upright rest (a moved start, where the
+/// plan's second derivative does not vanish): to 1e-6 relative.
+#[test]
+fn the_start_sensitivity_matches_central_differences() {
+    let (model, _) = upright_models();
+    let base: [f64; 4] = [UPRIGHT[0] + 0.2, -0.1, 1.0, -0.5];
+    let solve = |start: &[f64; 4]| {
+        OptimalControlProblem::new(&model, start, &UPRIGHT, HORIZON, STEPS)
+            .with_options(retract::bvp::PlanOptions::default().with_tolerance(1e-12))
+            .solve(PlanGuess::Spline)
+            .expect("solved")
+    };
+    let problem = OptimalControlProblem::new(&model, &base, &UPRIGHT, HORIZON, STEPS);
+    let plan = solve(&base);
+    let mut rti = problem
+        .real_time_iteration(PlanGuess::Plan(&plan))
+        .expect("rti");
+    problem.prepare(&mut rti).expect("prepared");
+    let eps = 1e-4;
+    for direction in [[1.0, 0.0, 0.0, 0.0], [0.3, -0.7, 0.2, 0.5]] {
+        let (dx, du) = problem
+            .start_sensitivity(&rti, &direction)
+            .expect("prepared");
+        let moved = |sign: f64| {
+            solve(&std::array::from_fn(|r| {
+                base[r] + sign * eps * direction[r]
+            }))
+        };
+        let (plus, minus) = (moved(1.0), moved(-1.0));
+        let fd_x = plus
+            .x
+            .iter()
+            .zip(&minus.x)
+            .map(|(a, b)| (a - b) / (2.0 * eps));
+        let fd_u = plus
+            .u
+            .iter()
+            .zip(&minus.u)
+            .map(|(a, b)| (a - b) / (2.0 * eps));
+        let scale = dx
+            .iter()
+            .map(|v| v.amax())
+            .chain(du.iter().map(|v| v.amax()))
+            .fold(0.0, f64::max);
+        let error_x = dx
+            .iter()
+            .zip(fd_x)
+            .map(|(a, b)| (a - b).amax())
+            .fold(0.0, f64::max);
+        let error_u = du
+            .iter()
+            .zip(fd_u)
+            .map(|(a, b)| (a - b).amax())
+            .fold(0.0, f64::max);
+        assert!(scale > 0.1, "{scale}");
+        assert!(
+            error_x.max(error_u) <= 1e-6 * scale,
+            "{direction:?}: {error_x:e} {error_u:e} of {scale:e}"
+        );
+    }
+}

@@ -127,7 +127,7 @@ pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use problem::OptimalControlProblem;
-pub use realtime::{Feedback, Preparation, RealTimeIteration};
+pub use realtime::{Feedback, Preparation, RealTimeIteration, Sensitivity};
 pub use workspace::Workspace;
 
 mod root_finder;

@@ -91,6 +91,11 @@ pub struct Feedback {
     pub start_change: f64,
 }
 
+/// A plan's derivative along a direction of its start:
+/// $(\partial x_i / \partial a\thinspace d)_{i \le N}$ and $(\partial u_i / \partial
+/// a\thinspace d)_{i < N}$ ([`OptimalControlProblem::start_sensitivity`]).
+pub type Sensitivity<const N: usize, const X: usize> = (Vec<SVector<f64, X>>, Vec<SVector<f64, N>>);
+
 impl<const N: usize, const X: usize> RealTimeIteration<N, X> {
     /// The iterate's jets $x_0, \dots, x_N$.
     pub fn x(&self) -> &[SVector<f64, X>] {
@@ -257,6 +262,54 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             step: step.size,
             start_change: step.start_change,
         })
+    }
+
+    /// The derivative of the iterate of `rti` with respect to the start, along `direction`:
+    /// $(\partial x_i / \partial a, \partial u_i / \partial a)\thinspace d$ for $d = $
+    /// `direction` (its free start components ignored), from the subproblem prepared at the
+    /// iterate, which must be a solution ([`Self::prepare`] at a converged plan): the
+    /// subproblem's solution is affine in $\delta x_0$, and its linear part is the KKT
+    /// system's derivative, so the sensitivity is the forward pass from $\delta x_0 = d$
+    /// less the one from $\delta x_0 = 0$. The preparation is kept (for more directions or a
+    /// feedback).
+    ///
+    /// # Errors
+    /// [`Failure::Invalid`] if `rti` is not prepared.
+    pub fn start_sensitivity<const S: usize, const M: usize>(
+        &self,
+        rti: &RealTimeIteration<N, X>,
+        direction: &[f64; X],
+    ) -> Result<Sensitivity<N, X>, Failure>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
+        let Some(lin) = rti.linearization.as_ref() else {
+            return Err(Failure::Invalid(Error::InvalidArgument {
+                name: "real-time iteration",
+                requirement: "prepared (OptimalControlProblem::prepare) before a sensitivity",
+            }));
+        };
+        let sqp = self.sqp::<S, M>(&rti.workspace);
+        let d = SVector::<f64, X>::from_column_slice(direction).component_mul(&self.fixed_start);
+        let mut pool = rti.workspace.pool.borrow_mut();
+        let (riccati, dynamics) = (&lin.riccati, &sqp.dynamics);
+        let moved = riccati.forward(dynamics, &lin.prepared, &d, &lin.r_end, &mut *pool);
+        let base = (riccati).forward(
+            dynamics,
+            &lin.prepared,
+            &SVector::zeros(),
+            &lin.r_end,
+            &mut *pool,
+        );
+        let dx = (moved.dx.iter().zip(&base.dx))
+            .map(|(a, b)| a - b)
+            .collect();
+        let du = (moved.du.iter().zip(&base.du))
+            .map(|(a, b)| a - b)
+            .collect();
+        moved.recycle(&mut *pool);
+        base.recycle(&mut *pool);
+        Ok((dx, du))
     }
 
     /// The SQP iteration's phases over `workspace`, with the problem's options.
