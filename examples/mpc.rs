@@ -1,29 +1,57 @@
-//! Receding-horizon control of the double pendulum with the plant in the loop
-//! (`examples/common/pendulum.rs` has the loop): from the hanging rest state, swing up and
-//! hold upright, re-planning every control period h = T / N (N = 50, T = 1 s) from the
-//! plant's state with at most two warm-started SQP iterations. Prints exactly one line:
-//! `re-plans=<n> failures=<f> median_us=<m> p99_us=<p> max_us=<x>` (a failure is a re-plan
-//! that returns an error; the times are those of the re-plans alone).
+//! The receding-horizon benchmark (docs/benchmarks.md, "Receding horizon"): the double
+//! pendulum held upright at q = (pi, 0) by re-plans of 1/2 |tau|^2 + 50 |q - (pi, 0)|^2 +
+//! |q'|^2 over T = 1 s, N = 50, one every control period of 0.02 s, the plant stepped with
+//! the torque held and its velocity kicked by (+k, -k) rad/s at t = 0.5 s (the loop is in
+//! `examples/common/upright.rs`). For each kick (2, 8) and each mode (real-time iterations
+//! with one and two feedback steps a period, `rti1` and `rti2`; full solves from the shifted
+//! plan, `full`) it prints exactly
 //!
-//! Run: `cargo run --release --example mpc` (1000 re-plans, 20 s of simulated time; add a
-//! number for another count).
+//! `kick=<k> mode=<rti1|rti2|full> max_dev=<d> settle_s=<s> median_us=<m> p99_us=<p> failures=<f>`
+//!
+//! (`max_dev`: the largest |q - (pi, 0)| after the kick; `settle_s`: the time from the kick
+//! after which it stays below 1e-3, `inf` if it does not by t = 5 s; the times: a period's
+//! re-plan, feedback and preparation; `failures`: periods whose re-plan failed), then for the
+//! real-time modes the feedback phase alone:
+//!
+//! `feedback kick=<k> mode=<rti1|rti2> median_us=<m> p99_us=<p> max_us=<x>`
+//!
+//! Run: `cargo run --release --example mpc`.
 
 #[path = "common/pendulum.rs"]
 mod pendulum;
+#[path = "common/upright.rs"]
+mod upright;
+
+use upright::{Mode, quantile, run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let replans = match std::env::args().nth(1) {
-        Some(count) => count.parse()?,
-        None => 1000,
-    };
-    let summary = pendulum::run(replans)?;
-    println!(
-        "re-plans={} failures={} median_us={:.1} p99_us={:.1} max_us={:.1}",
-        summary.replans,
-        summary.failures,
-        summary.quantile_us(0.5),
-        summary.quantile_us(0.99),
-        summary.quantile_us(1.0),
-    );
+    let modes = [Mode::Rti(1), Mode::Rti(2), Mode::Full];
+    let mut feedback = Vec::new();
+    for kick in [2.0, 8.0] {
+        for mode in modes {
+            let out = run(kick, mode)?;
+            println!(
+                "kick={kick} mode={} max_dev={:.4} settle_s={:.2} median_us={:.1} p99_us={:.1} failures={}",
+                mode.name(),
+                out.max_dev,
+                out.settle_s,
+                quantile(&out.replan_us, 0.5),
+                quantile(&out.replan_us, 0.99),
+                out.failures,
+            );
+            if mode != Mode::Full {
+                feedback.push(format!(
+                    "feedback kick={kick} mode={} median_us={:.1} p99_us={:.1} max_us={:.1}",
+                    mode.name(),
+                    quantile(&out.feedback_us, 0.5),
+                    quantile(&out.feedback_us, 0.99),
+                    quantile(&out.feedback_us, 1.0),
+                ));
+            }
+        }
+    }
+    for line in feedback {
+        println!("{line}");
+    }
     Ok(())
 }

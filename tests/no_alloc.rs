@@ -159,7 +159,7 @@ mod pendulum;
 /// A control period of the receding horizon (the real-time re-plan from the shifted plan in
 /// one workspace, its first torque and the plant's step) allocates nothing once the workspace
 /// holds as many vectors as a re-plan needs at once: 300 periods of the swing-up of
-/// `examples/mpc.rs`, counted from period 50. (The workspace grows only when a re-plan holds
+/// `examples/mpc_swing_up.rs`, counted from period 50. (The workspace grows only when a re-plan holds
 /// more vectors at once than any before it: here a certificate that refactorises beside the
 /// iteration's own factorisations, first at period 44.)
 #[test]
@@ -184,4 +184,44 @@ fn a_receding_horizon_period_allocates_nothing() {
     // the work was real: the pendulum is upright and the re-plans were certified
     let off = (jet[0] - std::f64::consts::PI).abs().max(jet[1].abs());
     assert!(off < 1e-2 && certified > 200, "{jet:?} {certified}");
+}
+
+// the receding-horizon benchmark's controller, shared with `examples/mpc.rs`
+#[path = "../examples/common/upright.rs"]
+mod upright;
+
+/// A control period of real-time iterations (the feedback step from the measured state, a
+/// second preparation and feedback for two iterations, the torque, the shift and the
+/// preparation for the next period, and the plant's step) allocates nothing: 100 periods of
+/// the benchmark of `examples/mpc.rs` with its (+8, -8) kick at period 25, counted from
+/// period 5, with one and with two iterations a period.
+#[test]
+fn a_real_time_iteration_period_allocates_nothing() {
+    use upright::{Controller, KICK_PERIOD, Mode, UPRIGHT, deviation};
+    let (model, plant) = pendulum::upright_models();
+    for mode in [Mode::Rti(1), Mode::Rti(2)] {
+        let mut controller = Controller::new(&model, mode).expect("upright");
+        let mut jet = UPRIGHT;
+        let mut z = plant.legendre(&SVector::from(jet));
+        let (mut counted, mut largest) = (0, 0.0_f64);
+        for period in 0..100 {
+            if period == KICK_PERIOD {
+                jet[2] += 8.0;
+                jet[3] -= 8.0;
+                z = plant.legendre(&SVector::from(jet));
+            }
+            let before = allocations();
+            let applied = controller.control(&jet);
+            let failed = controller.prepare();
+            (z, jet) = pendulum::plant_step(&plant, &z, &jet, applied.tau).expect("plant step");
+            if period >= 5 {
+                counted += allocations() - before;
+            }
+            assert!(!applied.failed() && !failed, "{mode:?}, period {period}");
+            largest = largest.max(deviation(&jet));
+        }
+        assert_eq!(counted, 0, "{mode:?}: allocations in 95 periods");
+        // the work was real: the kick moved the pendulum
+        assert!(largest > 0.5, "{mode:?}: {largest}");
+    }
 }

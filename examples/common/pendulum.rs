@@ -1,7 +1,8 @@
 //! The double pendulum: the planner's model (minimum torque, with its torque as the named
 //! output `tau`), the acrobot's cost and constraint, the plant (T - V), and receding-horizon
 //! control with the plant simulated in the loop. Shared by
-//! `examples/swing_up.rs`, `examples/mpc.rs` and `tests/planning/mpc.rs` (by path).
+//! `examples/swing_up.rs`, `examples/mpc_swing_up.rs`, `examples/mpc.rs` (the receding-horizon
+//! benchmark's cost, [`upright_cost`]) and `tests/planning/mpc.rs` (by path).
 //!
 //! Every control period h the planner re-plans from the plant's measured state (q, q') to the
 //! upright equilibrium over a fixed horizon T = N h: the minimum-torque problem
@@ -78,6 +79,31 @@ pub fn torque_cost(
     #[output]
     let tau = torque(q, dq, ddq, m1, m2, l1, l2, g);
     0.5 * (tau[0] * tau[0] + tau[1] * tau[1])
+}
+
+/// The receding-horizon benchmark's stage cost (docs/benchmarks.md, "Receding horizon"):
+/// L = 1/2 |tau|^2 + w_q |q - (q_up, 0)|^2 + w_v |q'|^2 ([`torque`]), with tau also a method
+/// (`UprightCost::tau(&self, x, u)`).
+#[higher_order_lagrangian(order = 2, helpers = [torque])]
+pub fn upright_cost(
+    q: [f64; 2],
+    dq: [f64; 2],
+    ddq: [f64; 2],
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+    w_q: f64,
+    w_v: f64,
+    q_up: f64,
+) -> f64 {
+    #[output]
+    let tau = torque(q, dq, ddq, m1, m2, l1, l2, g);
+    let e = q[0] - q_up;
+    0.5 * (tau[0] * tau[0] + tau[1] * tau[1])
+        + w_q * (e * e + q[1] * q[1])
+        + w_v * (dq[0] * dq[0] + dq[1] * dq[1])
 }
 
 /// The acrobot's cost: only the elbow is actuated, L = 1/2 tau_2^2; the shoulder's torque is
@@ -248,6 +274,15 @@ pub fn plant_step(
 pub fn models() -> (TorqueCost, Plant) {
     (
         TorqueCost::new(M1, M2, L1, L2, G),
+        Plant::new(M1, M2, L1, L2, G),
+    )
+}
+
+/// The benchmark's planner (weights 50 on the angles, 1 on the rates, upright at q = (pi, 0))
+/// and the plant.
+pub fn upright_models() -> (UprightCost, Plant) {
+    (
+        UprightCost::new(M1, M2, L1, L2, G, 50.0, 1.0, PI),
         Plant::new(M1, M2, L1, L2, G),
     )
 }

@@ -19,6 +19,7 @@ mod mechanical;
 mod mpc;
 mod optimize;
 mod placement;
+mod realtime;
 mod stage_systems;
 mod typed_data;
 mod vector_bounds;
@@ -35,6 +36,10 @@ mod car_models;
 // the double pendulum's models and receding-horizon loop, shared with the examples
 #[path = "../../examples/common/pendulum.rs"]
 mod pendulum;
+
+// the receding-horizon benchmark's controller and loop, shared with `examples/mpc.rs`
+#[path = "../../examples/common/upright.rs"]
+mod upright;
 
 // the spacecraft's attitude models and slew, shared with the example
 #[path = "../../examples/common/attitude.rs"]

@@ -46,6 +46,8 @@
 //!    `filter`, `termination`, `second_order`) over `state`, and the loop in `mod.rs`.
 //! 9. `solve` (the solve front: [`OptimalControlProblem::solve`] and its variants, the first
 //!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]).
+//! 10. `realtime` (real-time iterations in a preparation and a feedback phase,
+//!     [`RealTimeIteration`]).
 //!
 //! # Example
 //! The hand-written disc system of [`crate::models`] (with `retract`, a `#[higher_order_lagrangian]`
@@ -111,6 +113,7 @@ mod kkt;
 mod options;
 mod plan;
 mod problem;
+mod realtime;
 mod solve;
 mod sqp;
 mod stack;
@@ -124,6 +127,7 @@ pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use problem::OptimalControlProblem;
+pub use realtime::{Feedback, Preparation, RealTimeIteration, Sensitivity};
 pub use workspace::Workspace;
 
 mod root_finder;

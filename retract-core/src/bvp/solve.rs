@@ -90,6 +90,38 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
         let started = Instant::now();
+        self.check_problem::<S, M>()?;
+        let warm = match guess {
+            PlanGuess::Plan(plan) => Some(&plan.duals),
+            _ => None,
+        };
+        let iterate = self.first_iterate::<S, M>(guess, workspace)?;
+        let placed = self.placed();
+        Sqp::<Sys, N, K, X, S, M> {
+            problem: self,
+            dynamics: Dynamics::new(self.h(), self.options.theta),
+            started,
+            at_steps: &placed.at_steps,
+            at_nodes: &placed.at_nodes,
+            pool: &workspace.pool,
+            options,
+            real_time,
+        }
+        .run(iterate, warm)
+    }
+
+    /// The checks of a problem before any iterate: its data, the workspace's size, the
+    /// system's form and parameters, the stage systems, and the contradictions and end
+    /// violations of its constraints.
+    ///
+    /// # Errors
+    /// [`Failure::Invalid`] or [`Failure::Infeasible`], without an iterate.
+    pub(super) fn check_problem<const S: usize, const M: usize>(
+        &self,
+    ) -> Result<(), PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
         let invalid = |e| PlanError {
             failure: Failure::Invalid(e),
             last: None,
@@ -126,9 +158,25 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
-        let warm = match guess {
-            PlanGuess::Plan(plan) => Some(&plan.duals),
-            _ => None,
+        Ok(())
+    }
+
+    /// The first iterate from `guess` (vectors from `workspace`), checked: finite, a terminal
+    /// cost of the jet alone, boundary jets in the domain and the guess inside it.
+    ///
+    /// # Errors
+    /// [`Failure::Invalid`] or [`Failure::GuessOutsideDomain`], without an iterate.
+    pub(super) fn first_iterate<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        workspace: &mut Workspace<N, X>,
+    ) -> Result<Iterate<N, X>, PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
+        let invalid = |e| PlanError {
+            failure: Failure::Invalid(e),
+            last: None,
         };
         let mut iterate = {
             let pool = workspace.pool.get_mut();
@@ -146,18 +194,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
-        let placed = self.placed();
-        Sqp::<Sys, N, K, X, S, M> {
-            problem: self,
-            dynamics: Dynamics::new(self.h(), self.options.theta),
-            started,
-            at_steps: &placed.at_steps,
-            at_nodes: &placed.at_nodes,
-            pool: &workspace.pool,
-            options,
-            real_time,
-        }
-        .run(iterate, warm)
+        Ok(iterate)
     }
 
     /// Real-time iteration for receding horizons (as acados' RTI): at most `iterations` SQP

@@ -523,6 +523,24 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
         pool: &mut impl Vectors<N, X>,
     ) -> Direction<N, X> {
+        let prepared = self.prepare(dynamics, stages, rho, (r_end, s_end), pool);
+        let direction = self.forward(dynamics, &prepared, r0, r_end, pool);
+        prepared.recycle(pool);
+        direction
+    }
+
+    /// The part of [`Self::solve`] that does not depend on $\delta x_0$: the backward pass
+    /// for the stage linear terms of `stages` (the feed-forward terms and the cost-to-go's
+    /// linear term at $x_0$). [`Self::forward`] then gives the direction for any
+    /// $\delta x_0$ (the feedback phase of a real-time iteration).
+    pub fn prepare(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        stages: &[StageModel<N, X>],
+        rho: f64,
+        (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
+        pool: &mut impl Vectors<N, X>,
+    ) -> Prepared<N, X> {
         let theta = dynamics.theta;
         let linear = |i: usize| {
             let stage = &stages[i];
@@ -540,15 +558,26 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
                 constraint: stage.value + stage.cx * offset,
             }
         };
-        self.solve_linear(dynamics, &linear, r0, (r_end, s_end), pool)
+        self.prepare_linear(dynamics, &linear, (r_end, s_end), pool)
+    }
+
+    /// [`Self::prepare`] for the stage linear terms, defects and constraint offsets given by
+    /// `linear(i)`.
+    pub fn prepare_linear(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        linear: &impl Fn(usize) -> StageLinear<N, X>,
+        ends: (&SVector<f64, X>, &SVector<f64, X>),
+        pool: &mut impl Vectors<N, X>,
+    ) -> Prepared<N, X> {
+        let mut backward = pool.backward().take(self.stages.len());
+        let s_start = self.backward(dynamics, linear, ends, &mut backward);
+        Prepared { backward, s_start }
     }
 
     /// The subproblem's solution for the stage linear terms, defects and constraint offsets
     /// given by `linear(i)`: a backward pass for the feed-forward terms, then one forward pass
-    /// for the direction, which at the tail's first state $\delta x_b$ sets the terminal
-    /// multiplier from $D \nu = r_N - \delta x_N(\nu = 0)$ (with one refinement when the
-    /// terminal condition is missed by more than rounding; both by the cheap forward pass of
-    /// [`Self::terminal`] over the tail).
+    /// for the direction ([`Self::forward`]).
     pub fn solve_linear(
         &self,
         dynamics: &Dynamics<N, X>,
@@ -557,11 +586,30 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
         pool: &mut impl Vectors<N, X>,
     ) -> Direction<N, X> {
+        let prepared = self.prepare_linear(dynamics, linear, (r_end, s_end), pool);
+        let direction = self.forward(dynamics, &prepared, r0, r_end, pool);
+        prepared.recycle(pool);
+        direction
+    }
+
+    /// The forward pass of a solve from $\delta x_0 = $ `r0` (on the fixed start components)
+    /// over the backward pass `prepared`: $\delta u_i = K_i \delta x_i + k_i$ (plus $K_\nu
+    /// \nu$ in the tail), $\delta x_{i+1} = \bar A \delta x_i + \bar B \delta u_i + c_i$; at
+    /// the tail's first state $\delta x_b$ it sets the terminal multiplier from $D \nu = r_N -
+    /// \delta x_N(\nu = 0)$ (with one refinement when the terminal condition is missed by more
+    /// than rounding; both by the cheap forward pass of [`Self::terminal`] over the tail).
+    pub fn forward(
+        &self,
+        dynamics: &Dynamics<N, X>,
+        prepared: &Prepared<N, X>,
+        r0: &SVector<f64, X>,
+        r_end: &SVector<f64, X>,
+        pool: &mut impl Vectors<N, X>,
+    ) -> Direction<N, X> {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = self.stages.len();
         let boundary = self.boundary();
-        let mut backward = pool.backward().take(steps);
-        let s_start = self.backward(dynamics, linear, (r_end, s_end), &mut backward);
+        let (backward, s_start) = (&prepared.backward, prepared.s_start);
         let mut d = Direction {
             dx: pool.jets().take(steps + 1),
             du: pool.tops().take(steps),
@@ -585,9 +633,9 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         {
             let tail = (i >= boundary).then(|| self.tail_factor(i));
             if i == boundary {
-                let gap = r_end - self.terminal(dynamics, &backward, &x, None);
+                let gap = r_end - self.terminal(dynamics, backward, &x, None);
                 nu = self.d_inv * gap.component_mul(&self.fixed);
-                let x_end = self.terminal(dynamics, &backward, &x, Some(&nu));
+                let x_end = self.terminal(dynamics, backward, &x, Some(&nu));
                 let miss = (r_end - x_end).component_mul(&self.fixed);
                 if miss.amax() > 1e-12 * (1.0 + r_end.amax() + x_end.amax()) {
                     nu += self.d_inv * miss;
@@ -615,7 +663,6 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             d.du.push(u);
             d.dx.push(x);
         }
-        pool.backward().give(backward);
         d
     }
 
@@ -708,6 +755,20 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             x = a.left(&x) + b.left(&du) + l.defect;
         }
         x
+    }
+}
+
+/// The backward pass of a solve ([`Riccati::prepare`]): per step, last step first, what the
+/// forward pass needs, and the linear term $s_0$ of the cost-to-go at $x_0$.
+pub(crate) struct Prepared<const N: usize, const X: usize> {
+    backward: Vec<Backward<N, X>>,
+    s_start: SVector<f64, X>,
+}
+
+impl<const N: usize, const X: usize> Prepared<N, X> {
+    /// Gives the pass's vectors back to `pool`.
+    pub fn recycle(self, pool: &mut impl Vectors<N, X>) {
+        pool.backward().give(self.backward);
     }
 }
 

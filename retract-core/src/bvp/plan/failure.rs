@@ -124,3 +124,5 @@ impl core::fmt::Display for Failure {
         }
     }
 }
+
+impl std::error::Error for Failure {}

@@ -48,6 +48,7 @@ use crate::{Lagrangian, LiftedSystem};
 
 mod correction;
 mod direction;
+mod feedback;
 mod filter;
 mod first_multipliers;
 mod line_search;
@@ -56,6 +57,7 @@ mod second_order;
 mod state;
 mod termination;
 
+pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
 use state::{State, Subproblem};
 use termination::{Finished, barrier_floor};

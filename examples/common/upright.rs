@@ -1,0 +1,343 @@
+//! The receding-horizon benchmark of docs/benchmarks.md ("Receding horizon", BENCHMARKS.md
+//! of the project): the double pendulum of `pendulum.rs` held upright at q = (pi, 0) by
+//! re-plans of the stage cost 1/2 |tau|^2 + 50 |q - (pi, 0)|^2 + |q'|^2 ([`UprightCost`])
+//! over T = 1 s, N = 50 steps, one re-plan a control period h = 0.02 s; the plant stepped with
+//! the torque held; its velocity kicked at t = 0.5 s. Shared by `examples/mpc.rs` and the
+//! tests (by path, beside `pendulum.rs` as the crate's `pendulum`).
+//!
+//! Three ways to re-plan ([`Mode`]): real-time iterations as acados' RTI
+//! ([`RealTimeIteration`]: the subproblem prepared at the shifted iterate while the plant
+//! moves, then, once the state is measured, its full Newton step with the state embedded,
+//! one or two a period) and full solves from the shifted plan.
+#![allow(dead_code)] // each user takes a subset
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use crate::pendulum::{HORIZON, Plant, STEPS, UprightCost, plant_step, upright_models};
+use retract::LiftedSystem;
+use retract::bvp::{
+    OptimalControlProblem, Plan, PlanGuess, PlanOptions, RealTimeIteration, Workspace,
+};
+use retract::nalgebra::SVector;
+
+/// The upright rest state.
+pub const UPRIGHT: [f64; 4] = [PI, 0.0, 0.0, 0.0];
+/// The period of the kick (t = 0.5 s).
+pub const KICK_PERIOD: usize = 25;
+/// The periods simulated (5 s).
+pub const PERIODS: usize = 250;
+/// The settling threshold on |q - (pi, 0)|.
+pub const SETTLED: f64 = 1e-3;
+
+/// How the controller re-plans.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Real-time iterations: this many feedback steps a period (the first from the
+    /// preparation made during the last period).
+    Rti(usize),
+    /// Solved to the default tolerance from the shifted plan.
+    Full,
+}
+
+impl Mode {
+    /// The benchmark's name of the mode.
+    pub fn name(self) -> String {
+        match self {
+            Mode::Rti(n) => format!("rti{n}"),
+            Mode::Full => "full".into(),
+        }
+    }
+}
+
+/// The torque of a first step at its midpoint: tau((x_0 + x_1) / 2, u_0).
+pub fn first_torque(
+    model: &UprightCost,
+    (x0, x1): (&SVector<f64, 4>, &SVector<f64, 4>),
+    u0: &SVector<f64, 2>,
+) -> [f64; 2] {
+    let x = (x0 + x1) * 0.5;
+    let jet = [
+        x.fixed_rows::<2>(0).into_owned(),
+        x.fixed_rows::<2>(2).into_owned(),
+    ];
+    model.tau(&jet, u0)
+}
+
+/// A receding-horizon controller of the benchmark: one problem, its real-time iteration and
+/// the last full plan, in one workspace. Every period says how its torque was chosen
+/// ([`Status`]): a re-plan that is not converged is never applied silently, a failed one
+/// falls back to the previous plan shifted by a period, and the applied torque is clamped to
+/// the torque limit ([`Self::with_torque_limit`]; none by default, as in the benchmark).
+pub struct Controller<'m> {
+    model: &'m UprightCost,
+    problem: OptimalControlProblem<'m, UprightCost, 2, 2, 4>,
+    mode: Mode,
+    rti: RealTimeIteration<2, 4>,
+    plan: Plan<2, 4>,
+    workspace: Workspace<2, 4>,
+    /// The measured jet of the last period.
+    start: [f64; 4],
+    /// |tau_a| <= limit for the applied torque.
+    limit: f64,
+}
+
+/// The Newton step of a real-time iteration below which its iterate counts as converged
+/// (the iterate it started from solved the problem for the measured start to this size).
+pub const CONVERGED_STEP: f64 = 1e-6;
+
+/// Where a period's torque came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The re-plan of this period (converged or not: [`Status::converged`]).
+    Replan,
+    /// The re-plan failed (or gave no finite torque): the previous plan shifted by a period.
+    Shifted,
+}
+
+/// How a period's torque was chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Status {
+    /// Whether the re-plan converged: a full solve certified its plan, or a real-time
+    /// iteration's Newton step was below [`CONVERGED_STEP`] (its last step, with two).
+    pub converged: bool,
+    /// The plan the torque is read from.
+    pub source: Source,
+    /// Whether the torque was clamped to the limit.
+    pub clamped: bool,
+}
+
+/// What one period's re-plan gave.
+#[derive(Clone, Copy, Debug)]
+pub struct Period {
+    /// The torque to apply (within the limit, finite).
+    pub tau: [f64; 2],
+    /// The torque of the plan before clamping.
+    pub planned: [f64; 2],
+    /// The time from the measured state to the torque (us).
+    pub feedback_us: f64,
+    /// How the torque was chosen.
+    pub status: Status,
+}
+
+impl Period {
+    /// Whether the re-plan failed (the torque is the shifted plan's).
+    pub fn failed(&self) -> bool {
+        self.status.source == Source::Shifted
+    }
+}
+
+impl<'m> Controller<'m> {
+    /// A controller at upright rest: solved there, its real-time iteration prepared.
+    ///
+    /// # Errors
+    /// The first solve or preparation failing.
+    pub fn new(model: &'m UprightCost, mode: Mode) -> Result<Self, Box<dyn std::error::Error>> {
+        let problem = OptimalControlProblem::new(model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS);
+        let mut workspace = Workspace::new();
+        let plan = problem.solve_with(PlanGuess::Spline, &mut workspace)?;
+        let mut rti = problem.real_time_iteration(PlanGuess::Plan(&plan))?;
+        problem.prepare(&mut rti)?;
+        Ok(Self {
+            model,
+            problem,
+            mode,
+            rti,
+            plan,
+            workspace,
+            start: UPRIGHT,
+            limit: f64::INFINITY,
+        })
+    }
+
+    /// The controller with a wall-time budget for each solve or preparation
+    /// ([`PlanOptions::with_max_time`]; a solve that runs out of it fails and its period
+    /// falls back to the shifted plan).
+    pub fn with_time_budget(mut self, budget: std::time::Duration) -> Self {
+        let options = PlanOptions::default().with_max_time(budget);
+        self.problem = OptimalControlProblem::new(self.model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS)
+            .with_options(options);
+        self
+    }
+
+    /// The controller with the applied torque clamped to |tau_a| <= `limit`.
+    pub fn with_torque_limit(mut self, limit: f64) -> Self {
+        self.limit = limit;
+        self
+    }
+
+    /// The re-plan from the measured jet `jet`, up to the torque to apply.
+    pub fn control(&mut self, jet: &[f64; 4]) -> Period {
+        let started = Instant::now();
+        self.start = *jet;
+        // the fallback: the torque of the plan shifted at the last preparation
+        let shifted = self.torque();
+        let (replanned, converged) = match self.mode {
+            Mode::Rti(iterations) => {
+                let mut fed = self.problem.feedback(&mut self.rti, jet);
+                let replanned = fed.is_ok();
+                for _ in 1..iterations {
+                    if fed.is_ok() && self.problem.prepare(&mut self.rti).is_ok() {
+                        fed = self.problem.feedback(&mut self.rti, jet);
+                    }
+                }
+                let converged = fed.is_ok_and(|f| f.step <= CONVERGED_STEP);
+                (replanned, converged)
+            }
+            Mode::Full => {
+                self.problem.set_start(jet);
+                let _ = self.plan.try_shift();
+                let solved = self
+                    .problem
+                    .solve_with(PlanGuess::Plan(&self.plan), &mut self.workspace);
+                match solved {
+                    Ok(next) => {
+                        self.workspace
+                            .recycle(std::mem::replace(&mut self.plan, next));
+                        (true, true)
+                    }
+                    Err(_) => (false, false),
+                }
+            }
+        };
+        let planned = if replanned { self.torque() } else { shifted };
+        let finite = planned.iter().all(|t| t.is_finite());
+        let source = if replanned && finite {
+            Source::Replan
+        } else {
+            Source::Shifted
+        };
+        let chosen = match source {
+            Source::Replan => planned,
+            // (a shifted plan without a finite torque: none)
+            Source::Shifted if shifted.iter().all(|t| t.is_finite()) => shifted,
+            Source::Shifted => [0.0; 2],
+        };
+        let tau = chosen.map(|t| t.clamp(-self.limit, self.limit));
+        Period {
+            tau,
+            planned,
+            feedback_us: started.elapsed().as_secs_f64() * 1e6,
+            status: Status {
+                converged: converged && source == Source::Replan,
+                source,
+                clamped: tau != chosen,
+            },
+        }
+    }
+
+    /// The torque of the current plan's first step.
+    pub fn torque(&self) -> [f64; 2] {
+        match self.mode {
+            Mode::Rti(_) => {
+                let (x, u) = (self.rti.x(), self.rti.u());
+                first_torque(self.model, (&x[0], &x[1]), &u[0])
+            }
+            Mode::Full => {
+                let (x, u) = (&self.plan.x, &self.plan.u);
+                first_torque(self.model, (&x[0], &x[1]), &u[0])
+            }
+        }
+    }
+
+    /// The preparation for the next period (real-time iterations: the iterate shifted and its
+    /// subproblem prepared); whether it failed. A failed preparation starts the real-time
+    /// iteration again from the spline between the last measured jet and the goal.
+    pub fn prepare(&mut self) -> bool {
+        let Mode::Rti(_) = self.mode else {
+            return false;
+        };
+        self.rti.shift();
+        if self.problem.prepare(&mut self.rti).is_ok() {
+            return false;
+        }
+        self.problem.set_start(&self.start);
+        if let Ok(rti) = self.problem.real_time_iteration(PlanGuess::Spline) {
+            self.rti = rti;
+            let _ = self.problem.prepare(&mut self.rti);
+        }
+        true
+    }
+}
+
+/// What a run of the benchmark measured.
+pub struct Outcome {
+    /// The largest |q - (pi, 0)| after the kick.
+    pub max_dev: f64,
+    /// The time from the kick after which |q - (pi, 0)| stays below [`SETTLED`] (infinite if
+    /// it is not below at the end).
+    pub settle_s: f64,
+    /// Each period's re-plan time (feedback and preparation, us).
+    pub replan_us: Vec<f64>,
+    /// Each period's feedback time (us).
+    pub feedback_us: Vec<f64>,
+    /// Periods whose re-plan failed.
+    pub failures: usize,
+    /// The largest |tau| applied.
+    pub max_torque: f64,
+}
+
+/// The `p`-quantile (0..=1) of `times`, nearest rank.
+pub fn quantile(times: &[f64], p: f64) -> f64 {
+    let mut sorted = times.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let rank = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+    sorted[rank - 1]
+}
+
+/// |q - (pi, 0)| of a jet.
+pub fn deviation(jet: &[f64; 4]) -> f64 {
+    (jet[0] - PI).hypot(jet[1])
+}
+
+/// Runs the benchmark: [`PERIODS`] periods from upright rest, the plant's velocity kicked by
+/// (+kick, -kick) at [`KICK_PERIOD`] (the re-plan of that period sees it).
+///
+/// # Errors
+/// The controller's first solve, or a plant step, failing.
+pub fn run(kick: f64, mode: Mode) -> Result<Outcome, Box<dyn std::error::Error>> {
+    let (model, plant): (UprightCost, Plant) = upright_models();
+    let mut controller = Controller::new(&model, mode)?;
+    let mut jet = UPRIGHT;
+    let mut z = plant.legendre(&SVector::from(jet));
+    let h = HORIZON / STEPS as f64;
+    let mut out = Outcome {
+        max_dev: 0.0,
+        settle_s: 0.0,
+        replan_us: Vec::with_capacity(PERIODS),
+        feedback_us: Vec::with_capacity(PERIODS),
+        failures: 0,
+        max_torque: 0.0,
+    };
+    let mut last_unsettled = None;
+    for period in 0..PERIODS {
+        if period == KICK_PERIOD {
+            jet[2] += kick;
+            jet[3] -= kick;
+            z = plant.legendre(&SVector::from(jet));
+        }
+        let started = Instant::now();
+        let applied = controller.control(&jet);
+        let prepare_failed = controller.prepare();
+        out.replan_us.push(started.elapsed().as_secs_f64() * 1e6);
+        out.feedback_us.push(applied.feedback_us);
+        out.failures += usize::from(applied.failed() || prepare_failed);
+        let tau = applied.tau;
+        out.max_torque = out.max_torque.max(tau[0].abs()).max(tau[1].abs());
+        (z, jet) = plant_step(&plant, &z, &jet, tau)?;
+        if period >= KICK_PERIOD {
+            let dev = deviation(&jet);
+            out.max_dev = out.max_dev.max(dev);
+            if dev >= SETTLED || dev.is_nan() {
+                last_unsettled = Some(period);
+            }
+        }
+    }
+    out.settle_s = match last_unsettled {
+        Some(p) if p + 1 == PERIODS => f64::INFINITY,
+        // the state after period p is at t = (p + 1) h: settled from the next one on
+        Some(p) => (p + 2 - KICK_PERIOD) as f64 * h,
+        None => 0.0,
+    };
+    Ok(out)
+}
