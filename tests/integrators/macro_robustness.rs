@@ -1,7 +1,7 @@
 //! The macro on hostile but valid inputs: they compile to code that computes what the
 //! annotated function computes, with the right derivatives. (Inputs that must be rejected are
-//! in `validation/tests/ui/fail/signature/function_name_that_makes_no_type_name.rs` and
-//! `validation/tests/ui/fail/expressions/loop_too_long_at_the_i64_limits.rs`; the expansion
+//! in `ui/tests/ui/fail/signature/function_name_that_makes_no_type_name.rs` and
+//! `ui/tests/ui/fail/expressions/loop_too_long_at_the_i64_limits.rs`; the expansion
 //! itself is tested in `retract-codegen/tests/expansion/extreme_inputs.rs`.)
 
 use retract::Lagrangian;

@@ -1,5 +1,6 @@
 //! Integration tests of the integrators: the scheme, compositions, discretization maps, the
-//! sphere, the macro against hand-written code, the guard on steps, messages and robustness.
+//! sphere, the macro against hand-written code, the guard on steps, messages and robustness;
+//! also the SVG figures of `retract::plot`.
 //!
 //! One test crate per group (fewer crates build and link faster): each module was a test
 //! crate of its own; `common` holds the shared helpers and Lagrangians.
@@ -24,6 +25,7 @@ mod macro_robustness;
 mod macro_vs_handwritten;
 mod map_macro;
 mod messages_runtime;
+mod plot;
 mod robustness_chord_invariant;
 mod robustness_runtime;
 mod se3;

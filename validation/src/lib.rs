@@ -1,8 +1,8 @@
 //! Benchmarks (`benches/`), the speed report and the work-precision comparison with ODE
 //! peers (`examples/report.rs`, `examples/work_precision.rs`) and the heavier test suites of
-//! `retract` (the property tests of the generated derivatives and the compile-fail tests of
-//! the macros, `tests/`). It is kept apart so that `cargo run --example ...` in `retract`
-//! does not build criterion, proptest, trybuild, num-dual or ode_solvers.
+//! `retract` (the property tests of the generated derivatives, `tests/`; the compile-fail tests
+//! of the macros are in `ui/`). It is kept apart so that `cargo run --example ...` in `retract`
+//! does not build criterion, proptest, num-dual or ode_solvers.
 //!
 //! The library holds what the benches and the examples share, one implementation each: the
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and

@@ -1,7 +1,7 @@
 //! Extreme inputs to the macro, tested on the expansion: each input ends in correct code or
 //! in an error at its span, never in a panic, a hang or a silently wrong derivative. (The
 //! compiled behaviour is checked in the workspace's `tests/integrators/macro_robustness.rs`,
-//! `validation/tests/properties/derivatives.rs` and `validation/tests/ui`.)
+//! `validation/tests/properties/derivatives.rs` and `ui/tests/ui`.)
 
 use proc_macro2::TokenStream;
 use retract_codegen::{try_expand, try_expand_jet_function};
