@@ -1,5 +1,5 @@
-//! The cart-pole from its energy to a certified swing-up: the Lagrangian T - V written once,
-//! `#[mechanical_system]` derives the inverse dynamics tau(q, q', q''), the minimum-force cost
+//! The cart-pole from its energy to a certified swing-up: the Lagrangian T - V written once
+//! (`examples/common/cart_pole.rs`, `cart_pole_energy`), `#[mechanical_system]` derives the inverse dynamics tau(q, q', q''), the minimum-force cost
 //! 1/2 F^2 on the cart (the actuated coordinate) and the pole's equality tau_pole = 0; the
 //! optimizer plans the rest-to-rest swing-up of the swing-up suite (`../shared/BENCHMARKS.md`:
 //! mc = 1, mp = 0.3, l = 0.5, T = 2, N = 200) and certifies it. One line:
@@ -12,22 +12,17 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use retract::nalgebra::SVector;
-use retract::{OptimalControlProblem, PlanGuess, PlanOptions, mechanical_system};
+use retract::{OptimalControlProblem, PlanGuess, PlanOptions};
 
-/// Cart position x and pole angle th from the downward vertical, pole mass mp at length l:
-/// l = T - V, the cart driven, the pole free.
-#[mechanical_system(actuated = [0])]
-fn cart_pole(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
-    let kinetic = 0.5 * (mc + mp) * dq[0] * dq[0]
-        + mp * l * q[1].cos() * dq[0] * dq[1]
-        + 0.5 * mp * l * l * dq[1] * dq[1];
-    let potential = -mp * g * l * q[1].cos();
-    kinetic - potential
-}
+// the energy T - V (`cart_pole_energy`), shared with the tests
+#[path = "common/cart_pole.rs"]
+mod cart_pole;
+
+use cart_pole::CartPoleEnergy;
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let (t_end, steps) = (2.0, 200);
-    let system = CartPole::new(1.0, 0.3, 0.5, 9.81);
+    let system = CartPoleEnergy::new(1.0, 0.3, 0.5, 9.81);
     let passive = system.unactuated_torques();
     let options = PlanOptions::default().with_min_eigenvalue(true);
     let start = Instant::now();

@@ -168,7 +168,7 @@ pub use retract_macros::discretization_map;
 /// // the plant: one forced midpoint step under the cart force u = 2
 /// let plant = system.plant();
 /// let z0 = retract::LiftedSystem::legendre(&plant, &SVector::from([0.0, 0.4, 0.0, 0.0]));
-/// let force = system.input_force(&SVector::from([2.0]));
+/// let force = system.input_force(&SVector::from([0.0, 0.4]), &SVector::from([2.0]));
 /// let (z1, _) = retract::forced::forced_step(&plant, &z0, &force, 0.01, &Default::default())?;
 /// assert!(z1[0] > 0.0); // the cart moves forward
 /// # Ok::<(), retract::Error>(())

@@ -24,3 +24,29 @@ pub fn obstacle_field(n: usize, obstacles: usize) -> (TokenStream, TokenStream) 
     );
     (attr, item.parse().unwrap_or_default())
 }
+
+/// `#[mechanical_system]` on the planar n-link chain written as T - V (unit links, unit
+/// point masses at the link ends, joint angles relative to the previous link, every joint
+/// driven): the velocities of the masses accumulate link by link,
+/// v_j = v_{j-1} + phi_j' (cos phi_j, sin phi_j) with phi_j = q_0 + ... + q_j, and
+/// l = sum_j 1/2 |v_j|^2 + 9.81 (sum_{b <= j} cos phi_b). The text of
+/// `examples/common/mechanical.rs`'s `energy_chain!`. Returns (attribute, item).
+pub fn energy_chain(n: usize) -> (TokenStream, TokenStream) {
+    let item = format!(
+        "fn chain(q: [f64; {n}], dq: [f64; {n}]) -> f64 {{
+            let (mut phi, mut dphi) = (0.0, 0.0);
+            let (mut vx, mut vz, mut height) = (0.0, 0.0, 0.0);
+            let mut energy = 0.0;
+            for i in 0..{n} {{
+                phi += q[i];
+                dphi += dq[i];
+                vx += phi.cos() * dphi;
+                vz += phi.sin() * dphi;
+                height -= phi.cos();
+                energy += 0.5 * (vx * vx + vz * vz) - 9.81 * height;
+            }}
+            energy
+        }}"
+    );
+    (TokenStream::new(), item.parse().unwrap_or_default())
+}

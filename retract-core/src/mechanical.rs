@@ -8,10 +8,15 @@
 //!   = M(q, q')\thinspace q'' + \frac{\partial^2 l}{\partial q'\partial q}\thinspace q' - \frac{\partial l}{\partial q} - Q_{nc},
 //! \qquad M = \frac{\partial^2 l}{\partial q'^2},$$
 //!
-//! is the generalized force the actuators must supply for the motion $q(t)$. On the jet of
-//! order 2 ($x = (q, q')$, $u = q''$) each component $\tau_c$ is a function of $(x, u)$; the
-//! components no actuator supplies must vanish along a plan, which
-//! [`TorqueComponent`] poses as an equality of [`crate::bvp::OptimalControlProblem`].
+//! is the generalized force the inputs must supply for the motion $q(t)$, through the
+//! actuation matrix $B(q)$: $\tau = B(q)\thinspace u$. On the jet of order 2 ($x = (q, q')$,
+//! $u = q''$) each component $\tau_c$ is a function of $(x, u)$; what no input can supply
+//! must vanish along a plan, which [`TorqueComponent`] poses as an equality of
+//! [`crate::bvp::OptimalControlProblem`]: with actuated coordinates, $\tau_c = 0$ for each
+//! coordinate $c$ no actuator drives; with an actuation matrix of $n - 1$ columns of full
+//! rank, the one equality $a(q)^T \tau = 0$ with $a_i = (-1)^i \det B_{(i)}$ ($B$ without
+//! row $i$), which spans the vectors $B^T$ annihilates, so that $\tau = B u$ exactly where
+//! it holds.
 
 use nalgebra::SVector;
 
@@ -20,19 +25,25 @@ use crate::{Gradient, Hessian, JetFunction};
 /// A mechanical system on $\mathbb{R}^N$ with its Euler-Lagrange operator $\tau$ (module
 /// docs) as a function of the order-2 jet: $x = (q, q')$, $u = q''$. Implemented by
 /// `#[mechanical_system]`, whose type is also the optimal-control [`crate::Lagrangian`] of
-/// order 2, $\tfrac{R}{2}\sum_{a\ \mathrm{actuated}} \tau_a^2$.
+/// order 2, $\tfrac{R}{2}|u|^2 + C(q, q', u)$ with the input $u(q, q', q'')$ the motion needs
+/// (on the actuated coordinates $u = \tau$; through an actuation matrix $B$, the solution of
+/// $B u = \tau$ or of $B^T B u = B^T \tau$) and $C$ the user's cost.
 pub trait MechanicalSystem<const N: usize> {
-    /// The actuated coordinates, ascending.
+    /// The actuated coordinates, ascending (none where an actuation matrix drives the
+    /// system).
     fn actuated(&self) -> &'static [usize];
 
-    /// The coordinates no actuator drives, ascending (the complement of
-    /// [`Self::actuated`]): their $\tau_c$ must vanish.
+    /// The labels $c$ of the passive equalities, ascending: the coordinates no actuator
+    /// drives (the complement of [`Self::actuated`]), whose $\tau_c$ must vanish; or, with
+    /// an actuation matrix of $n - 1$ columns, the label 0 of $a(q)^T \tau = 0$ (module
+    /// docs).
     fn unactuated(&self) -> &'static [usize];
 
-    /// $\tau_c(x, u)$ (NaN for $c \ge N$).
+    /// The passive equality labelled $c$ at $(x, u)$: $\tau_c(x, u)$, or $a^T \tau$ (NaN for
+    /// another $c$).
     fn torque_value(&self, c: usize, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> f64;
 
-    /// The gradient of $\tau_c$ in $(x, u)$ (zero for $c \ge N$).
+    /// The gradient of $\tau_c$ in $(x, u)$ (zero for another $c$).
     fn torque_gradient(
         &self,
         c: usize,
@@ -40,7 +51,7 @@ pub trait MechanicalSystem<const N: usize> {
         u: &SVector<f64, N>,
     ) -> Gradient<N, 2>;
 
-    /// The Hessian of $\tau_c$ in $(x, u)$ (zero for $c \ge N$).
+    /// The Hessian of $\tau_c$ in $(x, u)$ (zero for another $c$).
     fn torque_hessian(
         &self,
         c: usize,
@@ -54,16 +65,17 @@ pub trait MechanicalSystem<const N: usize> {
     }
 }
 
-/// Component `index` of the Euler-Lagrange operator of `system`,
-/// $g(x, u) = \tau_{\mathrm{index}}(x, u)$, as a [`JetFunction`]: the equality
-/// $\tau_c = 0$ of a coordinate no actuator drives, for
+/// The passive equality labelled `index` of `system` (a component
+/// $g(x, u) = \tau_{\mathrm{index}}(x, u)$ of its Euler-Lagrange operator, or $a^T \tau$ for
+/// an actuation matrix; [`MechanicalSystem::unactuated`]) as a [`JetFunction`]: the equality
+/// $g = 0$ of what no input supplies, for
 /// [`crate::bvp::OptimalControlProblem::with_equalities`]. The generated method
 /// `unactuated_torques()` returns one per unactuated coordinate.
 #[derive(Clone, Copy, Debug)]
 pub struct TorqueComponent<'a, S: ?Sized> {
     /// The system.
     pub system: &'a S,
-    /// The coordinate $c$.
+    /// The label $c$ ([`MechanicalSystem::unactuated`]).
     pub index: usize,
 }
 

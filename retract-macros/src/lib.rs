@@ -104,38 +104,59 @@ pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
 
 /// Turns a mechanical Lagrangian l(q, q') = T - V written as a Rust function into its
 /// inverse dynamics and an optimal-control problem of order 2, differentiated at compile
-/// time: with D the total time derivative,
+/// time: with D the total time derivative and Q_nc(q, q') the non-conservative generalized
+/// forces (`forces = f`, none by default),
 ///
 /// ```text
-/// tau(q, q', q'') = D dl/dq' - dl/dq = M(q, q') q'' + d2l/dq'dq q' - dl/dq,   M = d2l/dq'2
+/// tau(q, q', q'') = D dl/dq' - dl/dq - Q_nc = M(q, q') q'' + d2l/dq'dq q' - dl/dq - Q_nc,
+/// M = d2l/dq'2
 /// ```
 ///
-/// is the generalized force the motion needs. The generated type (named after the function in
-/// UpperCamelCase, or `name = ...`; the parameters are its public fields, as for
-/// `#[higher_order_lagrangian]`) has the methods `tau(&q, &dq, &ddq)` and
-/// `mass_matrix(&q, &dq)`, and is itself the optimal-control Lagrangian of order 2
-/// (`retract::Lagrangian<n, 2>`, `LiftedSystem`, for `retract::OptimalControlProblem`)
+/// is the generalized force the motion needs from the inputs u in R^m, tau = B(q) u. The
+/// generated type (named after the function in UpperCamelCase, or `name = ...`; the
+/// parameters are its public fields, as for `#[higher_order_lagrangian]`) has the methods
+/// `tau(&q, &dq, &ddq)`, `mass_matrix(&q, &dq)`, `nonconservative_force(&q, &dq)`,
+/// `input(&q, &dq, &ddq)` (the u the motion needs) and `input_force(&q, &u)` (B(q) u), and is
+/// itself the optimal-control Lagrangian of order 2 (`retract::Lagrangian<n, 2>`,
+/// `LiftedSystem`, for `retract::OptimalControlProblem`)
 ///
 /// ```text
-/// L(q, q', q'') = R/2 sum_a tau_a^2   over the actuated coordinates a,
+/// L(q, q', q'') = R/2 |u|^2 + C(q, q', u),   u = u(q, q', q''),
 /// ```
 ///
-/// while the components tau_c of the coordinates no actuator drives must vanish: the stage
-/// equalities `unactuated_torques()` (each a `retract::TorqueComponent`, a `JetFunction`),
-/// handed to the problem by `with_equalities`. For plant simulation, `plant()` is l itself as
-/// a system of order 1 (the type `<Type>Plant`) and `input_force(&u)` the generalized force
-/// B u of an input on the actuated coordinates: `retract::forced::forced_step(&plant, &z0,
-/// &system.input_force(&u), h, &options)` is the forced midpoint rule (discrete
-/// Lagrange-d'Alembert), with the typed errors of every step. A runnable example is in the
-/// docs of `retract`, which re-exports this attribute.
+/// with C the user's cost (`cost = f`, none by default), while what no input can supply must
+/// vanish: the passive equalities `unactuated_torques()` (each a `retract::TorqueComponent`,
+/// a `JetFunction`), handed to the problem by `with_equalities`. The actuation is either
+///
+/// - `actuated = [i, ...]` (the actuated coordinates, indices of q; all of them by default):
+///   u = tau on them, tau_c = 0 on the others; or
+/// - `input_matrix = f`, B(q) with m = n or n - 1 columns of full rank: u = B^{-1} tau (square)
+///   or u = (B^T B)^{-1} B^T tau, and then the one equality a(q)^T tau = 0 with
+///   a_i = (-1)^i det B_(i) (B without row i), which spans what B^T annihilates: tau = B u
+///   exactly where it holds.
+///
+/// For plant simulation, `plant()` is l itself as a system of order 1 (the type
+/// `<Type>Plant`): `retract::forced::forced_step(&plant, &z0, &force, h, &options)` with
+/// `force = system.input_force(&q, &u)` (plus `nonconservative_force` at the step's midpoint
+/// where there are forces) is the forced midpoint rule (discrete Lagrange-d'Alembert), with
+/// the typed errors of every step. A runnable example is in the docs of `retract`, which
+/// re-exports this attribute.
 ///
 /// The arguments are q and q' (`[f64; N]`, or `f64` for N = 1), then the parameters; the body
-/// follows the rules of `#[higher_order_lagrangian]` (helpers included). Options:
-/// `actuated = [i, ...]` (the actuated coordinates, indices of q; all of them by default),
-/// `weight = R` (a positive literal, 1 by default), `name = TypeName`, `guard = false`,
-/// `helpers = [...]`, `order = 1` (the only order). Errors at the span: an order other than 1
-/// or an argument that looks like q'' (`ddq`), an actuated index out of range or repeated, a
-/// Lagrangian without kinetic energy, linear in q', or with a constant singular mass matrix.
+/// follows the rules of `#[higher_order_lagrangian]` (helpers included). The functions of
+/// `forces`, `input_matrix` and `cost` are helpers (`#[helper]` before the system, or `fn`s in
+/// its body) whose arguments are taken by name from the system's (q, q' and the parameters;
+/// `u: [f64; m]` for the cost): `fn damping(dq: [f64; 2], c: f64) -> [f64; 2]` returns Q_nc,
+/// `fn thrust(q: [f64; 3], r: f64) -> ([f64; 3], [f64; 3])` the columns of B (`[f64; n]`
+/// for one input), `fn effort(q: [f64; 2], u: [f64; 1], k: f64) -> f64` the cost. Options:
+/// `actuated = [i, ...]` or `input_matrix = f`, `forces = f`, `cost = f`, `weight = R` (a
+/// positive literal, 1 by default), `name = TypeName`, `guard = false`, `helpers = [...]`,
+/// `order = 1` (the only order). Errors at the span: an order other than 1 or an argument that
+/// looks like q'' (`ddq`), an actuated index out of range or repeated, `actuated` with
+/// `input_matrix`, a function that is not a helper, takes an argument the system does not
+/// have or returns the wrong shape, an actuation matrix with too many or too few columns or
+/// constant without full column rank, a Lagrangian without kinetic energy, linear in q', or
+/// with a constant singular mass matrix.
 #[proc_macro_attribute]
 pub fn mechanical_system(attr: TokenStream, item: TokenStream) -> TokenStream {
     retract_codegen::expand_mechanical_system(attr.into(), item.into()).into()

@@ -25,6 +25,10 @@ mod typed_data;
 mod vector_bounds;
 mod warm_start;
 
+// the systems written as their energy, shared with the example
+#[path = "../../examples/common/mechanical.rs"]
+mod mechanical_models;
+
 // the cart-pole of the swing-up suite, shared with the examples
 #[path = "../../examples/common/cart_pole.rs"]
 mod cart_pole;

@@ -77,6 +77,36 @@ pub(crate) fn chain_if_named(
     Ok((!helpers.is_empty()).then(|| chain(&helpers, which, attr, item)))
 }
 
+/// [`chain_if_named`] where the attribute's options also name the functions `named` (as
+/// `#[mechanical_system(forces = damping)]`): those not defined in the item's body join the
+/// helpers of the chain, so that a `#[helper]` need not be listed twice.
+pub(crate) fn chain_if_named_or_used(
+    attr: &TokenStream,
+    which: &str,
+    item: &TokenStream,
+    named: &[Ident],
+) -> syn::Result<Option<TokenStream>> {
+    let mut helpers = helper_names(attr)?;
+    let nested: Vec<String> = syn::parse2::<ItemFn>(item.clone())
+        .map(|f| {
+            f.block
+                .stmts
+                .iter()
+                .filter_map(|s| match s {
+                    syn::Stmt::Item(syn::Item::Fn(f)) => Some(f.sig.ident.to_string()),
+                    _ => None,
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    for name in named {
+        if !nested.contains(&name.to_string()) && !helpers.contains(name) {
+            helpers.push(name.clone());
+        }
+    }
+    Ok((!helpers.is_empty()).then(|| chain(&helpers, which, attr, item)))
+}
+
 /// The names of `helpers = [a, b]` in an attribute's options (none without it).
 fn helper_names(attr: &TokenStream) -> syn::Result<Vec<Ident>> {
     let metas = syn::parse::Parser::parse2(

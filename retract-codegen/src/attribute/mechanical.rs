@@ -14,10 +14,15 @@ use super::helper;
 use crate::emit::mechanical::mechanical_impl;
 use crate::emit::{Emission, system_items};
 use crate::front::actuation::{self, Actuation};
-use crate::front::lower::{Guard, Lower};
+use crate::front::lower::{Guard, Lower, Returned};
 use crate::front::signature::{Attribute, Kind, Signature};
-use crate::ir::graph::{Graph, Id};
-use crate::mechanics::euler_lagrange::{self, EulerLagrange, NotMechanical};
+use std::collections::HashMap;
+
+use crate::ir::diff::substitute;
+use crate::ir::graph::{Graph, Id, Var};
+use crate::mechanics::euler_lagrange::{
+    self, BadInputMatrix, EulerLagrange, Inputs, NotMechanical,
+};
 use crate::mechanics::{self, Mechanics, Reduced};
 use crate::pipeline::{self, Passes, fail_softly};
 
@@ -32,10 +37,12 @@ pub fn try_expand_mechanical_system(
     attr: TokenStream,
     item: TokenStream,
 ) -> syn::Result<TokenStream> {
-    if let Some(chain) = helper::chain_if_named(&attr, "mechanical_system", &item)? {
+    let actuation = actuation::parse(attr.clone())?;
+    let named: Vec<syn::Ident> = actuation.functions().cloned().collect();
+    if let Some(chain) = helper::chain_if_named_or_used(&attr, "mechanical_system", &item, &named)?
+    {
         return Ok(chain);
     }
-    let actuation = actuation::parse(attr.clone())?;
     pipeline::run(&mut MechanicalPasses { actuation }, attr, item)
 }
 
@@ -44,10 +51,14 @@ struct MechanicalPasses {
     actuation: Actuation,
 }
 
-/// l and its guarded expressions, as lowered.
+/// l and its guarded expressions, as lowered, with the values of the functions the options
+/// name: Q_nc, the columns of B, and the cost C with u_j as the placeholder `Var::Core(j)`.
 struct Lowered {
     root: Id,
     guards: Vec<Guard>,
+    forces: Option<Vec<Id>>,
+    columns: Option<Vec<Vec<Id>>>,
+    cost: Option<Id>,
 }
 
 /// A system to emit: its signature, its mechanics, its guards, the reduced step.
@@ -98,7 +109,8 @@ struct Derived {
     system: System,
     plant: System,
     euler_lagrange: EulerLagrange,
-    actuated: Vec<usize>,
+    /// The actuated coordinates; `None` with an actuation matrix.
+    actuated: Option<Vec<usize>>,
 }
 
 impl Passes for MechanicalPasses {
@@ -122,10 +134,15 @@ impl Passes for MechanicalPasses {
                 ),
             ));
         }
+        // (before the body, whose locals would shadow the arguments taken by name)
+        let (forces, columns, cost) = self.named_functions(lower, function, sig);
         let root = lower.body(&function.block);
         Lowered {
             root,
             guards: std::mem::take(&mut lower.guards),
+            forces,
+            columns,
+            cost,
         }
     }
 
@@ -142,20 +159,51 @@ impl Passes for MechanicalPasses {
     ) -> syn::Result<Derived> {
         let n = sig.dim;
         let actuated = self.actuation.coordinates(n)?;
-        let euler_lagrange = euler_lagrange::build(graph, lowered.root, n, &actuated)
-            .map_err(|reason| not_mechanical(sig, reason))?;
-        let cost =
-            euler_lagrange::effort(graph, &euler_lagrange.tau, &actuated, self.actuation.weight);
+        let inputs = match lowered.columns {
+            Some(columns) => Inputs::Matrix(columns),
+            None => Inputs::Coordinates(&actuated),
+        };
+        let euler_lagrange =
+            euler_lagrange::build(graph, lowered.root, n, lowered.forces.as_deref(), inputs)
+                .map_err(|reason| match reason {
+                    Ok(reason) => not_mechanical(sig, reason),
+                    Err(bad) => bad_input_matrix(&self.actuation, bad, n),
+                })?;
+        // the user's cost and every guard with u_j in place of its placeholder
+        let input = euler_lagrange.input.clone();
+        let with_input = |_: &mut Graph, v: Var| match v {
+            Var::Core(j) => input.get(j as usize).copied(),
+            _ => None,
+        };
+        let mut memo = HashMap::new();
+        let user_cost = lowered
+            .cost
+            .map(|c| substitute(graph, c, &with_input, &mut memo));
+        let mut guards = lowered.guards;
+        for guard in &mut guards {
+            guard.node = substitute(graph, guard.node, &with_input, &mut memo);
+        }
+        let cost = euler_lagrange::effort(
+            graph,
+            &euler_lagrange.input,
+            self.actuation.weight,
+            user_cost,
+        );
         let dq = sig.jet[1].span();
-        let system =
-            System::build(graph, order_two(sig), cost, lowered.guards.clone()).map_err(|_| {
-                syn::Error::new(
-                    dq,
-                    "the actuated rows of the mass matrix vanish: no actuator moves the system",
-                )
-            })?;
-        let plant = System::build(graph, plant_signature(sig), lowered.root, lowered.guards)
+        let system = System::build(graph, order_two(sig), cost, guards.clone()).map_err(|_| {
+            syn::Error::new(
+                dq,
+                "the actuated rows of the mass matrix vanish: no actuator moves the system",
+            )
+        })?;
+        // (the plant's guards are those of l: the cost's are no part of it)
+        let plant_guards = guards
+            .into_iter()
+            .filter(|guard| !depends_on_input(graph, guard.node, &euler_lagrange.input))
+            .collect();
+        let plant = System::build(graph, plant_signature(sig), lowered.root, plant_guards)
             .map_err(|_| not_mechanical(sig, NotMechanical::Singular))?;
+        let actuated = self.actuation.input_matrix.is_none().then_some(actuated);
         Ok(Derived {
             system,
             plant,
@@ -165,6 +213,12 @@ impl Passes for MechanicalPasses {
     }
 
     fn emit(&self, function: &ItemFn, _: &Signature, graph: &Graph, d: Derived) -> TokenStream {
+        // (a parameter may serve only the functions the options name: forces, B, cost)
+        let mut function = function.clone();
+        function
+            .attrs
+            .push(syn::parse_quote!(#[allow(unused_variables)]));
+        let function = &function;
         let (emission, plant) = (
             d.system.emission(function, graph),
             d.plant.emission(function, graph),
@@ -175,10 +229,128 @@ impl Passes for MechanicalPasses {
             &emission,
             &plant,
             &d.euler_lagrange,
-            &d.actuated,
+            d.actuated.as_deref(),
         ));
         out
     }
+}
+
+/// The values of the functions the options name: Q_nc, the columns of B, the cost.
+type NamedFunctions = (Option<Vec<Id>>, Option<Vec<Vec<Id>>>, Option<Id>);
+
+impl MechanicalPasses {
+    /// Lowers the functions the options name (`forces`, `input_matrix`, `cost`), each
+    /// checked for its shape at the span of its return type: Q_nc and the columns of B are
+    /// arrays of n (a number where n = 1), the cost a number with u_j as `Var::Core(j)`.
+    fn named_functions(
+        &self,
+        lower: &mut Lower<'_>,
+        function: &ItemFn,
+        sig: &Signature,
+    ) -> NamedFunctions {
+        let (n, stmts) = (sig.dim, &function.block.stmts);
+        let call = |lower: &mut Lower<'_>, name: &syn::Ident, role, extra: &[(&str, Vec<Id>)]| {
+            lower.call_by_name(stmts, name, role, extra)
+        };
+        fn refuse<T>(lower: &mut Lower<'_>, span: Span, msg: String) -> Option<T> {
+            lower.errors.push(syn::Error::new(span, msg));
+            None
+        }
+        let array = |returned: Returned| match returned {
+            Returned::Array(ids) if ids.len() == n => Some(ids),
+            Returned::Number(id) if n == 1 => Some(vec![id]),
+            _ => None,
+        };
+        let forces = self.actuation.forces.as_ref().and_then(|name| {
+            let (returned, span) = call(lower, name, "forces", &[])?;
+            array(returned).or_else(|| {
+                let msg = format!(
+                    "`{name}` returns the non-conservative forces Q_nc(q, q'), one per \
+                     coordinate: `[f64; {n}]`"
+                );
+                refuse(lower, span, msg)
+            })
+        });
+        let columns = self.actuation.input_matrix.as_ref().and_then(|name| {
+            let (returned, span) = call(lower, name, "input_matrix", &[])?;
+            let columns = match returned {
+                Returned::Arrays(columns) => columns
+                    .into_iter()
+                    .map(|c| array(Returned::Array(c)))
+                    .collect(),
+                single => array(single).map(|c| vec![c]),
+            };
+            columns.or_else(|| {
+                let msg = format!(
+                    "`{name}` returns the columns of the actuation matrix B(q), the generalized \
+                     force of each input: `[f64; {n}]` for one input, a tuple `([f64; {n}], \
+                     [f64; {n}], ...)` for several"
+                );
+                refuse(lower, span, msg)
+            })
+        });
+        let inputs = match (&columns, self.actuation.coordinates(n)) {
+            (Some(columns), _) => columns.len(),
+            (None, Ok(actuated)) => actuated.len(),
+            (None, Err(_)) => n, // (reported by the mechanics pass)
+        };
+        let cost = self.actuation.cost.as_ref().and_then(|name| {
+            let u: Vec<Id> = (0..inputs)
+                .map(|j| lower.g.var(Var::Core(j as u32)))
+                .collect();
+            match call(lower, name, "cost", &[("u", u)])? {
+                (Returned::Number(id), _) => Some(id),
+                (_, span) => refuse(
+                    lower,
+                    span,
+                    format!("`{name}` returns the cost C(q, q', u), an `f64`"),
+                ),
+            }
+        });
+        (forces, columns, cost)
+    }
+}
+
+/// Whether `node` depends on an input's expression (a term of the cost).
+fn depends_on_input(g: &Graph, node: Id, input: &[Id]) -> bool {
+    let mut stack = vec![node];
+    let mut seen = std::collections::HashSet::new();
+    while let Some(id) = stack.pop() {
+        if input.contains(&id) {
+            return true;
+        }
+        if seen.insert(id) {
+            stack.extend(crate::ir::graph::children(g.node(id)));
+        }
+    }
+    false
+}
+
+/// The error of an actuation matrix that makes no actuation, at the option's value.
+fn bad_input_matrix(actuation: &Actuation, bad: BadInputMatrix, n: usize) -> syn::Error {
+    let span = actuation
+        .input_matrix
+        .as_ref()
+        .map_or_else(Span::call_site, syn::Ident::span);
+    let msg = match bad {
+        BadInputMatrix::Rows(rows) => {
+            format!("a column of the actuation matrix has {rows} entries, not {n}")
+        }
+        BadInputMatrix::TooManyInputs(m) => format!(
+            "the actuation matrix has {m} columns for {n} coordinates: at most {n} inputs \
+             can be told apart"
+        ),
+        BadInputMatrix::TooManyPassive(m) => format!(
+            "the actuation matrix has {m} columns for {n} coordinates: {} passive directions; \
+             an actuation matrix may leave at most one (n - 1 or n columns): use `actuated = \
+             [..]` where the inputs drive coordinates",
+            n - m
+        ),
+        BadInputMatrix::RankDeficient => "the actuation matrix does not have full column rank: \
+             some input moves nothing, or two inputs move the same way"
+            .to_string(),
+    };
+    syn::Error::new(span, msg)
 }
 
 /// The signature of the order-2 optimal-control Lagrangian: `sig` with q'' added to the jet.
@@ -286,5 +458,58 @@ mod tests {
         assert!(singular.contains("singular constant matrix"), "{singular}");
         // a parameter of the jet's type with another name is a parameter
         assert!(expand("", ", k: [f64; 2]", ENERGY).is_ok());
+    }
+
+    #[test]
+    fn forces_input_matrix_and_cost_are_helpers_taken_by_name() {
+        let body = format!(
+            "fn damping(dq: [f64; 2], c: f64) -> [f64; 2] {{ [-c * dq[0], -c * dq[1]] }} \
+             fn drive(q: [f64; 2]) -> [f64; 2] {{ [1.0, q[0].sin()] }} \
+             fn extra(u: [f64; 1], q: [f64; 2]) -> f64 {{ q[0] * u[0] }} {ENERGY}"
+        );
+        let out = expand(
+            "input_matrix = drive, forces = damping, cost = extra",
+            ", c: f64",
+            &body,
+        )
+        .unwrap();
+        for item in [
+            "pub const INPUTS: usize = 1",
+            "pub const PASSIVE: [usize; 1] = [0]",
+            "pub fn nonconservative_force(",
+            "pub fn input(",
+        ] {
+            assert!(out.contains(item), "{item} missing:\n{out}");
+        }
+        assert!(!out.contains("pub const ACTUATED"), "{out}");
+    }
+
+    #[test]
+    fn misused_functions_are_errors_at_their_spans() {
+        let err = |attr: &str, body: &str| {
+            expand(attr, ", c: f64", &format!("{body} {ENERGY}")).unwrap_err()
+        };
+        let two = "fn f(q: [f64; 2]) -> [f64; 2] { [q[0], 0.0] }";
+        // a function not in the body is a `#[helper]`'s: the chain calls its macro (rustc
+        // reports a missing one at the name)
+        let chained = expand("forces = nothing", ", c: f64", ENERGY).unwrap();
+        assert!(chained.starts_with("nothing! {"), "{chained}");
+        assert!(err("forces = 1.0", "").contains("name a helper function"));
+        let unknown = err("forces = f", "fn f(x: [f64; 2]) -> [f64; 2] { x }");
+        assert!(unknown.contains("taken by name"), "{unknown}");
+        let scalar = err("forces = f", "fn f(c: f64) -> f64 { c }");
+        assert!(scalar.contains("one per coordinate"), "{scalar}");
+        let both = err("actuated = [0], input_matrix = f", two);
+        assert!(both.contains("exclude each other"), "{both}");
+        let three = "fn f(q: [f64; 2]) -> ([f64; 2], [f64; 2], [f64; 2]) { ([1.0, 0.0], [0.0, \
+                     1.0], [1.0, 1.0]) }";
+        assert!(err("input_matrix = f", three).contains("at most 2 inputs"));
+        let parallel = "fn f(q: [f64; 2]) -> ([f64; 2], [f64; 2]) { ([1.0, 0.0], [2.0, 0.0]) }";
+        let rank = err("input_matrix = f", parallel);
+        assert!(rank.contains("full column rank"), "{rank}");
+        let zero = "fn f(q: [f64; 2]) -> [f64; 2] { [0.0, 0.0] }";
+        assert!(err("input_matrix = f", zero).contains("full column rank"));
+        let cost = err("cost = f", two);
+        assert!(cost.contains("an `f64`"), "{cost}");
     }
 }

@@ -1,8 +1,10 @@
 //! The items of a mechanical system (`#[mechanical_system]`) beyond those of its order-2
-//! optimal-control Lagrangian: the inherent methods `tau` (inverse dynamics), `mass_matrix`
-//! and `unactuated_torques` with the constants `ACTUATED` and `UNACTUATED`, and the impl of
-//! `retract_core::MechanicalSystem` (each unactuated component of tau with its gradient and
-//! Hessian in (x, u), for the optimizer's stage equalities).
+//! optimal-control Lagrangian: the inherent methods `tau` (inverse dynamics), `mass_matrix`,
+//! `nonconservative_force`, `input` (the u a motion needs) and `unactuated_torques` with the
+//! constants `INPUTS`, `PASSIVE` (and `ACTUATED`, `UNACTUATED` where the actuation names
+//! coordinates), `plant` and `input_force`, and the impl of `retract_core::MechanicalSystem`
+//! (each passive equality with its gradient and Hessian in (x, u), for the optimizer's stage
+//! equalities).
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -19,16 +21,44 @@ pub(crate) fn mechanical_impl(
     e: &Emission<'_>,
     plant: &Emission<'_>,
     el: &EulerLagrange,
-    actuated: &[usize],
+    actuated: Option<&[usize]>,
 ) -> TokenStream {
     let mut out = inherent(e, el, actuated);
-    out.extend(plant_methods(e, plant, actuated));
-    out.extend(mechanical_system_impl(e, el, actuated));
+    out.extend(plant_methods(e, plant, el));
+    out.extend(mechanical_system_impl(e, el, actuated.unwrap_or(&[])));
     out
 }
 
-/// `impl Type { ACTUATED, UNACTUATED, tau, mass_matrix, unactuated_torques }`.
-fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenStream {
+/// `__out[(i, j)] = value;` (or `__out[i]` for a vector: `cols` = 0) for the entries of
+/// `entries` (row-major, `cols` columns) that are not zero, with their statements.
+fn sets(
+    e: &Emission<'_>,
+    entries: &[crate::ir::graph::Id],
+    cols: usize,
+    names: &Names<'_>,
+) -> TokenStream {
+    let code = emit(e.g, entries, names);
+    let stmts = &code.stmts;
+    let sets = entries.iter().enumerate().filter_map(|(r, &id)| {
+        let v = &code.exprs[r];
+        let at = match (r.checked_div(cols), r.checked_rem(cols)) {
+            (Some(i), Some(j)) => {
+                let (i, j) = (index(i), index(j));
+                quote!([(#i, #j)])
+            }
+            _ => {
+                let i = index(r);
+                quote!([#i])
+            }
+        };
+        (!e.g.is_const(id, 0.0)).then(|| quote!(__out #at = #v;))
+    });
+    quote!(#stmts #(#sets)*)
+}
+
+/// `impl Type { INPUTS, PASSIVE, (ACTUATED, UNACTUATED,) tau, mass_matrix,
+/// nonconservative_force, input, unactuated_torques }`.
+fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) -> TokenStream {
     let (g, n) = (e.g, e.n);
     let (na, core, vec_n, vec_n_path, n_lit) = (&e.na, &e.core, &e.vec_n, &e.vec_n_path, &e.n_lit);
     let (float, allow) = (&e.float, &e.allow);
@@ -46,22 +76,27 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenSt
     };
     let tau = emit(g, &el.tau, &names);
     let (tau_stmts, tau_exprs) = (&tau.stmts, &tau.exprs);
-    let mass = emit(g, &el.mass, &names);
-    let mass_sets = el.mass.iter().enumerate().filter_map(|(r, &id)| {
-        let v = &mass.exprs[r];
-        let (i, j) = (index(r / n), index(r % n));
-        (!g.is_const(id, 0.0)).then(|| quote!(__out[(#i, #j)] = #v;))
-    });
-    let mass_stmts = &mass.stmts;
-    let unactuated: Vec<usize> = el.unactuated.iter().map(|u| u.index).collect();
-    let (a_len, u_len) = (index(actuated.len()), index(unactuated.len()));
-    let (a_list, u_list) = (
-        actuated.iter().map(|&i| index(i)),
-        unactuated.iter().map(|&i| index(i)),
-    );
-    let components = unactuated.iter().map(|&c| {
+    let mass = sets(e, &el.mass, n, &names);
+    let forces = sets(e, &el.forces, 0, &names);
+    let input = sets(e, &el.input, 0, &names);
+    let m_lit = index(el.input.len());
+    let passive: Vec<usize> = el.unactuated.iter().map(|u| u.index).collect();
+    let p_len = index(passive.len());
+    let p_list = passive.iter().map(|&i| index(i));
+    let components = passive.iter().map(|&c| {
         let c = index(c);
         quote!(#core::TorqueComponent { system: self, index: #c })
+    });
+    let coordinates = actuated.map(|actuated| {
+        let a_len = index(actuated.len());
+        let a_list = actuated.iter().map(|&i| index(i));
+        let u_list = passive.iter().map(|&i| index(i));
+        quote! {
+            /// The actuated coordinates, ascending: the input u is tau there.
+            pub const ACTUATED: [usize; #a_len] = [#(#a_list),*];
+            /// The coordinates no actuator drives, ascending: their tau must vanish.
+            pub const UNACTUATED: [usize; #p_len] = [#(#u_list),*];
+        }
     });
     let ParamTokens {
         generics, ty_full, ..
@@ -70,13 +105,17 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenSt
         #[automatically_derived]
         #allow
         impl #generics #ty_full {
-            /// The actuated coordinates, ascending.
-            pub const ACTUATED: [usize; #a_len] = [#(#a_list),*];
-            /// The coordinates no actuator drives, ascending: their tau must vanish.
-            pub const UNACTUATED: [usize; #u_len] = [#(#u_list),*];
+            #coordinates
+            /// The number m of inputs u.
+            pub const INPUTS: usize = #m_lit;
+            /// The labels of the passive equalities (`unactuated_torques`): the unactuated
+            /// coordinates c (tau_c = 0), or 0 for a^T tau = 0 of an actuation matrix B of
+            /// n - 1 columns (a spanning the vectors that B^T annihilates).
+            pub const PASSIVE: [usize; #p_len] = [#(#p_list),*];
 
-            /// The inverse dynamics tau(q, q', q'') = d/dt dl/dq' - dl/dq, the generalized
-            /// force the motion needs: straight-line code differentiated at compile time.
+            /// The inverse dynamics tau(q, q', q'') = d/dt dl/dq' - dl/dq - Q_nc(q, q'), the
+            /// generalized force the motion needs from the inputs: straight-line code
+            /// differentiated at compile time.
             #[must_use]
             pub fn tau(&self, q: &#vec_n, dq: &#vec_n, ddq: &#vec_n) -> #vec_n {
                 #float
@@ -89,16 +128,36 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenSt
             #[must_use]
             pub fn mass_matrix(&self, q: &#vec_n, dq: &#vec_n) -> #na::SMatrix<f64, #n_lit, #n_lit> {
                 #float
-                #mass_stmts
                 let mut __out = #na::SMatrix::<f64, #n_lit, #n_lit>::zeros();
-                #(#mass_sets)*
+                #mass
                 __out
             }
 
-            /// The equalities tau_c = 0 of the unactuated coordinates (`UNACTUATED`), for
-            /// `OptimalControlProblem::with_equalities`.
+            /// The non-conservative generalized forces Q_nc(q, q') (zero without `forces`).
             #[must_use]
-            pub fn unactuated_torques(&self) -> [#core::TorqueComponent<'_, Self>; #u_len] {
+            pub fn nonconservative_force(&self, q: &#vec_n, dq: &#vec_n) -> #vec_n {
+                #float
+                let mut __out = #vec_n_path::zeros();
+                #forces
+                __out
+            }
+
+            /// The input u(q, q', q'') the motion needs: tau on the actuated coordinates, or
+            /// for an actuation matrix B(q) the solution of B u = tau (square B) or of the
+            /// normal equations B^T B u = B^T tau (n - 1 columns; exact where the passive
+            /// equality holds).
+            #[must_use]
+            pub fn input(&self, q: &#vec_n, dq: &#vec_n, ddq: &#vec_n) -> #na::SVector<f64, #m_lit> {
+                #float
+                let mut __out = #na::SVector::<f64, #m_lit>::zeros();
+                #input
+                __out
+            }
+
+            /// The passive equalities (`PASSIVE`), each a function of the jet that must
+            /// vanish, for `OptimalControlProblem::with_equalities`.
+            #[must_use]
+            pub fn unactuated_torques(&self) -> [#core::TorqueComponent<'_, Self>; #p_len] {
                 [#(#components),*]
             }
         }
@@ -106,9 +165,9 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenSt
 }
 
 /// `impl Type { plant, input_force }`: the plant with the same parameters, and the
-/// generalized force B u of an input u on the actuated coordinates.
-fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, actuated: &[usize]) -> TokenStream {
-    let (na, vec_n, vec_n_path, allow) = (&e.na, &e.vec_n, &e.vec_n_path, &e.allow);
+/// generalized force B(q) u of an input u.
+fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, el: &EulerLagrange) -> TokenStream {
+    let (na, vec_n, allow, float) = (&e.na, &e.vec_n, &e.allow, &e.float);
     let ParamTokens {
         generics, ty_full, ..
     } = &e.params;
@@ -117,11 +176,18 @@ fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, actuated: &[usize]) -> 
         let name = &p.name;
         quote!(#name: self.#name)
     });
-    let a_len = index(actuated.len());
-    let sets = actuated.iter().enumerate().map(|(i, &a)| {
-        let (i, a) = (index(i), index(a));
-        quote!(__out[#a] = u[#i];)
-    });
+    let m = el.input.len();
+    let in_q = |_: u8, i: u32| {
+        let i = index(i as usize);
+        quote!(q[#i])
+    };
+    let names = Names {
+        sig: e.sig,
+        jet: &in_q,
+    };
+    let matrix = sets(e, &el.input_matrix, m, &names);
+    let m_lit = index(m);
+    let n_lit = &e.n_lit;
     quote! {
         #[automatically_derived]
         #allow
@@ -129,19 +195,21 @@ fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, actuated: &[usize]) -> 
             /// The plant: the Lagrangian l(q, q') of order 1 with these parameters, for plant
             /// simulation under an input u by the forced midpoint rule (discrete
             /// Lagrange-d'Alembert), `retract::forced::forced_step(&system.plant(), &z0,
-            /// &system.input_force(&u), h, &options)`.
+            /// &system.input_force(&q, &u), h, &options)` (add `nonconservative_force` at the
+            /// step's midpoint where the system has forces).
             #[must_use]
             pub fn plant(&self) -> #plant_ty {
                 #plant_name { #(#fields),* }
             }
 
-            /// The generalized force B u of the input u: u_i on the i-th actuated coordinate
-            /// (`ACTUATED`), zero on the others.
+            /// The generalized force B(q) u of the input u (with actuated coordinates, u_j on
+            /// the j-th of `ACTUATED`, zero on the others).
             #[must_use]
-            pub fn input_force(&self, u: &#na::SVector<f64, #a_len>) -> #vec_n {
-                let mut __out = #vec_n_path::zeros();
-                #(#sets)*
-                __out
+            pub fn input_force(&self, q: &#vec_n, u: &#na::SVector<f64, #m_lit>) -> #vec_n {
+                #float
+                let mut __out = #na::SMatrix::<f64, #n_lit, #m_lit>::zeros();
+                #matrix
+                __out * u
             }
         }
     }

@@ -1,6 +1,10 @@
 //! The options of `#[mechanical_system]` beyond the signature's: which coordinates the
-//! actuators drive (`actuated = [i, ...]`, all of them by default) and the weight R of the
-//! effort 1/2 R |tau_actuated|^2 (`weight = R`, 1 by default), each error at its span.
+//! actuators drive (`actuated = [i, ...]`, all of them by default) or the actuation matrix
+//! B(q) (`input_matrix = f`, a helper returning its columns), the weight R of the effort
+//! 1/2 R |u|^2 (`weight = R`, 1 by default), the non-conservative generalized forces
+//! Q_nc(q, q') (`forces = f`) and a cost C(q, q', u) added to the effort (`cost = f`), each
+//! error at its span. The functions are helpers (`#[helper]` before the system, or `fn`s in
+//! its body) whose arguments are taken by name (`front::lower`'s `call_by_name`).
 
 use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
@@ -8,7 +12,7 @@ use syn::spanned::Spanned;
 use crate::util::combine;
 
 /// The options this module reads (`front::signature` skips them).
-pub(crate) const OPTIONS: [&str; 2] = ["actuated", "weight"];
+pub(crate) const OPTIONS: [&str; 5] = ["actuated", "weight", "forces", "input_matrix", "cost"];
 
 /// The actuation of a mechanical system, as written.
 pub(crate) struct Actuation {
@@ -16,9 +20,22 @@ pub(crate) struct Actuation {
     pub actuated: Option<Vec<(usize, Span)>>,
     /// R > 0.
     pub weight: f64,
+    /// The helper returning Q_nc(q, q') as `[f64; n]`.
+    pub forces: Option<syn::Ident>,
+    /// The helper returning the columns of B(q): `[f64; n]` (one input) or a tuple of them.
+    pub input_matrix: Option<syn::Ident>,
+    /// The helper returning the cost C(q, q', u) as an `f64`.
+    pub cost: Option<syn::Ident>,
 }
 
 impl Actuation {
+    /// The functions the options name (forces, actuation matrix, cost), in that order.
+    pub fn functions(&self) -> impl Iterator<Item = &syn::Ident> {
+        [&self.forces, &self.input_matrix, &self.cost]
+            .into_iter()
+            .flatten()
+    }
+
     /// The actuated coordinates of a system of dimension `n`, ascending, or the errors at the
     /// indices out of range or repeated.
     pub fn coordinates(&self, n: usize) -> syn::Result<Vec<usize>> {
@@ -56,6 +73,9 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
     let mut out = Actuation {
         actuated: None,
         weight: 1.0,
+        forces: None,
+        input_matrix: None,
+        cost: None,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("actuated") {
@@ -77,6 +97,26 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
                 )),
             });
             out.actuated = Some(indices.collect::<syn::Result<_>>()?);
+        } else if let Some(slot) = [
+            ("forces", &mut out.forces),
+            ("input_matrix", &mut out.input_matrix),
+            ("cost", &mut out.cost),
+        ]
+        .into_iter()
+        .find_map(|(name, slot)| meta.path.is_ident(name).then_some(slot))
+        {
+            let value: syn::Expr = meta.value()?.parse()?;
+            let name = match &value {
+                syn::Expr::Path(p) => p.path.get_ident().cloned(),
+                _ => None,
+            };
+            *slot = Some(name.ok_or_else(|| {
+                syn::Error::new(
+                    value.span(),
+                    "name a helper function here by its name, as `forces = damping` \
+                     (`#[helper] fn damping(...)` before the system, or a `fn` in its body)",
+                )
+            })?);
         } else if meta.path.is_ident("weight") {
             let value: syn::Expr = meta.value()?.parse()?;
             let weight = match &value {
@@ -108,5 +148,12 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
         Ok(())
     });
     syn::parse::Parser::parse2(parser, attr)?;
+    if let (Some(_), Some(matrix)) = (&out.actuated, &out.input_matrix) {
+        return Err(syn::Error::new(
+            matrix.span(),
+            "`input_matrix` and `actuated` exclude each other: the actuation is either the \
+             actuated coordinates or the matrix B(q) of the inputs' generalized forces",
+        ));
+    }
     Ok(out)
 }

@@ -28,6 +28,7 @@ use crate::util::tidy;
 mod outputs;
 mod values;
 pub use outputs::{item_without_output_marks, without_output_marks};
+pub use values::Returned;
 use values::Value;
 pub(crate) use values::helper_signature_problem;
 

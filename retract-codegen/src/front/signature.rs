@@ -266,8 +266,9 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             ))
         } else if attribute == Attribute::Mechanical {
             Err(meta.error(
-                "unsupported option; supported: `actuated = [i, ...]`, `weight = R`, \
-                 `name = TypeName`, `guard = false`, `helpers = [...]`, `order = 1`",
+                "unsupported option; supported: `actuated = [i, ...]`, `input_matrix = f`, \
+                 `forces = f`, `cost = f`, `weight = R`, `name = TypeName`, `guard = false`, \
+                 `helpers = [...]`, `order = 1`",
             ))
         } else if attribute == Attribute::Lagrangian {
             Err(meta.error(

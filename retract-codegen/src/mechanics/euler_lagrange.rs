@@ -1,18 +1,35 @@
 //! The Euler-Lagrange operator of a mechanical Lagrangian l(q, q') (`#[mechanical_system]`),
-//! as graph nodes in the order-2 jet (q, q', q''):
+//! with the non-conservative generalized forces Q_nc(q, q'), as graph nodes in the order-2
+//! jet (q, q', q''):
 //!
 //! ```text
-//! tau_i = D (dl/dq'_i) - dl/dq_i = sum_j M_ij q''_j + sum_j d2l/dq'_i dq_j q'_j - dl/dq_i,
+//! tau_i = D (dl/dq'_i) - dl/dq_i - Q_nc,i
+//!       = sum_j M_ij q''_j + sum_j d2l/dq'_i dq_j q'_j - dl/dq_i - Q_nc,i,
 //! M_ij  = d2l/dq'_i dq'_j
 //! ```
 //!
-//! with D the total derivative (`ir::diff::total_derivative`, q' and q'' the next jets), and
-//! the optimal-control Lagrangian of order 2 built from it, L = R/2 sum_a tau_a^2 over the
-//! actuated coordinates a.
+//! with D the total derivative (`ir::diff::total_derivative`, q' and q'' the next jets). The
+//! motion is driven by inputs u in R^m through tau = B(q) u; the input the motion needs,
+//! u(q, q', q''), and the passive equalities (what no input can supply) are:
+//!
+//! - actuated coordinates A (`actuated = [..]`, B the columns e_a of the identity):
+//!   u = tau_A, and tau_c = 0 for every c not in A;
+//! - an actuation matrix B(q), n x m, of full column rank m = n (square): u = B^{-1} tau, no
+//!   equality; m = n - 1: u = (B^T B)^{-1} B^T tau, exact where tau is in the range of B,
+//!   which is the one equality a(q)^T tau = 0 with the annihilator
+//!   a_i = (-1)^i det B_(i) (B_(i): B without row i; a^T b_j = det[b_j | B] = 0, and a != 0
+//!   iff B has rank n - 1). Then tau = B u exactly where the equality holds: tau - B u is the
+//!   component of tau along a.
+//!
+//! More passive directions (m < n - 1) need a choice of annihilator that no formula of B
+//! gives everywhere; they are refused (use `actuated` where B selects coordinates).
+//!
+//! The optimal-control Lagrangian of order 2 built from it is
+//! L = R/2 |u|^2 + C(q, q', u), C the user's cost (zero without one).
 
 use crate::ir::diff::{Differentiator, total_derivative};
 use crate::ir::graph::{Graph, Id, Var};
-use crate::mechanics::{derivatives, invert};
+use crate::mechanics::{derivatives, invert, symbolic_solve};
 
 /// tau and the mass matrix of l, with the derivatives of the components that no actuator
 /// drives (the stage equalities tau_c = 0).
@@ -21,8 +38,23 @@ pub struct EulerLagrange {
     pub tau: Vec<Id>,
     /// M_ij at `i * n + j`.
     pub mass: Vec<Id>,
-    /// The components of the coordinates no actuator drives, ascending.
+    /// Q_nc,i (zeros without forces).
+    pub forces: Vec<Id>,
+    /// u_j(q, q', q''), the input the motion needs (module docs), j = 0..m.
+    pub input: Vec<Id>,
+    /// B_ij at `i * m + j`, functions of q and the parameters.
+    pub input_matrix: Vec<Id>,
+    /// The passive equalities: with actuated coordinates, tau_c of each unactuated c
+    /// (labelled c), ascending; with an actuation matrix, a^T tau (labelled 0) where m = n - 1.
     pub unactuated: Vec<Component>,
+}
+
+/// How the inputs drive the coordinates.
+pub enum Inputs<'a> {
+    /// The actuated coordinates, ascending.
+    Coordinates(&'a [usize]),
+    /// The columns b_j of B(q), each of n entries.
+    Matrix(Vec<Vec<Id>>),
 }
 
 /// A component tau_c with its gradient and Hessian in (q, q', q'') (as
@@ -48,14 +80,28 @@ pub enum NotMechanical {
     Singular,
 }
 
-/// The Euler-Lagrange operator of `l` on R^n with the coordinates `actuated` driven (module
-/// docs), or why M cannot be a mass matrix.
+/// Why an actuation matrix B (n x m) is refused.
+pub enum BadInputMatrix {
+    /// A column has not n entries.
+    Rows(usize),
+    /// m > n.
+    TooManyInputs(usize),
+    /// m < n - 1 (module docs).
+    TooManyPassive(usize),
+    /// B is constant without full column rank, or its inversion is structurally singular.
+    RankDeficient,
+}
+
+/// The Euler-Lagrange operator of `l` on R^n with the forces `forces` (Q_nc, n entries) and
+/// the inputs `inputs` (module docs), or why M cannot be a mass matrix (`Err(Ok(_))`) or B
+/// cannot be an actuation matrix (`Err(Err(_))`).
 pub fn build(
     g: &mut Graph,
     l: Id,
     n: usize,
-    actuated: &[usize],
-) -> Result<EulerLagrange, NotMechanical> {
+    forces: Option<&[Id]>,
+    inputs: Inputs<'_>,
+) -> Result<EulerLagrange, Result<NotMechanical, BadInputMatrix>> {
     let mut d = Differentiator::default();
     let jet = |order: u8, i: usize| Var::Jet {
         order,
@@ -66,30 +112,59 @@ pub fn build(
         .map(|r| d.diff(g, momenta[r / n], jet(1, r % n)))
         .collect();
     if mass.iter().all(|&m| g.is_const(m, 0.0)) {
-        return Err(if momenta.iter().all(|&p| g.is_const(p, 0.0)) {
+        return Err(Ok(if momenta.iter().all(|&p| g.is_const(p, 0.0)) {
             NotMechanical::NoVelocity
         } else {
             NotMechanical::Linear
-        });
+        }));
     }
     let numbers: Option<Vec<f64>> = mass.iter().map(|&m| g.as_const(m)).collect();
     if numbers.is_some_and(|values| invert(&values, n).is_none()) {
-        return Err(NotMechanical::Singular);
+        return Err(Ok(NotMechanical::Singular));
     }
+    let zero = g.constant(0.0);
+    let forces = forces.map_or_else(|| vec![zero; n], <[Id]>::to_vec);
     let tau: Vec<Id> = (0..n)
         .map(|i| {
             let dp = total_derivative(g, &mut d, momenta[i], n, 2);
             let dl = d.diff(g, l, jet(0, i));
-            g.sub(dp, dl)
+            let conservative = g.sub(dp, dl);
+            g.sub(conservative, forces[i])
         })
         .collect();
-    let unactuated = (0..n)
-        .filter(|c| !actuated.contains(c))
-        .map(|index| {
-            let (_, gradient, hessian) = derivatives(g, tau[index], n, 2);
+    let (input, input_matrix, passive) = match inputs {
+        Inputs::Coordinates(actuated) => {
+            let one = g.constant(1.0);
+            let matrix = (0..n * actuated.len())
+                .map(|r| {
+                    let (i, j) = (r / actuated.len(), r % actuated.len());
+                    if actuated[j] == i { one } else { zero }
+                })
+                .collect();
+            let passive: Vec<(usize, Id)> = (0..n)
+                .filter(|c| !actuated.contains(c))
+                .map(|c| (c, tau[c]))
+                .collect();
+            (actuated.iter().map(|&a| tau[a]).collect(), matrix, passive)
+        }
+        Inputs::Matrix(columns) => {
+            let (input, passive) = through_matrix(g, &tau, &columns).map_err(Err)?;
+            let m = columns.len();
+            let matrix = (0..n * m).map(|r| columns[r % m][r / m]).collect();
+            (
+                input,
+                matrix,
+                passive.map(|a| (0, a)).into_iter().collect::<Vec<_>>(),
+            )
+        }
+    };
+    let unactuated = passive
+        .into_iter()
+        .map(|(index, value)| {
+            let (_, gradient, hessian) = derivatives(g, value, n, 2);
             Component {
                 index,
-                value: tau[index],
+                value,
                 gradient,
                 hessian,
             }
@@ -98,17 +173,118 @@ pub fn build(
     Ok(EulerLagrange {
         tau,
         mass,
+        forces,
+        input,
+        input_matrix,
         unactuated,
     })
 }
 
-/// The optimal-control Lagrangian of order 2: L = `weight`/2 sum_a tau_a^2 over `actuated`.
-pub fn effort(g: &mut Graph, tau: &[Id], actuated: &[usize], weight: f64) -> Id {
+/// u and the passive equality a^T tau (none where B is square) of the actuation matrix with
+/// columns `columns` (module docs).
+fn through_matrix(
+    g: &mut Graph,
+    tau: &[Id],
+    columns: &[Vec<Id>],
+) -> Result<(Vec<Id>, Option<Id>), BadInputMatrix> {
+    let (n, m) = (tau.len(), columns.len());
+    if let Some(column) = columns.iter().find(|c| c.len() != n) {
+        return Err(BadInputMatrix::Rows(column.len()));
+    }
+    if m > n {
+        return Err(BadInputMatrix::TooManyInputs(m));
+    }
+    if m + 1 < n {
+        return Err(BadInputMatrix::TooManyPassive(m));
+    }
+    let dot = |g: &mut Graph, a: &[Id], b: &[Id]| {
+        let mut sum = g.constant(0.0);
+        for (&x, &y) in a.iter().zip(b) {
+            let product = g.mul(x, y);
+            sum = g.add_op(sum, product);
+        }
+        sum
+    };
+    // square: B u = tau; else the normal equations B^T B u = B^T tau
+    let (system, rhs): (Vec<Vec<Id>>, Vec<Vec<Id>>) = if m == n {
+        let rows = (0..n).map(|i| columns.iter().map(|c| c[i]).collect());
+        (rows.collect(), tau.iter().map(|&t| vec![t]).collect())
+    } else {
+        let gram = columns
+            .iter()
+            .map(|a| columns.iter().map(|b| dot(g, a, b)).collect())
+            .collect();
+        (gram, columns.iter().map(|c| vec![dot(g, c, tau)]).collect())
+    };
+    let numbers: Option<Vec<f64>> = system.iter().flatten().map(|&e| g.as_const(e)).collect();
+    if numbers.is_some_and(|values| invert(&values, m).is_none()) {
+        return Err(BadInputMatrix::RankDeficient);
+    }
+    let (solution, _) =
+        symbolic_solve(g, system, rhs, INVERSION_BUDGET).ok_or(BadInputMatrix::RankDeficient)?;
+    let input = solution.into_iter().map(|row| row[0]).collect();
+    if m == n {
+        return Ok((input, None));
+    }
+    let annihilator: Vec<Id> = (0..n)
+        .map(|i| {
+            let minor: Vec<Vec<Id>> = (0..n)
+                .filter(|&r| r != i)
+                .map(|r| columns.iter().map(|c| c[r]).collect())
+                .collect();
+            let det = determinant(g, &minor);
+            if i % 2 == 0 { det } else { g.neg(det) }
+        })
+        .collect();
+    if annihilator.iter().all(|&a| g.is_const(a, 0.0)) {
+        return Err(BadInputMatrix::RankDeficient);
+    }
+    let passive = dot(g, &annihilator, tau);
+    Ok((input, Some(passive)))
+}
+
+/// Nodes the symbolic solve for u may add.
+const INVERSION_BUDGET: usize = 20_000;
+
+/// The determinant of a square matrix of nodes, by the Laplace expansion along the rows with
+/// the minors memoized by their set of columns (m 2^m products for m x m).
+fn determinant(g: &mut Graph, a: &[Vec<Id>]) -> Id {
+    let m = a.len();
+    // det[S] of the last |S| rows over the columns S, built up from the empty set
+    let mut det: Vec<Option<Id>> = vec![None; 1 << m];
+    det[0] = Some(g.constant(1.0));
+    let mut masks: Vec<usize> = (1..1usize << m).collect();
+    masks.sort_by_key(|s| s.count_ones());
+    for mask in masks {
+        let row = m - mask.count_ones() as usize;
+        let mut sum = g.constant(0.0);
+        for (position, j) in (0..m).filter(|j| mask & (1 << j) != 0).enumerate() {
+            let Some(rest) = det[mask & !(1 << j)] else {
+                continue;
+            };
+            let term = g.mul(a[row][j], rest);
+            sum = if position % 2 == 0 {
+                g.add_op(sum, term)
+            } else {
+                g.sub(sum, term)
+            };
+        }
+        det[mask] = Some(sum);
+    }
+    det[(1 << m) - 1].unwrap_or_else(|| g.constant(0.0))
+}
+
+/// The optimal-control Lagrangian of order 2: L = `weight`/2 |u|^2 + `cost` (module docs).
+pub fn effort(g: &mut Graph, input: &[Id], weight: f64, cost: Option<Id>) -> Id {
     let mut sum = g.constant(0.0);
-    for &a in actuated {
-        let square = g.powi(tau[a], 2);
+    for &u in input {
+        let square = g.powi(u, 2);
         sum = g.add_op(sum, square);
     }
     let half_weight = g.constant(0.5 * weight);
-    g.mul(half_weight, sum)
+    let effort = g.mul(half_weight, sum);
+    match cost {
+        Some(c) => g.add_op(effort, c),
+        None => effort,
+    }
 }

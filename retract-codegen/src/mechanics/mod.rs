@@ -390,7 +390,7 @@ const CLOSED_FORM_BUDGET: usize = 20_000;
 /// value the run-time check of the factors guards). `None` if a column has no structurally
 /// nonzero candidate or the graph grows past `budget` nodes. The flag says whether every
 /// pivot was a nonzero constant.
-fn symbolic_solve(
+pub(crate) fn symbolic_solve(
     g: &mut Graph,
     mut a: Vec<Vec<Id>>,
     mut y: Vec<Vec<Id>>,

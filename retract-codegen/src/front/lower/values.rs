@@ -31,6 +31,14 @@ pub(super) enum Value {
     Tuple(Vec<Value>),
 }
 
+/// What a function named by an option returned (`Lower::call_by_name`).
+pub enum Returned {
+    Number(Id),
+    Array(Vec<Id>),
+    /// A tuple of arrays.
+    Arrays(Vec<Vec<Id>>),
+}
+
 /// The shape a helper's argument or result must have.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Shape {
@@ -97,6 +105,104 @@ impl Lower<'_> {
                 }
             }
         }
+    }
+
+    /// The helper `name` (registered from `stmts`, the body of the function being lowered)
+    /// called with its arguments taken by name: each parameter is the argument or parameter of
+    /// the function of the same name (its jet q, q' and its parameters, as the function gets
+    /// them), or one of the arrays `extra`; `role` names the option in messages. Call it
+    /// before the body is lowered (whose locals would shadow the arguments). `None` after an
+    /// error (reported); else the value and the span of the helper's return type.
+    pub fn call_by_name(
+        &mut self,
+        stmts: &[Stmt],
+        name: &syn::Ident,
+        role: &str,
+        extra: &[(&str, Vec<Id>)],
+    ) -> Option<(Returned, proc_macro2::Span)> {
+        self.register_helpers(stmts);
+        let Some(f) = self.helpers.get(&name.to_string()).cloned() else {
+            self.error(
+                name.span(),
+                format!(
+                    "`{role} = {name}`: no helper function `{name}`: write `#[helper] fn \
+                     {name}(...)` before the system, or `fn {name}(...)` in its body"
+                ),
+            );
+            return None;
+        };
+        let mut scope = std::collections::HashMap::new();
+        for (extra_name, ids) in extra {
+            self.arrays.push(ids.clone());
+            let slot = (self.arrays.len() - 1) as u32;
+            scope.insert((*extra_name).to_string(), Binding::Array { slot });
+        }
+        let mut args = syn::punctuated::Punctuated::new();
+        let mut known = true;
+        for input in &f.sig.inputs {
+            let syn::FnArg::Typed(typed) = input else {
+                continue; // (rejected at registration)
+            };
+            let Pat::Ident(param) = &*typed.pat else {
+                continue;
+            };
+            let arg = param.ident.to_string();
+            if !scope.contains_key(&arg) && !self.scopes[0].contains_key(&arg) {
+                let mut names: Vec<String> = self.sig.jet.iter().map(|j| j.to_string()).collect();
+                names.extend(extra.iter().map(|(n, _)| (*n).to_string()));
+                names.extend(self.sig.params.iter().map(|p| p.name.to_string()));
+                self.error(
+                    param.ident.span(),
+                    format!(
+                        "`{arg}`: the arguments of `{name}` (`{role}`) are taken by name from \
+                         those of the system: {}",
+                        names.join(", ")
+                    ),
+                );
+                known = false;
+            }
+            let path: syn::ExprPath = syn::parse_quote_spanned!(param.ident.span()=> #param);
+            args.push(Expr::Path(path));
+        }
+        if !known {
+            return None;
+        }
+        let call = syn::ExprCall {
+            attrs: Vec::new(),
+            func: Box::new(syn::parse_quote_spanned!(name.span()=> #name)),
+            paren_token: Default::default(),
+            args,
+        };
+        let errors = self.errors.len();
+        self.scopes.push(scope);
+        let value = self.inline(&f, &call);
+        self.scopes.pop();
+        let span = match &f.sig.output {
+            syn::ReturnType::Type(_, ty) => ty.span(),
+            syn::ReturnType::Default => name.span(),
+        };
+        let returned = match value {
+            _ if self.errors.len() > errors => return None,
+            Value::Scalar(id) => Returned::Number(id),
+            Value::Array(ids) => Returned::Array(ids),
+            Value::Tuple(parts) => {
+                let arrays: Option<Vec<Vec<Id>>> = parts
+                    .into_iter()
+                    .map(|p| match p {
+                        Value::Array(ids) => Some(ids),
+                        _ => None,
+                    })
+                    .collect();
+                match arrays {
+                    Some(arrays) => Returned::Arrays(arrays),
+                    None => {
+                        self.error(span, format!("`{name}` returns a tuple of arrays or none"));
+                        return None;
+                    }
+                }
+            }
+        };
+        Some((returned, span))
     }
 
     /// The value of `e`: an array or tuple literal, a local array, a helper call, or a number.
