@@ -341,9 +341,10 @@ fn bad_input_matrix(actuation: &Actuation, bad: BadInputMatrix, n: usize) -> syn
              can be told apart"
         ),
         BadInputMatrix::TooManyPassive(m) => format!(
-            "the actuation matrix has {m} columns for {n} coordinates: {} passive directions; \
+            "the actuation matrix has {m} column{} for {n} coordinates: {} passive directions; \
              an actuation matrix may leave at most one (n - 1 or n columns): use `actuated = \
              [..]` where the inputs drive coordinates",
+            if m == 1 { "" } else { "s" },
             n - m
         ),
         BadInputMatrix::RankDeficient => "the actuation matrix does not have full column rank: \
@@ -494,7 +495,7 @@ mod tests {
         // reports a missing one at the name)
         let chained = expand("forces = nothing", ", c: f64", ENERGY).unwrap();
         assert!(chained.starts_with("nothing! {"), "{chained}");
-        assert!(err("forces = 1.0", "").contains("name a helper function"));
+        assert!(err("forces = 1.0", "").contains("`forces` names a helper function"));
         let unknown = err("forces = f", "fn f(x: [f64; 2]) -> [f64; 2] { x }");
         assert!(unknown.contains("taken by name"), "{unknown}");
         let scalar = err("forces = f", "fn f(c: f64) -> f64 { c }");

@@ -105,6 +105,11 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
         .into_iter()
         .find_map(|(name, slot)| meta.path.is_ident(name).then_some(slot))
         {
+            let option = meta
+                .path
+                .get_ident()
+                .map(ToString::to_string)
+                .unwrap_or_default();
             let value: syn::Expr = meta.value()?.parse()?;
             let name = match &value {
                 syn::Expr::Path(p) => p.path.get_ident().cloned(),
@@ -113,8 +118,10 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
             *slot = Some(name.ok_or_else(|| {
                 syn::Error::new(
                     value.span(),
-                    "name a helper function here by its name, as `forces = damping` \
-                     (`#[helper] fn damping(...)` before the system, or a `fn` in its body)",
+                    format!(
+                        "`{option}` names a helper function by its name, as `{option} = f` \
+                         (`#[helper] fn f(...)` before the system, or a `fn` in its body)"
+                    ),
                 )
             })?);
         } else if meta.path.is_ident("weight") {
