@@ -225,7 +225,9 @@ where
     /// [`crate::bvp::PlanOptions::max_backtracks`] halvings); [`Failure::TimeLimit`] if the
     /// budget runs out between trials. Where the first trial is rejected and does not reduce
     /// $\theta$, second-order corrections are tried before halving
-    /// ([`Self::second_order_correction`], with the subproblem's factorisation).
+    /// ([`Self::second_order_correction`], with the subproblem's factorisation), if the
+    /// problem has nonlinear constraints (stage equalities or inequalities: the dynamics and
+    /// the boundary data are linear, and a correction would repeat the step).
     fn filter_search(
         &self,
         (iterate, models, direction, factor): Searched<'_, N, X>,
@@ -273,6 +275,7 @@ where
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
                 && theta_t >= theta
                 && options.second_order_corrections > 0
+                && (!self.problem.equalities.is_empty() || !barrier.s.is_empty())
             {
                 let at = (iterate, models);
                 let first = (barrier, ds, alpha);
