@@ -606,7 +606,7 @@ fn a_warm_start_is_certified_at_the_returned_point() {
     assert!(worst < 1e-9, "scheme residual {worst:e}");
 }
 
-/// Second-order corrections (on by default) against none, on the cart-pole swing-ups whose
+/// Second-order corrections (4, IPOPT's default) against none, on the cart-pole swing-ups whose
 /// pole-torque equality curves: both reach the same certified minimum, and the corrections
 /// cost no iterations overall (they replace halvings of steps that the curvature of the
 /// equality would have cut).

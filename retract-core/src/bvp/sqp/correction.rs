@@ -2,8 +2,8 @@
 //! 2006, §2.4, Algorithm A steps 5.5-5.10): where the full step is rejected and raises the
 //! constraint violation (the Maratos effect of curved constraints), the step is recomputed
 //! with the same factorisation for the accumulated residual of the nonlinear constraints,
-//! up to [`crate::bvp::PlanOptions::second_order_corrections`] times (IPOPT's $p_{\max}$, 4 by
-//! default) while each reduces the violation by [`KAPPA_SOC`].
+//! up to [`crate::bvp::PlanOptions::second_order_corrections`] times (IPOPT's $p_{\max}$; 0,
+//! none, by default) while each reduces the violation by [`KAPPA_SOC`].
 //!
 //! The dynamics and the boundary data are linear, so their residual at the corrected step is
 //! the first one's: only the stage equalities $g^{=}$ and the inequalities' $g - s$ change.
