@@ -264,12 +264,11 @@ where
             let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
             let mut accepts = |t: f64, p: f64| self.filter_accepts(filter, current, (t, p), alpha);
             if parts.is_some_and(|(phi_t, theta_t)| accepts(theta_t, phi_t)) {
-                let (corrected, trial) = (None, trial);
                 return Ok(Some(Accepted {
                     trial,
                     alpha,
                     at_rounding,
-                    corrected,
+                    corrected: None,
                 }));
             }
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
