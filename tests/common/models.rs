@@ -90,3 +90,18 @@ pub fn disc_bump_guess(
         .collect();
     (x, u)
 }
+
+/// The double pendulum of the swing-up suite (`../shared/BENCHMARKS.md`): unit masses and
+/// rods, gravity `g`, $L = \frac12 |\tau|^2$ of the joint torques.
+#[higher_order_lagrangian(order = 2)]
+pub fn double_pendulum(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
+    let c2 = q[1].cos();
+    let s2 = q[1].sin();
+    let m11 = 3.0 + 2.0 * c2;
+    let m12 = 1.0 + c2;
+    let g1 = 2.0 * g * q[0].sin() + g * (q[0] + q[1]).sin();
+    let g2 = g * (q[0] + q[1]).sin();
+    let tau1 = m11 * ddq[0] + m12 * ddq[1] - s2 * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
+    let tau2 = m12 * ddq[0] + ddq[1] + s2 * dq[0] * dq[0] + g2;
+    0.5 * (tau1 * tau1 + tau2 * tau2)
+}

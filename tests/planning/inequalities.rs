@@ -4,21 +4,10 @@
 
 use std::f64::consts::PI;
 
+use crate::common::models::DoublePendulum;
+
 use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Variable};
 use retract::{JetFunction, higher_order_lagrangian, jet_function};
-
-/// The double pendulum of the swing-up suite.
-#[higher_order_lagrangian(order = 2)]
-fn double_pendulum(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
-    let c2 = q[1].cos();
-    let s2 = q[1].sin();
-    let tau1 = (3.0 + 2.0 * c2) * ddq[0] + (1.0 + c2) * ddq[1]
-        - s2 * (2.0 * dq[0] * dq[1] + dq[1] * dq[1])
-        + 2.0 * g * q[0].sin()
-        + g * (q[0] + q[1]).sin();
-    let tau2 = (1.0 + c2) * ddq[0] + ddq[1] + s2 * dq[0] * dq[0] + g * (q[0] + q[1]).sin();
-    0.5 * (tau1 * tau1 + tau2 * tau2)
-}
 
 /// limit - tau1 >= 0 (sign = 1) or limit + tau1 >= 0 (sign = -1): the shoulder torque limit.
 #[jet_function(order = 2)]

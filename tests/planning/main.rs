@@ -8,6 +8,7 @@
 mod common;
 
 mod attitude_slew;
+mod batch;
 mod budgets;
 mod bvp;
 mod car;

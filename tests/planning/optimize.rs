@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
+use common::models::{DISC_GOAL, DISC_START, DoublePendulum, OneDisc, disc_bump_guess};
 
 use std::f64::consts::PI;
 
@@ -13,20 +13,6 @@ use retract::bvp::{
 };
 use retract::nalgebra::{DMatrix, SVector};
 use retract::{JetFunction, Lagrangian, LiftedSystem, higher_order_lagrangian, jet_function};
-
-/// The double pendulum of the swing-up suite (`../shared/BENCHMARKS.md`).
-#[higher_order_lagrangian(order = 2)]
-fn double_pendulum(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
-    let c2 = q[1].cos();
-    let s2 = q[1].sin();
-    let m11 = 3.0 + 2.0 * c2;
-    let m12 = 1.0 + c2;
-    let g1 = 2.0 * g * q[0].sin() + g * (q[0] + q[1]).sin();
-    let g2 = g * (q[0] + q[1]).sin();
-    let tau1 = m11 * ddq[0] + m12 * ddq[1] - s2 * (2.0 * dq[0] * dq[1] + dq[1] * dq[1]) + g1;
-    let tau2 = m12 * ddq[0] + ddq[1] + s2 * dq[0] * dq[0] + g2;
-    0.5 * (tau1 * tau1 + tau2 * tau2)
-}
 
 fn solve_disc(
     steps: usize,

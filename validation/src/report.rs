@@ -19,7 +19,9 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
 use crate::systems::{closest_approach, paper_system};
-use crate::{expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision};
+use crate::{
+    batch_speed, expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision,
+};
 
 /// How much the report measures: rounds and calls per sample of each part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +44,8 @@ pub struct Size {
     pub race_rounds: usize,
     /// Expansions of each case of the compile-time cost.
     pub expansion_rounds: usize,
+    /// Plans in each batch of the thread scaling, and its interleaved rounds.
+    pub batch: (usize, usize),
 }
 
 impl Size {
@@ -57,6 +61,7 @@ impl Size {
             planner_rounds: 60,
             race_rounds: 200,
             expansion_rounds: 5,
+            batch: (64, 5),
         }
     }
 
@@ -73,6 +78,7 @@ impl Size {
             planner_rounds: 2,
             race_rounds: 2,
             expansion_rounds: 1,
+            batch: (4, 1),
         }
     }
 }
@@ -114,6 +120,12 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     long_run::write_long_runs(out, &long, size.long_run_end)?;
     let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
+    let (plans, rounds) = size.batch;
+    let batches = [
+        batch_speed::one_disc(plans, rounds)?,
+        batch_speed::swing_up(plans / 4, rounds)?,
+    ];
+    batch_speed::write_batches(out, &batches)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
     let seconds = started.elapsed().as_secs_f64();

@@ -52,8 +52,9 @@ pub struct Curve<'a, const N: usize> {
     kind: Kind<'a, N>,
 }
 
-type Function<'a, const N: usize> = Box<dyn Fn(f64) -> [f64; N] + 'a>;
-type Derivatives<'a, const N: usize> = Box<dyn Fn(f64, usize) -> [f64; N] + 'a>;
+// (`Send + Sync`: a guess is shared by the threads of a batch or a multi-start)
+type Function<'a, const N: usize> = Box<dyn Fn(f64) -> [f64; N] + Send + Sync + 'a>;
+type Derivatives<'a, const N: usize> = Box<dyn Fn(f64, usize) -> [f64; N] + Send + Sync + 'a>;
 
 enum Kind<'a, const N: usize> {
     Function(Function<'a, N>),
@@ -84,7 +85,7 @@ impl<'a, const N: usize> Curve<'a, N> {
     /// The path $q(t)$, its derivatives by central differences (see the type docs). The
     /// closure is called at times up to $(2k-1) d / 2 \approx 0.004$ beyond the horizon
     /// $[0, T]$, so it must be defined there.
-    pub fn from_fn(q: impl Fn(f64) -> [f64; N] + 'a) -> Self {
+    pub fn from_fn(q: impl Fn(f64) -> [f64; N] + Send + Sync + 'a) -> Self {
         Self {
             kind: Kind::Function(Box::new(q)),
         }
@@ -93,7 +94,9 @@ impl<'a, const N: usize> Curve<'a, N> {
     /// The path from its derivatives: `derivative(t, j)` $= q^{(j)}(t)$, called for
     /// $j = 0, \dots, 2k-1$ (the root finder's momenta need them all; the optimizer only
     /// $j \le k$).
-    pub fn from_derivatives(derivative: impl Fn(f64, usize) -> [f64; N] + 'a) -> Self {
+    pub fn from_derivatives(
+        derivative: impl Fn(f64, usize) -> [f64; N] + Send + Sync + 'a,
+    ) -> Self {
         Self {
             kind: Kind::Derivatives(Box::new(derivative)),
         }

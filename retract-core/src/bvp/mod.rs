@@ -48,6 +48,9 @@
 //!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]).
 //! 10. `realtime` (real-time iterations in a preparation and a feedback phase,
 //!     [`RealTimeIteration`]).
+//! 11. `batch` (many plans at once: [`solve_batch`], [`solve_stream`],
+//!     [`OptimalControlProblem::solve_multistart`]; on rayon's thread pool with the
+//!     `parallel` feature).
 //!
 //! # Example
 //! The hand-written disc system of [`crate::models`] (with `retract`, a `#[higher_order_lagrangian]`
@@ -103,6 +106,7 @@
 //! ```
 
 mod barrier;
+mod batch;
 mod constraints;
 mod curve;
 mod dynamics;
@@ -119,6 +123,7 @@ mod sqp;
 mod stack;
 mod workspace;
 
+pub use batch::{Job, MultiStart, Outcome, Stream, solve_batch, solve_stream};
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
