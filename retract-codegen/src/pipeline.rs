@@ -14,7 +14,6 @@ use syn::ItemFn;
 use crate::front::lower::Lower;
 use crate::front::signature::{self, Attribute, Signature};
 use crate::ir::graph::Graph;
-use crate::util::combine;
 
 /// The passes of one attribute, chained by [`run`].
 pub(crate) trait Passes {
@@ -71,9 +70,7 @@ pub(crate) fn run<P: Passes>(
     let lowered = {
         let mut lower = Lower::new(&mut graph, &sig);
         let lowered = passes.lower(&mut lower, &function, &sig);
-        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
-            return Err(e);
-        }
+        lower.errors.check()?;
         lowered
     };
     let (sig, lowered) = passes.charts(&mut graph, sig, lowered);

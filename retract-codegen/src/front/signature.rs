@@ -13,7 +13,7 @@ use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
 use syn::{FnArg, Ident, ItemFn, Pat, ReturnType, Type};
 
-use crate::util::combine;
+use crate::util::ErrorContext;
 
 /// Highest supported order.
 pub const MAX_ORDER: usize = 4;
@@ -361,13 +361,12 @@ fn camel(name: &Ident, attribute: Attribute) -> syn::Result<Ident> {
 /// messages written for a Lagrangian reworded for the attribute.
 struct Errors {
     attribute: Attribute,
-    list: Vec<syn::Error>,
+    list: ErrorContext,
 }
 
 impl Errors {
     fn fail(&mut self, span: Span, msg: String) {
-        self.list
-            .push(syn::Error::new(span, self.attribute.reword(msg)));
+        self.list.error(span, self.attribute.reword(msg));
     }
 }
 
@@ -755,10 +754,6 @@ fn parameters_first(args: &[(Ident, Kind)], count: usize) -> Option<usize> {
 pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
     let options = parse_options(attr, attribute)?;
     let sig = &item.sig;
-    let mut errors = Errors {
-        attribute,
-        list: Vec::new(),
-    };
 
     let options = match (attribute, options.order) {
         (Attribute::Mechanical, Some((order, span))) if order != 1 => {
@@ -785,6 +780,10 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                 attribute.name()
             ),
         ));
+    };
+    let mut errors = Errors {
+        attribute,
+        list: ErrorContext::new(),
     };
     check_qualifiers(sig, &mut errors);
     let jet_count = attribute.jet_count(order);
@@ -866,9 +865,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             Ident::new("Lagrangian", sig.ident.span())
         }),
     };
-    if let Some(e) = combine(errors.list) {
-        return Err(e);
-    }
+    errors.list.check()?;
     Ok(Signature {
         order,
         dim,
