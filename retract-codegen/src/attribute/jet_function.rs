@@ -13,7 +13,6 @@ use quote::{ToTokens, quote};
 use syn::ItemFn;
 
 use super::helper;
-use crate::charts;
 use crate::emit::helpers::{
     ParamTokens, allow_generated, chart_system_impl, function_and_type, param_tokens,
     space_description,
@@ -23,7 +22,7 @@ use crate::front::lower::Lower;
 use crate::front::signature::{Attribute, Signature};
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics;
-use crate::pipeline::{self, Passes, fail_softly};
+use crate::pipeline::{self, Passes, compose_with_chart, fail_softly};
 use crate::util::tidy;
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
@@ -63,7 +62,7 @@ impl Passes for JetFunctionPasses {
         sig: Signature,
         roots: Vec<Id>,
     ) -> (Signature, Vec<Id>) {
-        charts::compose(graph, sig, &roots)
+        compose_with_chart(graph, sig, &roots)
     }
 
     fn mechanics(
