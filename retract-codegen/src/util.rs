@@ -73,6 +73,13 @@ impl Drop for ErrorContext {
     }
 }
 
+/// The path through which generated code names what it calls of `retract_core`: the
+/// runtime's hidden `__private` module (one flat list of what only generated code needs),
+/// reached through the facade's, so that the user's crate depends on `retract` alone.
+pub(crate) fn core_path() -> proc_macro2::TokenStream {
+    quote::quote!(::retract::__private::retract_core::__private)
+}
+
 /// The deepest nesting of delimited groups (`()`, `[]`, `{}`) an attribute parses. syn parses
 /// a nested group by recursion, about 16 KiB of stack a level when unoptimised (as a
 /// proc-macro's dependencies are built): 512 levels of `(1.0 + (...))` overflowed rustc's

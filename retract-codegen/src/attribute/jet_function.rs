@@ -23,7 +23,7 @@ use crate::front::signature::{Attribute, Signature};
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics;
 use crate::pipeline::{self, Passes, compose_with_chart, fail_softly};
-use crate::util::tidy;
+use crate::util::{core_path, tidy};
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
 /// so the rest of the crate still type-checks. Never panics.
@@ -115,7 +115,7 @@ fn generate(function: &ItemFn, sig: &Signature, mut components: Vec<Component>) 
         proc_macro2::Literal::usize_unsuffixed(n),
         proc_macro2::Literal::usize_unsuffixed(k),
     );
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let na = quote!(::retract::__private::nalgebra);
     let vec_n = quote!(#na::SVector<f64, #n_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
@@ -205,7 +205,7 @@ fn vector_impl(sig: &Signature, params: &ParamTokens, components: &[Component]) 
         proc_macro2::Literal::usize_unsuffixed(sig.dim),
         proc_macro2::Literal::usize_unsuffixed(sig.order),
     );
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let na = quote!(::retract::__private::nalgebra);
     let vec_n = quote!(#na::SVector<f64, #n_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
@@ -327,7 +327,9 @@ mod tests {
         )
         .unwrap();
         assert!(out.contains("struct Height<'a>"), "{out}");
-        assert!(out.contains("JetFunction<1, 1> for Height<'a>"), "{out}");
+        // (the formatter may break the impl's header before `for`)
+        let words = out.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(words.contains("JetFunction<1, 1> for Height<'a>"), "{out}");
         assert!(out.contains("g sums over it"), "{out}");
     }
 

@@ -76,9 +76,9 @@ pub(crate) struct Frame {
     pub name: &'static str,
     /// Its length: a parameter `[f64; len]`.
     pub len: usize,
-    /// The runtime's trait of a system in this chart: the module of `retract_core`, the
-    /// trait, and its methods that read and replace the frame.
-    pub runtime: [&'static str; 4],
+    /// The runtime's trait of a system in this chart (in `retract_core::__private`) and its
+    /// methods that read and replace the frame.
+    pub runtime: [&'static str; 3],
     /// The doc of the frame's field in the parameter struct.
     pub doc: &'static str,
     /// The frame after `new`.

@@ -69,7 +69,7 @@ impl Chart for Se3 {
         Some(Frame {
             name: "se3_centre",
             len: 12,
-            runtime: ["se3", "Se3System", "centre", "with_centre"],
+            runtime: ["Se3System", "centre", "with_centre"],
             doc: "The chart's centre (C, c), a pose: C row major, then c \
                   (`retract::se3::centre_pose`), moved by `retract::se3`; the identity after \
                   `new`.",

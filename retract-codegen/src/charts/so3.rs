@@ -186,7 +186,7 @@ impl Chart for So3 {
         Some(Frame {
             name: "so3_centre",
             len: 9,
-            runtime: ["so3", "So3System", "centre", "with_centre"],
+            runtime: ["So3System", "centre", "with_centre"],
             doc: "The Gibbs chart's centre C, a rotation matrix row major \
                   (`retract::so3::centre_matrix`), moved by `retract::so3`; the identity after \
                   `new`.",

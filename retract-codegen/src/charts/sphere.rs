@@ -72,7 +72,7 @@ impl Chart for Sphere {
         Some(Frame {
             name: "sphere_chart",
             len: 9,
-            runtime: ["sphere", "SphereSystem", "chart", "with_chart"],
+            runtime: ["SphereSystem", "chart", "with_chart"],
             doc: "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set \
                   by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`.",
             initial: || quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),

@@ -11,6 +11,7 @@ use crate::charts::Space;
 use crate::emit::codegen::{Leaves, signed_add};
 use crate::front::signature::{Kind, Signature};
 use crate::ir::graph::Var;
+use crate::util::core_path;
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -199,13 +200,14 @@ pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStre
     };
     let field = syn::Ident::new(frame.name, proc_macro2::Span::call_site());
     let len = index(frame.len);
-    let [module, tr, read, replace] = frame
+    let core = core_path();
+    let [tr, read, replace] = frame
         .runtime
         .map(|name| syn::Ident::new(name, proc_macro2::Span::call_site()));
     quote! {
         #[automatically_derived]
         #allow
-        impl #generics ::retract::__private::retract_core::#module::#tr for #ty {
+        impl #generics #core::#tr for #ty {
             fn #read(&self) -> [f64; #len] {
                 self.#field
             }
