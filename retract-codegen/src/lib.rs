@@ -11,9 +11,9 @@
 //! - `front`: the attribute's options and the signature (`signature`: order, dimension,
 //!   parameters, space), the body lowered to the expression graph (`lower`);
 //! - `ir`: the hash-consed expression graph (`graph`) and its differentiation (`diff`);
-//! - `charts`: a function on the sphere, SO(3) or SE(3) composed with its space's chart
-//!   (`sphere`: gnomonic; `so3`: Gibbs; `se3`: the product chart), so that the later stages see
-//!   R^n;
+//! - `charts`: the spaces, each behind one trait `Chart` (`flat`: R^n; `sphere`: gnomonic;
+//!   `so3`: Gibbs; `se3`: the product chart), registered in `Space`: a function on a manifold
+//!   is composed with its space's chart, so that the later stages see R^n;
 //! - `mechanics`: gradient, Hessian, momenta, the scheme and its Jacobians, the reduced step,
 //!   the separable form (`separable`); for a discretization map its conditions
 //!   (`map_conditions`) and its lift by total derivatives (`lift`);
@@ -21,7 +21,7 @@
 //!   `codegen` (one `let` per shared node).
 //!
 //! `pipeline` chains the stages, once for every attribute. Helpers used by several stages
-//! (`util`) import none of them.
+//! (`util`: the error context, token text) import none of them.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -13,8 +13,7 @@ use syn::ItemFn;
 
 use crate::front::lower::Lower;
 use crate::front::signature::{self, Attribute, Signature};
-use crate::ir::graph::Graph;
-use crate::util::combine;
+use crate::ir::graph::{Graph, Id};
 
 /// The passes of one attribute, chained by [`run`].
 pub(crate) trait Passes {
@@ -71,14 +70,25 @@ pub(crate) fn run<P: Passes>(
     let lowered = {
         let mut lower = Lower::new(&mut graph, &sig);
         let lowered = passes.lower(&mut lower, &function, &sig);
-        if let Some(e) = combine(std::mem::take(&mut lower.errors)) {
-            return Err(e);
-        }
+        lower.errors.check()?;
         lowered
     };
     let (sig, lowered) = passes.charts(&mut graph, sig, lowered);
     let derived = passes.mechanics(&mut graph, &sig, lowered)?;
     Ok(passes.emit(&function, &sig, &graph, derived))
+}
+
+/// `roots` (a function and its guarded expressions) composed with the chart of `sig`'s space
+/// (`charts`), with the signature of the composed function (`Signature::in_chart`: the
+/// chart's frame appended to the parameters); unchanged on R^n.
+pub(crate) fn compose_with_chart(
+    graph: &mut Graph,
+    sig: Signature,
+    roots: &[Id],
+) -> (Signature, Vec<Id>) {
+    let frame = sig.params.len() as u32;
+    let roots = sig.space.chart().compose(graph, sig.order, frame, roots);
+    (sig.in_chart(), roots)
 }
 
 /// The expansion of `item` where it succeeded; where it failed, the original item (its

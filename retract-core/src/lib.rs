@@ -78,7 +78,8 @@ mod serde_float;
 pub mod state;
 pub mod system;
 
-// The paths before the layers, for one release (the planner and generated code name them).
+// The paths before the layers, for one release (the planner and code written against them
+// name them; generated code names `__private` alone).
 #[doc(hidden)]
 pub use manifold::{se3, so3, sphere};
 #[cfg(feature = "std")]
@@ -100,7 +101,7 @@ pub mod __private {
     pub use crate::manifold::se3::Se3System;
     pub use crate::manifold::so3::So3System;
     pub use crate::manifold::sphere::SphereSystem;
-    pub use crate::mechanical::MechanicalSystem;
+    pub use crate::mechanical::{MechanicalSystem, TorqueComponent};
     pub use crate::numeric::linalg::solve;
     pub use crate::numeric::special::stumpff;
     pub use crate::scheme::lifted::{hamiltonian, legendre, predictor, step_cost, vector_field};

@@ -13,7 +13,6 @@ use quote::{ToTokens, quote};
 use syn::ItemFn;
 
 use super::helper;
-use crate::charts;
 use crate::emit::helpers::{
     ParamTokens, allow_generated, chart_system_impl, function_and_type, param_tokens,
     space_description,
@@ -23,8 +22,8 @@ use crate::front::lower::Lower;
 use crate::front::signature::{Attribute, Signature};
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics;
-use crate::pipeline::{self, Passes, fail_softly};
-use crate::util::tidy;
+use crate::pipeline::{self, Passes, compose_with_chart, fail_softly};
+use crate::util::{core_path, tidy};
 
 /// Expands `#[jet_function(attr)] item`; on error, the original item plus `compile_error!`s,
 /// so the rest of the crate still type-checks. Never panics.
@@ -63,7 +62,7 @@ impl Passes for JetFunctionPasses {
         sig: Signature,
         roots: Vec<Id>,
     ) -> (Signature, Vec<Id>) {
-        charts::compose(graph, sig, &roots)
+        compose_with_chart(graph, sig, &roots)
     }
 
     fn mechanics(
@@ -116,7 +115,7 @@ fn generate(function: &ItemFn, sig: &Signature, mut components: Vec<Component>) 
         proc_macro2::Literal::usize_unsuffixed(n),
         proc_macro2::Literal::usize_unsuffixed(k),
     );
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let na = quote!(::retract::__private::nalgebra);
     let vec_n = quote!(#na::SVector<f64, #n_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
@@ -206,7 +205,7 @@ fn vector_impl(sig: &Signature, params: &ParamTokens, components: &[Component]) 
         proc_macro2::Literal::usize_unsuffixed(sig.dim),
         proc_macro2::Literal::usize_unsuffixed(sig.order),
     );
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let na = quote!(::retract::__private::nalgebra);
     let vec_n = quote!(#na::SVector<f64, #n_lit>);
     let jet_blocks = quote!([#vec_n; #k_lit]);
@@ -328,7 +327,9 @@ mod tests {
         )
         .unwrap();
         assert!(out.contains("struct Height<'a>"), "{out}");
-        assert!(out.contains("JetFunction<1, 1> for Height<'a>"), "{out}");
+        // (the formatter may break the impl's header before `for`)
+        let words = out.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(words.contains("JetFunction<1, 1> for Height<'a>"), "{out}");
         assert!(out.contains("g sums over it"), "{out}");
     }
 

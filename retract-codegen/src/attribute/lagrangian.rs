@@ -8,14 +8,14 @@ use proc_macro2::TokenStream;
 use syn::ItemFn;
 
 use super::helper;
-use crate::charts;
+use crate::charts::Space;
 use crate::emit::outputs::outputs_impl;
 use crate::emit::{Emission, system_items};
 use crate::front::lower::{Guard, Lower, Output, without_output_marks};
-use crate::front::signature::{Attribute, Signature, Space};
+use crate::front::signature::{Attribute, Signature};
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics::{self, Degenerate, Mechanics, Reduced};
-use crate::pipeline::{self, Passes, fail_softly};
+use crate::pipeline::{self, Passes, compose_with_chart, fail_softly};
 
 /// Expands `#[higher_order_lagrangian(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
@@ -94,11 +94,14 @@ impl Passes for LagrangianPasses<'_> {
         self.stats.guards = lower.guards.len();
         if let Some(output) = lower.outputs.first().filter(|_| sig.space != Space::Flat) {
             let span = output.name.span();
-            lower.errors.push(syn::Error::new(
+            lower.errors.error(
                 span,
-                "named outputs are not supported with `sphere`, `so3` or `se3` (the generated system \
-                 works in a chart)",
-            ));
+                format!(
+                    "named outputs are not supported with {} (the generated system works in a \
+                     chart)",
+                    Space::option_list(", ", " or ")
+                ),
+            );
         }
         Lowered {
             root,
@@ -165,10 +168,7 @@ impl Passes for LagrangianPasses<'_> {
 /// The error of a Lagrangian whose Legendre map is singular, at its top argument.
 fn degenerate(sig: &Signature, reason: Degenerate) -> syn::Error {
     let top = &sig.jet[sig.order];
-    let what = charts::of(sig.space).map_or_else(
-        || format!("q^({})", sig.order),
-        |chart| chart.top(sig.order),
-    );
+    let what = sig.space.chart().top(sig.order);
     let msg = match reason {
         Degenerate::Independent => format!(
             "the Lagrangian does not depend on `{top}` = {what}: its Legendre map is \
@@ -198,7 +198,7 @@ fn in_chart(
     let roots: Vec<Id> = core::iter::once(root)
         .chain(guards.iter().map(|g| g.node))
         .collect();
-    let (sig, composed) = charts::compose(graph, sig, &roots);
+    let (sig, composed) = compose_with_chart(graph, sig, &roots);
     let guards = guards
         .into_iter()
         .zip(&composed[1..])

@@ -19,7 +19,6 @@ use crate::ir::graph::Graph;
 use crate::mechanics::lift::{Lift, lift};
 use crate::mechanics::map_conditions::{self, Spanned};
 use crate::pipeline::{self, Passes, fail_softly};
-use crate::util::combine;
 
 /// Expands `#[discretization_map(attr)] item`; on error, the original item plus
 /// `compile_error!`s, so the rest of the crate still type-checks. Never panics.
@@ -70,10 +69,8 @@ impl Passes for MapPasses {
         sig: &Signature,
         points: [Vec<Spanned>; 2],
     ) -> syn::Result<Lift> {
-        if sig.check
-            && let Some(e) = combine(map_conditions::check(graph, sig, &points))
-        {
-            return Err(e);
+        if sig.check {
+            map_conditions::check(graph, sig, &points)?;
         }
         let r = points.map(|side| side.iter().map(|&(id, _)| id).collect());
         Ok(lift(graph, &r, sig.dim, sig.order))

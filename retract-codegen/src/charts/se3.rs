@@ -14,22 +14,20 @@
 //! jet for every centre.
 
 use crate::charts::so3::{
-    body_angular_velocity, chart_rotation, jet3, mat_mul, param_entries, rates,
+    body_angular_velocity, body_argument, chart_rotation, jet3, mat_mul, param_entries, rates,
+    wrong_body_argument,
 };
-use crate::front::signature::Signature;
-use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Chart;
+use super::{Chart, Frame};
 use crate::ir::diff::substitute_jet;
 use crate::ir::graph::{Graph, Id};
 
 /// `roots` (L and its guarded expressions, in the arguments g, xi, ... of `sig`) rewritten
 /// in the chart jet: `Var::Jet { order: 0, index: e }` becomes g_e of the pose (R, p) and
 /// `Var::Jet { order: j, index: a }` (j >= 1) becomes xi^(j-1)_a. The centre parameter is
-/// number `sig.params.len()`.
-pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-    let param = sig.params.len() as u32;
+/// number `param`.
+pub fn compose(g: &mut Graph, order: usize, param: u32, roots: &[Id]) -> Vec<Id> {
     let (rotation, position) = (param_entries(g, param, 0, 9), param_entries(g, param, 9, 3));
     let (y, x) = (jet3(g, 0, 0), jet3(g, 0, 3));
     let (dy, dx) = (jet3(g, 1, 0), jet3(g, 1, 3));
@@ -55,7 +53,7 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
         xi.push(acc);
     }
     let mut jet = vec![pose];
-    jet.extend(rates(g, xi, 6, sig.order));
+    jet.extend(rates(g, xi, 6, order));
     substitute_jet(g, roots, jet)
 }
 
@@ -63,14 +61,68 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
 pub(crate) struct Se3;
 
 impl Chart for Se3 {
-    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-        compose(graph, sig, roots)
+    fn option(&self) -> Option<&'static str> {
+        Some("se3")
     }
 
-    fn description(&self) -> &'static str {
+    fn frame(&self) -> Option<Frame> {
+        Some(Frame {
+            name: "se3_centre",
+            len: 12,
+            runtime: ["Se3System", "centre", "with_centre"],
+            doc: "The chart's centre (C, c), a pose: C row major, then c \
+                  (`retract::se3::centre_pose`), moved by `retract::se3`; the identity after \
+                  `new`.",
+            initial: || quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+        })
+    }
+
+    fn body_coordinates(&self) -> Option<(usize, usize)> {
+        Some((12, 6))
+    }
+
+    fn required_argument(&self, order: usize, i: usize) -> Option<usize> {
+        body_argument(12, 6, order, i)
+    }
+
+    fn wrong_argument(&self, order: usize, i: usize, name: &syn::Ident, found: &str) -> String {
+        let prefix = format!(
+            "a Lagrangian on SE(3) (`se3`) of order {order} takes g = (R, p): [f64; 12], then \
+             xi, ..., xi^({}): [f64; 6] (xi = (Omega, v))",
+            order - 1
+        );
+        let expected = if i == 0 { 12 } else { 6 };
+        wrong_body_argument(
+            [
+                &prefix,
+                "the pose g = (R, p): R row major (g[3 * i + j] = R_ij), then p = g[9..12]",
+                "the body velocity xi = (Omega, v), v = R^T p'",
+                "xi",
+            ],
+            (i, expected),
+            name,
+            found,
+        )
+    }
+
+    fn missing_arguments(&self, order: usize, found: usize) -> Option<String> {
+        Some(format!(
+            "order = {order} with `se3` needs {} arguments before the parameters (g: [f64; 12], \
+             then xi, ..., xi^({}): [f64; 6]); the signature has {found}",
+            order + 1,
+            order - 1,
+        ))
+    }
+
+    fn compose(&self, graph: &mut Graph, order: usize, frame: u32, roots: &[Id]) -> Vec<Id> {
+        compose(graph, order, frame, roots)
+    }
+
+    fn description(&self, _dim: usize) -> String {
         "SE(3), written in the pose (R, p) and the body velocity (Omega, v) with its derivatives, \
          in the chart (Gibbs chart of R, position in the centre's axes) centred at `se3_centre` \
          (R^6; see `retract::se3`),"
+            .into()
     }
 
     fn arguments(&self, k: usize) -> String {
@@ -79,18 +131,5 @@ impl Chart for Se3 {
 
     fn top(&self, k: usize) -> String {
         format!("xi^({})", k - 1)
-    }
-
-    fn runtime(&self) -> [&'static str; 4] {
-        ["se3", "Se3System", "centre", "with_centre"]
-    }
-
-    fn frame_doc(&self) -> &'static str {
-        "The chart's centre (C, c), a pose: C row major, then c (`retract::se3::centre_pose`), \
-         moved by `retract::se3`; the identity after `new`."
-    }
-
-    fn initial_frame(&self) -> TokenStream {
-        quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
     }
 }

@@ -14,11 +14,9 @@
 //! replaced by that expression; 1 + |y|^2 >= 1, so the chart itself needs no guard. The
 //! pieces (Q, Omega, the derivatives) also serve the SE(3) stage (`crate::charts::se3`).
 
-use crate::front::signature::Signature;
-use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Chart;
+use super::{Chart, Frame};
 use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
 use crate::ir::graph::{Graph, Id, Var};
 
@@ -133,29 +131,114 @@ pub(crate) fn rates(g: &mut Graph, xi: Vec<Id>, dim: usize, k: usize) -> Vec<Vec
 /// `roots` (L and its guarded expressions, in the arguments R, Omega, ... of `sig`)
 /// rewritten in the chart jet: `Var::Jet { order: 0, index: e }` becomes R_e of
 /// R = C Q(y) and `Var::Jet { order: j, index: a }` (j >= 1) becomes Omega^(j-1)_a. The
-/// centre parameter is number `sig.params.len()`.
-pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-    let centre = param_entries(g, sig.params.len() as u32, 0, 9);
+/// centre parameter is number `frame`.
+pub fn compose(g: &mut Graph, order: usize, frame: u32, roots: &[Id]) -> Vec<Id> {
+    let centre = param_entries(g, frame, 0, 9);
     let (y, dy) = (jet3(g, 0, 0), jet3(g, 1, 0));
     let q = chart_rotation(g, y);
     let r = mat_mul(g, &centre, &q).to_vec();
     let omega = body_angular_velocity(g, y, dy).to_vec();
     let mut jet = vec![r];
-    jet.extend(rates(g, omega, 3, sig.order));
+    jet.extend(rates(g, omega, 3, order));
     substitute_jet(g, roots, jet)
 }
 
 /// The Gibbs chart of SO(3) (module docs).
 pub(crate) struct So3;
 
+/// The length a Lagrangian in body coordinates of order `order` requires of its jet argument
+/// `i` as written: the group element's (`group`) for i = 0, a body rate's (`rate`) for
+/// 1 <= i <= order.
+pub(crate) fn body_argument(group: usize, rate: usize, order: usize, i: usize) -> Option<usize> {
+    match i {
+        0 => Some(group),
+        _ if i <= order => Some(rate),
+        _ => None,
+    }
+}
+
+/// The message for a jet argument of a Lagrangian in body coordinates whose type is not the
+/// required one: `prefix` says what the arguments are, `element` and `velocity` what the
+/// first two hold, `rate` the body rate's symbol.
+pub(crate) fn wrong_body_argument(
+    [prefix, element, velocity, rate]: [&str; 4],
+    (i, expected): (usize, usize),
+    name: &syn::Ident,
+    found: &str,
+) -> String {
+    let what = match i {
+        0 => element.to_string(),
+        1 => velocity.to_string(),
+        _ => format!("{rate}^({}), the derivative of the body velocity", i - 1),
+    };
+    format!(
+        "{prefix}; argument {} (`{name}`) must be `[f64; {expected}]` ({what}), not {found}",
+        i + 1
+    )
+}
+
 impl Chart for So3 {
-    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-        compose(graph, sig, roots)
+    fn option(&self) -> Option<&'static str> {
+        Some("so3")
     }
 
-    fn description(&self) -> &'static str {
+    fn frame(&self) -> Option<Frame> {
+        Some(Frame {
+            name: "so3_centre",
+            len: 9,
+            runtime: ["So3System", "centre", "with_centre"],
+            doc: "The Gibbs chart's centre C, a rotation matrix row major \
+                  (`retract::so3::centre_matrix`), moved by `retract::so3`; the identity after \
+                  `new`.",
+            initial: || quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+        })
+    }
+
+    fn body_coordinates(&self) -> Option<(usize, usize)> {
+        Some((9, 3))
+    }
+
+    fn required_argument(&self, order: usize, i: usize) -> Option<usize> {
+        body_argument(9, 3, order, i)
+    }
+
+    fn wrong_argument(&self, order: usize, i: usize, name: &syn::Ident, found: &str) -> String {
+        let prefix = format!(
+            "a Lagrangian on SO(3) (`so3`) of order {order} takes R: [f64; 9], then Omega, ..., \
+             Omega^({}): [f64; 3]",
+            order - 1
+        );
+        let expected = if i == 0 { 9 } else { 3 };
+        wrong_body_argument(
+            [
+                &prefix,
+                "the rotation R, row major: r[3 * i + j] = R_ij",
+                "the body angular velocity Omega",
+                "Omega",
+            ],
+            (i, expected),
+            name,
+            found,
+        )
+    }
+
+    fn missing_arguments(&self, order: usize, found: usize) -> Option<String> {
+        Some(format!(
+            "order = {order} with `so3` needs {} arguments before the parameters (R: [f64; 9], \
+             then Omega, ..., Omega^({}): [f64; 3]); the signature has {found}",
+            order + 1,
+            order - 1,
+        ))
+    }
+
+    fn compose(&self, graph: &mut Graph, order: usize, frame: u32, roots: &[Id]) -> Vec<Id> {
+        compose(graph, order, frame, roots)
+    }
+
+    fn description(&self, _dim: usize) -> String {
         "SO(3), written in the rotation R and the body velocity Omega with its derivatives, in \
          the Gibbs chart centred at `so3_centre` (R^3; see `retract::so3`),"
+            .into()
     }
 
     fn arguments(&self, k: usize) -> String {
@@ -165,18 +248,5 @@ impl Chart for So3 {
     fn top(&self, k: usize) -> String {
         // (the top argument is Omega^(k-1), which holds the chart's q^(k))
         format!("Omega^({})", k - 1)
-    }
-
-    fn runtime(&self) -> [&'static str; 4] {
-        ["so3", "So3System", "centre", "with_centre"]
-    }
-
-    fn frame_doc(&self) -> &'static str {
-        "The Gibbs chart's centre C, a rotation matrix row major (`retract::so3::centre_matrix`), \
-         moved by `retract::so3`; the identity after `new`."
-    }
-
-    fn initial_frame(&self) -> TokenStream {
-        quote!([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
     }
 }

@@ -11,11 +11,9 @@
 //! chart jet (D y^(i) = y^(i+1)). Every ambient jet variable of L (and of its guards) is
 //! replaced by that expression; |s| >= 1, so the chart itself needs no guard.
 
-use crate::front::signature::Signature;
-use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::Chart;
+use super::{Chart, Frame};
 use crate::ir::diff::{Differentiator, substitute_jet, total_derivative};
 use crate::ir::graph::{Func, Graph, Id, Var};
 
@@ -54,12 +52,11 @@ fn ambient_jet(g: &mut Graph, chart: u32, k: usize) -> Vec<[Id; 3]> {
     jet
 }
 
-/// `roots` (L and its guarded expressions, in the ambient jet of `sig`) rewritten in the
-/// chart jet: each ambient `Var::Jet { order: j, index: a }` becomes D^j phi_a(y). The chart
-/// parameter is number `sig.params.len()`.
-pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-    let chart = sig.params.len() as u32;
-    let jet = ambient_jet(g, chart, sig.order);
+/// `roots` (L and its guarded expressions, in the ambient jet of an order-`order` function)
+/// rewritten in the chart jet: each ambient `Var::Jet { order: j, index: a }` becomes
+/// D^j phi_a(y). The chart parameter is number `chart`.
+pub fn compose(g: &mut Graph, order: usize, chart: u32, roots: &[Id]) -> Vec<Id> {
+    let jet = ambient_jet(g, chart, order);
     substitute_jet(g, roots, jet.into_iter().map(|q| q.to_vec()).collect())
 }
 
@@ -67,25 +64,43 @@ pub fn compose(g: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
 pub(crate) struct Sphere;
 
 impl Chart for Sphere {
-    fn compose(&self, graph: &mut Graph, sig: &Signature, roots: &[Id]) -> Vec<Id> {
-        compose(graph, sig, roots)
+    fn option(&self) -> Option<&'static str> {
+        Some("sphere")
     }
 
-    fn description(&self) -> &'static str {
+    fn frame(&self) -> Option<Frame> {
+        Some(Frame {
+            name: "sphere_chart",
+            len: 9,
+            runtime: ["SphereSystem", "chart", "with_chart"],
+            doc: "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set \
+                  by `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`.",
+            initial: || quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+        })
+    }
+
+    fn chart_dim(&self, _dim: usize) -> usize {
+        2
+    }
+
+    fn required_argument(&self, _order: usize, i: usize) -> Option<usize> {
+        (i == 0).then_some(3)
+    }
+
+    fn wrong_argument(&self, _order: usize, _i: usize, _name: &syn::Ident, found: &str) -> String {
+        format!(
+            "a Lagrangian on the sphere (`sphere`) is written in ambient coordinates: its jet q, \
+             q', ... must be `[f64; 3]`, not {found}"
+        )
+    }
+
+    fn compose(&self, graph: &mut Graph, order: usize, frame: u32, roots: &[Id]) -> Vec<Id> {
+        compose(graph, order, frame, roots)
+    }
+
+    fn description(&self, _dim: usize) -> String {
         "the unit sphere S^2, in the gnomonic chart `sphere_chart` (R^2; see `retract::sphere`),"
-    }
-
-    fn runtime(&self) -> [&'static str; 4] {
-        ["sphere", "SphereSystem", "chart", "with_chart"]
-    }
-
-    fn frame_doc(&self) -> &'static str {
-        "The gnomonic chart's frame [c, e1, e2] (`retract::sphere::Chart::params`), set by \
-         `retract::sphere`; the north pole (c = z, e1 = x, e2 = y) after `new`."
-    }
-
-    fn initial_frame(&self) -> TokenStream {
-        quote!([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+            .into()
     }
 }
 

@@ -33,6 +33,7 @@ use quote::{format_ident, quote};
 
 use crate::emit::scopes::bounded_scopes;
 use crate::ir::graph::{Func, Graph, Id, Node, Var, children};
+use crate::util::core_path;
 
 /// How a function names the leaves: symbol -> expression tokens.
 pub trait Leaves {
@@ -701,7 +702,10 @@ impl Emitter<'_> {
             }
             Node::Unary(Func::Stumpff(k), a) => {
                 let (a, k) = (r(a), u32::from(k));
-                quote!(::retract::__private::retract_core::stumpff(#k, #a))
+                {
+                    let core = core_path();
+                    quote!(#core::stumpff(#k, #a))
+                }
             }
             Node::Unary(f, a) => {
                 let a = r(a);

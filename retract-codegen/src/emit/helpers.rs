@@ -7,10 +7,11 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use syn::ItemFn;
 
-use crate::charts;
+use crate::charts::Space;
 use crate::emit::codegen::{Leaves, signed_add};
-use crate::front::signature::{Kind, Signature, Space};
+use crate::front::signature::{Kind, Signature};
 use crate::ir::graph::Var;
+use crate::util::core_path;
 
 /// `i` as an unsuffixed literal (an index or a length in the generated code).
 pub(crate) fn index(i: usize) -> Literal {
@@ -185,30 +186,28 @@ pub(crate) fn type_items(
 
 /// Where a generated system lives, for its docs: "R^n", or the space and its chart.
 pub(crate) fn space_description(sig: &Signature) -> String {
-    charts::of(sig.space).map_or_else(
-        || format!("R^{}", sig.dim),
-        |chart| chart.description().into(),
-    )
+    sig.space.chart().description(sig.dim)
 }
 
 /// For a function on the sphere (`sphere`), `SphereSystem`; on SO(3) (`so3`), `So3System`;
-/// on SE(3) (`se3`), `Se3System` (`charts::Chart::runtime`): the chart parameter, read and
+/// on SE(3) (`se3`), `Se3System` (`charts::Frame::runtime`): the chart parameter, read and
 /// replaced. Nothing on R^n.
 pub(crate) fn chart_system_impl(space: Space, params: &ParamTokens) -> TokenStream {
     let (generics, ty) = (&params.generics, &params.ty_full);
     let allow = allow_generated();
-    let (Some((name, len)), Some(chart)) = (space.chart_param(), charts::of(space)) else {
+    let Some(frame) = space.chart().frame() else {
         return TokenStream::new();
     };
-    let field = syn::Ident::new(name, proc_macro2::Span::call_site());
-    let len = index(len);
-    let [module, tr, read, replace] = chart
-        .runtime()
+    let field = syn::Ident::new(frame.name, proc_macro2::Span::call_site());
+    let len = index(frame.len);
+    let core = core_path();
+    let [tr, read, replace] = frame
+        .runtime
         .map(|name| syn::Ident::new(name, proc_macro2::Span::call_site()));
     quote! {
         #[automatically_derived]
         #allow
-        impl #generics ::retract::__private::retract_core::#module::#tr for #ty {
+        impl #generics #core::#tr for #ty {
             fn #read(&self) -> [f64; #len] {
                 self.#field
             }
@@ -245,7 +244,7 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
         (quote!(), quote!(#ty))
     };
     // the chart of a system on a manifold is set by the stepper, not by the user
-    let chart = sig.space.chart_param();
+    let frame = sig.space.chart().frame();
     let fields = sig
         .params
         .iter()
@@ -265,14 +264,14 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
                     )
                 }
             };
-            let doc = match (chart, charts::of(sig.space)) {
-                (Some((frame, _)), Some(chart)) if name == frame => chart.frame_doc().to_string(),
+            let doc = match &frame {
+                Some(frame) if name == frame.name => frame.doc.to_string(),
                 _ => doc,
             };
             quote!(#[doc = #doc] pub #name: #t)
         })
         .collect();
-    let user_params = &sig.params[..sig.params.len() - usize::from(chart.is_some())];
+    let user_params = &sig.params[..sig.params.len() - usize::from(frame.is_some())];
     let ctor_args = user_params
         .iter()
         .map(|p| {
@@ -297,10 +296,10 @@ pub(crate) fn param_tokens(sig: &Signature, symbol: &str) -> ParamTokens {
             quote!(#name)
         })
         .collect();
-    if let (Some((name, _)), Some(chart)) = (chart, charts::of(sig.space)) {
-        let field = syn::Ident::new(name, proc_macro2::Span::call_site());
-        let frame = chart.initial_frame();
-        field_names.push(quote!(#field: #frame));
+    if let Some(frame) = frame {
+        let field = syn::Ident::new(frame.name, proc_macro2::Span::call_site());
+        let initial = (frame.initial)();
+        field_names.push(quote!(#field: #initial));
     }
     ParamTokens {
         generics,

@@ -200,7 +200,7 @@ fn legendre_solve(
                 let mut __a = #na::SMatrix::<f64, #n_lit, #n_lit>::zeros();
                 #(#entries)*
                 let __rhs = #vec_n_path::from([#(#rhs),*]);
-                #core::linalg::solve(&__a, &__rhs)
+                #core::solve(&__a, &__rhs)
                     .ok_or(#core::Error::SingularJacobian { iteration: 0 })
             }
         }

@@ -56,17 +56,17 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
 
             /// The Ostrogradsky Hamiltonian H(x, p).
             fn hamiltonian(&self, z: &#vec_s) -> ::core::result::Result<f64, #core::Error> {
-                #core::lifted::hamiltonian::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+                #core::hamiltonian::<Self, #n_lit, #k_lit, #s_lit>(self, z)
             }
 
             /// Hamilton's equations.
             fn vector_field(&self, z: &#vec_s) -> ::core::result::Result<#vec_s, #core::Error> {
-                #core::lifted::vector_field::<Self, #n_lit, #k_lit, #s_lit>(self, z)
+                #core::vector_field::<Self, #n_lit, #k_lit, #s_lit>(self, z)
             }
 
             /// The Legendre map (q, ..., q^(2k-1)) -> (x, p).
             fn legendre(&self, jet: &#vec_s) -> #vec_s {
-                #core::lifted::legendre::<Self, #n_lit, #k_lit, #s_lit>(self, jet)
+                #core::legendre::<Self, #n_lit, #k_lit, #s_lit>(self, jet)
             }
 
             /// F(z0, w) of the lifted theta-scheme, straight-line.
@@ -102,7 +102,7 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
 
             /// h L(x_theta, u), the cost of one step.
             fn step_cost(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> f64 {
-                #core::lifted::step_cost::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta)
+                #core::step_cost::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta)
             }
 
             #check_domain
@@ -116,7 +116,7 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
                 h: f64,
                 _theta: f64,
             ) -> ::core::result::Result<#vec_m, #core::Error> {
-                #core::lifted::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
+                #core::predictor::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, h)
             }
         }
     }

@@ -14,7 +14,7 @@ use crate::emit::codegen::emit;
 use crate::front::signature::Signature;
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics::lift::Lift;
-use crate::util::tidy;
+use crate::util::{core_path, tidy};
 
 /// The function, its parameter struct and the `DiscretizationMap` impl.
 pub(crate) fn map_items(function: &ItemFn, sig: &Signature, g: &Graph, lift: &Lift) -> TokenStream {
@@ -51,7 +51,7 @@ pub(crate) fn map_items(function: &ItemFn, sig: &Signature, g: &Graph, lift: &Li
 fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let (n_lit, k_lit) = (index(n), index(k));
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let na = quote!(::retract::__private::nalgebra);
     let blocks = quote!([#na::SVector<f64, #n_lit>; #k_lit]);
     let jet = |order: u8, i: u32| {
@@ -108,7 +108,7 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
     quote! {
         #[automatically_derived]
         #allow
-        impl #generics #core::map::DiscretizationMap<#n_lit, #k_lit> for #ty_full {
+        impl #generics #core::DiscretizationMap<#n_lit, #k_lit> for #ty_full {
             /// The lifted points (R1(x, xi), R2(x, xi)), straight-line code.
             fn points(&self, x: &#blocks, xi: &#blocks) -> (#blocks, #blocks) {
                 #float
@@ -121,11 +121,11 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
 
             /// The Jacobians of the lifted points, differentiated at compile time; structural
             /// zeros are not computed.
-            fn jacobians(&self, x: &#blocks, xi: &#blocks) -> #core::map::MapJacobians<#n_lit, #k_lit> {
+            fn jacobians(&self, x: &#blocks, xi: &#blocks) -> #core::MapJacobians<#n_lit, #k_lit> {
                 #float
                 #jacobian_stmts
                 let __zero = #zero_blocks;
-                let mut __out = #core::map::MapJacobians {
+                let mut __out = #core::MapJacobians {
                     r1_x: __zero,
                     r1_xi: __zero,
                     r2_x: __zero,
@@ -142,11 +142,11 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
                 xi: &#blocks,
                 w1: &#blocks,
                 w2: &#blocks,
-            ) -> #core::map::CovectorHessian<#n_lit, #k_lit> {
+            ) -> #core::CovectorHessian<#n_lit, #k_lit> {
                 #float
                 #hessian_stmts
                 let __zero = #zero_blocks;
-                let mut __out = #core::map::CovectorHessian {
+                let mut __out = #core::CovectorHessian {
                     xx: __zero,
                     x_xi: __zero,
                     xi_xi: __zero,

@@ -30,6 +30,7 @@ use crate::front::lower::Guard;
 use crate::front::signature::Signature;
 use crate::ir::graph::{Graph, Id};
 use crate::mechanics::{Mechanics, Reduced};
+use crate::util::core_path;
 use helpers::{Names, ParamTokens, allow_generated, float_import, index, param_tokens};
 
 pub(crate) mod codegen;
@@ -114,7 +115,7 @@ impl<'a> Emission<'a> {
         let (n, k) = (sig.dim, sig.order);
         let (s, m) = (2 * n * k, 2 * n * k + n);
         let (n_lit, k_lit, s_lit, m_lit) = (index(n), index(k), index(s), index(m));
-        let core = quote!(::retract::__private::retract_core);
+        let core = core_path();
         let na = quote!(::retract::__private::nalgebra);
         let vec_n = quote!(#na::SVector<f64, #n_lit>);
         Emission {

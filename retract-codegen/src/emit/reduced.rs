@@ -558,7 +558,7 @@ impl<'a> Reduction<'a> {
         if let [Term::Product(a, b)] = terms.as_slice() {
             // one product: its own rounding error, exact, carries the correction
             return quote!({
-                let (__p, __e) = #core::reduced::two_product(#a, #b);
+                let (__p, __e) = #core::two_product(#a, #b);
                 __p + (__e + #small)
             });
         }
@@ -570,7 +570,7 @@ impl<'a> Reduction<'a> {
         let (left, right) = signed.split_at(split);
         let (left, right) = (signed_sum(left), signed_sum(right));
         quote!({
-            let (__s, __e) = #core::reduced::two_sum(#left, #right);
+            let (__s, __e) = #core::two_sum(#left, #right);
             __s + (__e + #small)
         })
     }

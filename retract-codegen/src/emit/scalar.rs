@@ -9,6 +9,7 @@ use super::helpers::{Names, float_import, index, xu_leaf};
 use crate::emit::codegen::emit;
 use crate::front::signature::Signature;
 use crate::ir::graph::{Graph, Id};
+use crate::util::core_path;
 
 /// The bodies of the value, gradient and Hessian methods of a scalar function of the jet,
 /// in `(x, u)`: shared by `Lagrangian` and `JetFunction`.
@@ -31,7 +32,7 @@ pub(crate) fn scalar_bodies(
     hessian: &[Vec<Id>],
 ) -> ScalarBodies {
     let (n, k) = (sig.dim, sig.order);
-    let core = quote!(::retract::__private::retract_core);
+    let core = core_path();
     let float = float_import();
     let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
     let xu = Names { sig, jet: &in_xu };

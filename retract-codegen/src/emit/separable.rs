@@ -12,7 +12,7 @@ use crate::mechanics::separable;
 pub(crate) fn separable_impl(e: &Emission<'_>) -> Option<TokenStream> {
     let c = separable::kinetic_weight(e.g, e.mech, e.n, e.k)?;
     let (n_lit, k_lit, float) = (&e.n_lit, &e.k_lit, &e.float);
-    let header = e.impl_header(quote!(split::Separable<#n_lit, #k_lit>));
+    let header = e.impl_header(quote!(Separable<#n_lit, #k_lit>));
     let code = emit(e.g, &[c], &e.scheme());
     let (stmts, value) = (&code.stmts, &code.exprs[0]);
     Some(quote! {

@@ -8,7 +8,6 @@ use quote::{ToTokens, quote};
 
 use super::Emission;
 use super::helpers::{chart_system_impl, function_and_type, index, space_description, type_items};
-use crate::charts;
 use crate::front::signature::Attribute;
 use crate::util::tidy;
 
@@ -29,8 +28,7 @@ pub(crate) fn type_and_constructor(e: &Emission<'_>) -> TokenStream {
     let fn_name = &function.sig.ident;
     let body_text = tidy(&function.block.to_token_stream().to_string());
     let space = space_description(sig);
-    let args = charts::of(sig.space)
-        .map_or_else(|| format!("q, ..., q^({k})"), |chart| chart.arguments(*k));
+    let args = sig.space.chart().arguments(*k);
     let struct_doc = if sig.attribute == Attribute::Mechanical && *k == 1 {
         format!(
             "The plant of the mechanical system [`{fn_name}`] on {space}: its Lagrangian \

@@ -9,7 +9,7 @@
 use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
 
-use crate::util::combine;
+use crate::util::ErrorContext;
 
 /// The options this module reads (`front::signature` skips them).
 pub(crate) const OPTIONS: [&str; 5] = ["actuated", "weight", "forces", "input_matrix", "cost"];
@@ -42,7 +42,7 @@ impl Actuation {
         let Some(list) = &self.actuated else {
             return Ok((0..n).collect());
         };
-        let mut errors = Vec::new();
+        let mut errors = ErrorContext::new();
         let mut seen = vec![false; n];
         for &(i, span) in list {
             if i >= n {
@@ -61,10 +61,8 @@ impl Actuation {
                 ));
             }
         }
-        match combine(errors) {
-            Some(e) => Err(e),
-            None => Ok((0..n).filter(|&i| seen[i]).collect()),
-        }
+        errors.check()?;
+        Ok((0..n).filter(|&i| seen[i]).collect())
     }
 }
 

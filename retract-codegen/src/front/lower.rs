@@ -23,7 +23,7 @@ use syn::{BinOp, Block, Expr, Lit, Pat, Stmt, UnOp};
 
 use crate::front::signature::{Attribute, Kind, Signature};
 use crate::ir::graph::{Func, Graph, Id, Node, Var};
-use crate::util::tidy;
+use crate::util::{ErrorContext, tidy};
 
 mod outputs;
 mod values;
@@ -178,7 +178,8 @@ pub struct Lower<'a> {
     sig: &'a Signature,
     scopes: Vec<HashMap<String, Binding>>,
     slice: Option<SliceLoop>,
-    pub errors: Vec<syn::Error>,
+    /// The errors of the body, checked by the pipeline once the body is lowered.
+    pub errors: ErrorContext,
     /// Guarded expressions that depend on the jet, in order of appearance, deduplicated.
     pub guards: Vec<Guard>,
     unrolled: usize,
@@ -247,7 +248,7 @@ impl<'a> Lower<'a> {
             sig,
             scopes: vec![top],
             slice: None,
-            errors: Vec::new(),
+            errors: ErrorContext::new(),
             guards: Vec::new(),
             unrolled: 0,
             too_long: false,
@@ -266,7 +267,7 @@ impl<'a> Lower<'a> {
     /// Records an error; messages name a Lagrangian, reworded for `#[jet_function]`.
     fn error(&mut self, span: Span, msg: impl Into<String>) -> Id {
         let msg = self.sig.attribute.reword(msg.into());
-        self.errors.push(syn::Error::new(span, msg));
+        self.errors.error(span, msg);
         self.g.constant(0.0)
     }
 

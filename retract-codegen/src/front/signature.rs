@@ -13,7 +13,8 @@ use proc_macro2::{Span, TokenStream};
 use syn::spanned::Spanned;
 use syn::{FnArg, Ident, ItemFn, Pat, ReturnType, Type};
 
-use crate::util::combine;
+use crate::charts::Space;
+use crate::util::ErrorContext;
 
 /// Highest supported order.
 pub const MAX_ORDER: usize = 4;
@@ -125,63 +126,27 @@ pub struct Signature {
     pub components: Option<usize>,
 }
 
-/// The configuration space of a Lagrangian or jet function.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Space {
-    /// R^n: the jet is the argument list as written.
-    Flat,
-    /// The unit sphere S^2 (`sphere`): the jet is ambient (`[f64; 3]`) and the generated
-    /// system works in a gnomonic chart (`crate::charts::sphere`).
-    Sphere,
-    /// The rotation group SO(3) (`so3`): the arguments are the rotation R (`[f64; 9]`, row
-    /// major) and the body velocity Omega with its derivatives (`[f64; 3]`); the generated
-    /// system works in a Gibbs chart centred at a rotation (`crate::charts::so3`).
-    So3,
-    /// The rigid motions SE(3) (`se3`): the arguments are the pose g = (R, p) (`[f64; 12]`,
-    /// R row major, then the position p) and the body velocity xi = (Omega, v), v = R^T p',
-    /// with its derivatives (`[f64; 6]`); the generated system works in the product chart
-    /// (Gibbs chart of R, position in the centre's axes) centred at a pose (`crate::charts::se3`).
-    Se3,
-}
-
-impl Space {
-    /// The name and length of the parameter that holds the chart's frame, appended after
-    /// the user's parameters; `None` on R^n.
-    pub fn chart_param(self) -> Option<(&'static str, usize)> {
-        match self {
-            Space::Flat => None,
-            Space::Sphere => Some((SPHERE_CHART, 9)),
-            Space::So3 => Some((SO3_CENTRE, 9)),
-            Space::Se3 => Some((SE3_CENTRE, 12)),
-        }
-    }
-
-    /// For a Lagrangian written in body coordinates on a group (`so3`, `se3`): the length of
-    /// the group element's argument and of each body rate's (the chart's dimension).
-    pub fn body_coordinates(self) -> Option<(usize, usize)> {
-        match self {
-            Space::So3 => Some((9, 3)),
-            Space::Se3 => Some((12, 6)),
-            Space::Flat | Space::Sphere => None,
-        }
-    }
-
-    /// The option's name, for messages.
-    fn option(self) -> &'static str {
-        match self {
-            Space::Flat => "",
-            Space::Sphere => "sphere",
-            Space::So3 => "so3",
-            Space::Se3 => "se3",
-        }
-    }
-}
-
 impl Signature {
+    /// The signature of the function composed with the chart of its space: the chart's
+    /// dimension (`Chart::chart_dim`) and the parameters followed by the chart's frame;
+    /// unchanged on R^n.
+    pub fn in_chart(&self) -> Signature {
+        let chart = self.space.chart();
+        let mut sig = self.clone();
+        sig.dim = chart.chart_dim(self.dim);
+        if let Some(frame) = chart.frame() {
+            sig.params.push(Param {
+                name: Ident::new(frame.name, Span::call_site()),
+                kind: Kind::Array(frame.len),
+            });
+        }
+        sig
+    }
+
     /// The number of components of jet argument `order` as written: 9 for the rotation of
     /// `so3`, 12 for the pose of `se3`, else the dimension n.
     pub fn jet_len(&self, order: u8) -> usize {
-        match self.space.body_coordinates() {
+        match self.space.chart().body_coordinates() {
             Some((group, _)) if order == 0 => group,
             _ => self.dim,
         }
@@ -238,19 +203,18 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
             let lit: syn::LitBool = meta.value()?.parse()?;
             options.guard = lit.value;
             Ok(())
-        } else if let Some(space) =
-            [Space::Sphere, Space::So3, Space::Se3]
-                .into_iter()
-                .find(|space| {
-                    meta.path.is_ident(space.option())
-                        && !matches!(attribute, Attribute::Map | Attribute::Mechanical)
-                })
+        } else if let Some((space, option)) = Space::OPTIONS
+            .into_iter()
+            .filter_map(|space| Some((space, space.chart().option()?)))
+            .find(|(_, option)| {
+                meta.path.is_ident(option)
+                    && !matches!(attribute, Attribute::Map | Attribute::Mechanical)
+            })
         {
             if let Some((other, _)) = options.space.filter(|(other, _)| *other != space) {
                 return Err(meta.error(format!(
-                    "`{}` and `{}` exclude each other: a Lagrangian lives on one space",
-                    other.option(),
-                    space.option()
+                    "`{}` and `{option}` exclude each other: a Lagrangian lives on one space",
+                    other.chart().option().unwrap_or_default(),
                 )));
             }
             options.space = Some((space, meta.path.span()));
@@ -271,15 +235,16 @@ fn parse_options(attr: TokenStream, attribute: Attribute) -> syn::Result<Options
                  `helpers = [...]`, `order = 1`",
             ))
         } else if attribute == Attribute::Lagrangian {
-            Err(meta.error(
+            Err(meta.error(format!(
                 "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, \
-                 `guard = false`, `sphere`, `so3`, `se3`",
-            ))
+                 `guard = false`, {}",
+                Space::option_list(", ", ", ")
+            )))
         } else {
-            Err(meta.error(
-                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, `sphere`, \
-                 `so3`, `se3`",
-            ))
+            Err(meta.error(format!(
+                "unsupported option; supported: `order = k` (1..=4), `name = TypeName`, {}",
+                Space::option_list(", ", ", ")
+            )))
         }
     });
     syn::parse::Parser::parse2(parser, attr)?;
@@ -361,13 +326,12 @@ fn camel(name: &Ident, attribute: Attribute) -> syn::Result<Ident> {
 /// messages written for a Lagrangian reworded for the attribute.
 struct Errors {
     attribute: Attribute,
-    list: Vec<syn::Error>,
+    list: ErrorContext,
 }
 
 impl Errors {
     fn fail(&mut self, span: Span, msg: String) {
-        self.list
-            .push(syn::Error::new(span, self.attribute.reword(msg)));
+        self.list.error(span, self.attribute.reword(msg));
     }
 }
 
@@ -562,116 +526,44 @@ fn dimension(
     }
 }
 
-/// The conditions of `sphere`: the jet is ambient, `[f64; 3]`.
-fn check_sphere(args: &[(Ident, Kind)], jet_kind: Option<Kind>, span: Span, errors: &mut Errors) {
-    if jet_kind.is_some() && jet_kind != Some(Kind::Array(3)) {
-        errors.fail(
-            args.first().map_or(span, |(name, _)| name.span()),
-            format!(
-                "a Lagrangian on the sphere (`sphere`) is written in ambient coordinates: its \
-                 jet q, q', ... must be `[f64; 3]`, not {}",
-                jet_kind.map(Kind::describe).unwrap_or_default()
-            ),
-        );
-    }
-}
-
-/// The conditions of `so3` and `se3`: the arguments are the group element (the rotation
-/// `[f64; 9]`, the pose `[f64; 12]`) and then the body velocity and its derivatives
-/// (`[f64; 3]`, `[f64; 6]`).
-fn check_body(space: Space, args: &[(Ident, Kind)], order: usize, errors: &mut Errors) {
-    let Some((group, rate)) = space.body_coordinates() else {
-        return;
-    };
-    let (element, velocity, prefix) = if space == Space::So3 {
-        (
-            "the rotation R, row major: r[3 * i + j] = R_ij",
-            "the body angular velocity Omega",
-            format!(
-                "a Lagrangian on SO(3) (`so3`) of order {order} takes R: [f64; 9], then Omega, \
-                 ..., Omega^({}): [f64; 3]",
-                order - 1
-            ),
-        )
-    } else {
-        (
-            "the pose g = (R, p): R row major (g[3 * i + j] = R_ij), then p = g[9..12]",
-            "the body velocity xi = (Omega, v), v = R^T p'",
-            format!(
-                "a Lagrangian on SE(3) (`se3`) of order {order} takes g = (R, p): [f64; 12], \
-                 then xi, ..., xi^({}): [f64; 6] (xi = (Omega, v))",
-                order - 1
-            ),
-        )
-    };
-    for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
-        let (expected, what) = match i {
-            0 => (Kind::Array(group), element.to_string()),
-            1 => (Kind::Array(rate), velocity.to_string()),
-            _ => (
-                Kind::Array(rate),
-                format!(
-                    "{}^({}), the derivative of the body velocity",
-                    if space == Space::So3 { "Omega" } else { "xi" },
-                    i - 1
-                ),
-            ),
-        };
-        if *kind != expected {
-            errors.fail(
-                name.span(),
-                format!(
-                    "{prefix}; argument {} (`{name}`) must be `{}` ({what}), not {}",
-                    i + 1,
-                    expected.describe(),
-                    kind.describe()
-                ),
-            );
-        }
-    }
-}
-
-/// The conditions of a chart option: those of its space, and no parameter takes the name
-/// of the chart's.
+/// The conditions of a space option: the jet arguments have the types the space requires
+/// ([`Chart::required_argument`](crate::charts::Chart::required_argument)), and no parameter
+/// takes the name of the chart's frame.
 fn check_space(
     space: Space,
     args: &[(Ident, Kind)],
-    (order, jet_kind, jet_count): (usize, Option<Kind>, usize),
-    span: Span,
+    (order, jet_count): (usize, usize),
     errors: &mut Errors,
 ) {
-    match space {
-        Space::Flat => return,
-        Space::Sphere => check_sphere(args, jet_kind, span, errors),
-        Space::So3 | Space::Se3 => check_body(space, args, order, errors),
+    let chart = space.chart();
+    for (i, (name, kind)) in args.iter().take(order + 1).enumerate() {
+        match chart.required_argument(order, i) {
+            Some(len) if *kind != Kind::Array(len) => {
+                errors.fail(
+                    name.span(),
+                    chart.wrong_argument(order, i, name, &kind.describe()),
+                );
+            }
+            _ => {}
+        }
     }
-    let Some((chart, _)) = space.chart_param() else {
+    let Some(frame) = chart.frame() else {
         return;
     };
     for (name, _) in args.iter().skip(jet_count) {
-        if name == chart {
+        if name == frame.name {
             errors.fail(
                 name.span(),
                 format!(
-                    "`{chart}` is the name of the chart that `{}` adds to the parameters; \
-                     rename this parameter",
-                    space.option()
+                    "`{}` is the name of the chart that `{}` adds to the parameters; rename \
+                     this parameter",
+                    frame.name,
+                    chart.option().unwrap_or_default()
                 ),
             );
         }
     }
 }
-
-/// The name of the chart parameter `[c, e1, e2]` (9 numbers) that `sphere` appends.
-pub const SPHERE_CHART: &str = "sphere_chart";
-
-/// The name of the chart centre (a rotation matrix, 9 numbers, row major) that `so3`
-/// appends.
-pub const SO3_CENTRE: &str = "so3_centre";
-
-/// The name of the chart centre (a pose: rotation matrix row major, then the position; 12
-/// numbers) that `se3` appends.
-pub const SE3_CENTRE: &str = "se3_centre";
 
 /// The names of q, q', ..., q^(order) (the first `order + 1` arguments), or of q and v for
 /// a map; errors where one is not of the type of q.
@@ -755,10 +647,6 @@ fn parameters_first(args: &[(Ident, Kind)], count: usize) -> Option<usize> {
 pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Result<Signature> {
     let options = parse_options(attr, attribute)?;
     let sig = &item.sig;
-    let mut errors = Errors {
-        attribute,
-        list: Vec::new(),
-    };
 
     let options = match (attribute, options.order) {
         (Attribute::Mechanical, Some((order, span))) if order != 1 => {
@@ -786,12 +674,16 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             ),
         ));
     };
+    let mut errors = Errors {
+        attribute,
+        list: ErrorContext::new(),
+    };
     check_qualifiers(sig, &mut errors);
     let jet_count = attribute.jet_count(order);
     let (args, jet_span) = arguments(sig, jet_count, &mut errors);
     let jet_kind = args.first().map(|(_, k)| *k);
     let space = options.space.map_or(Space::Flat, |(space, _)| space);
-    let (dim, scalar_jet) = if let Some((_, rate)) = space.body_coordinates() {
+    let (dim, scalar_jet) = if let Some((_, rate)) = space.chart().body_coordinates() {
         (rate, false)
     } else {
         dimension(sig, jet_kind, jet_span, order, &mut errors)
@@ -799,14 +691,8 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
     if attribute == Attribute::Map {
         check_map_return(sig, jet_kind, &mut errors);
     }
-    if let Some((space, span)) = options.space {
-        check_space(
-            space,
-            &args,
-            (order, jet_kind, jet_count),
-            span,
-            &mut errors,
-        );
+    if let Some((space, _)) = options.space {
+        check_space(space, &args, (order, jet_count), &mut errors);
     }
     if args.len() < jet_count && errors.list.is_empty() {
         let msg = if attribute == Attribute::Map {
@@ -815,22 +701,8 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
                  of one type) before its parameters; the signature has {}",
                 args.len()
             )
-        } else if space == Space::So3 {
-            format!(
-                "order = {order} with `so3` needs {} arguments before the parameters (R: \
-                 [f64; 9], then Omega, ..., Omega^({}): [f64; 3]); the signature has {}",
-                order + 1,
-                order - 1,
-                args.len()
-            )
-        } else if space == Space::Se3 {
-            format!(
-                "order = {order} with `se3` needs {} arguments before the parameters (g: \
-                 [f64; 12], then xi, ..., xi^({}): [f64; 6]); the signature has {}",
-                order + 1,
-                order - 1,
-                args.len()
-            )
+        } else if let Some(msg) = space.chart().missing_arguments(order, args.len()) {
+            msg
         } else {
             format!(
                 "order = {order} needs {} jet arguments (q, q', ..., q^({order})) of one type; \
@@ -841,7 +713,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
         };
         errors.fail(order_span, msg);
     }
-    let jet = if space.body_coordinates().is_some() {
+    let jet = if space.chart().body_coordinates().is_some() {
         // (their types were checked by `check_body`)
         args.iter()
             .take(jet_count)
@@ -866,9 +738,7 @@ pub fn parse(attr: TokenStream, item: &ItemFn, attribute: Attribute) -> syn::Res
             Ident::new("Lagrangian", sig.ident.span())
         }),
     };
-    if let Some(e) = combine(errors.list) {
-        return Err(e);
-    }
+    errors.list.check()?;
     Ok(Signature {
         order,
         dim,

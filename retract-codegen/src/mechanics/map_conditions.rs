@@ -20,6 +20,7 @@ use proc_macro2::Span;
 use crate::front::signature::{Kind, Signature};
 use crate::ir::diff::{Differentiator, substitute};
 use crate::ir::graph::{Graph, Id, Node, Var};
+use crate::util::ErrorContext;
 
 /// Number of pseudo-random points of the numerical test.
 pub const POINTS: usize = 4;
@@ -39,8 +40,8 @@ struct Condition {
 }
 
 /// Checks the conditions on `r = [R1, R2]` (n components each): the errors, one per
-/// component or entry that fails.
-pub fn check(g: &mut Graph, sig: &Signature, r: &[Vec<Spanned>; 2]) -> Vec<syn::Error> {
+/// component or entry that fails, combined.
+pub fn check(g: &mut Graph, sig: &Signature, r: &[Vec<Spanned>; 2]) -> syn::Result<()> {
     let n = sig.dim;
     let mut memo = HashMap::new();
     let at_rest = |g: &mut Graph, v: Var| match v {
@@ -94,10 +95,13 @@ pub fn check(g: &mut Graph, sig: &Signature, r: &[Vec<Spanned>; 2]) -> Vec<syn::
             });
         }
     }
-    conditions
-        .into_iter()
-        .filter_map(|c| verdict(g, sig, &c).map(|why| syn::Error::new(c.span, why)))
-        .collect()
+    let mut errors = ErrorContext::new();
+    for c in &conditions {
+        if let Some(why) = verdict(g, sig, c) {
+            errors.error(c.span, why);
+        }
+    }
+    errors.check()
 }
 
 /// `None` if the condition holds, else the message.
