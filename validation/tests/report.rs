@@ -70,6 +70,30 @@ fn quick_report_prints_the_work_precision_line() {
         "{text}"
     );
     planner_lines(&text, &summary.planner);
+    batch_lines(&text);
+}
+
+/// The batch lines: for each batch, `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`
+/// for t = 1, 2, ... in turn, with positive figures and scaling 1 at one thread.
+fn batch_lines(text: &str) {
+    for name in ["one-disc", "swing-up"] {
+        let prefix = format!("batch {name} threads=");
+        let rows: Vec<(usize, f64, f64)> = (text.lines())
+            .filter_map(|l| l.strip_prefix(&prefix))
+            .map(|rest| {
+                let (t, rest) = rest.split_once(" plans_per_s=").expect("plans_per_s");
+                let (p, s) = rest.split_once(" scaling=").expect("scaling");
+                let parse = |v: &str| v.parse::<f64>().expect("a number");
+                (t.parse().expect("a thread count"), parse(p), parse(s))
+            })
+            .collect();
+        assert!(!rows.is_empty(), "no `{prefix}` lines in:\n{text}");
+        for (i, &(t, p, s)) in rows.iter().enumerate() {
+            assert_eq!(t, i + 1);
+            assert!(p > 0.0 && s > 0.0, "{name}: {rows:?}");
+        }
+        assert_eq!(rows[0].2, 1.0);
+    }
 }
 
 /// The planner's lines: one `ratios: ` line naming every race, the races as solved (both
