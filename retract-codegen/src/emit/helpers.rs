@@ -62,6 +62,10 @@ impl Leaves for Names<'_> {
             }
             Var::Step => quote!(h),
             Var::Theta => quote!(theta),
+            Var::Direction(a) => {
+                let a = self::index(a as usize);
+                quote!(__d[#a])
+            }
         }
     }
 

@@ -41,6 +41,9 @@ pub enum Var {
     /// Component `index` of block `block` of the covector w1 (`side` 0) or w2 (`side` 1)
     /// that contracts a discretization map's points (`#[discretization_map]`).
     Covector { side: u8, block: u8, index: u32 },
+    /// Component `index` (`j * n + i` for q^(j)_i) of a direction d in the jet (x, u), for a
+    /// Hessian-vector product H d.
+    Direction(u32),
 }
 
 /// A unary function.
