@@ -66,6 +66,10 @@ impl Leaves for Names<'_> {
                 let a = self::index(a as usize);
                 quote!(__d[#a])
             }
+            Var::Hoisted(i) => {
+                let i = self::index(i as usize);
+                quote!(__h[#i])
+            }
         }
     }
 

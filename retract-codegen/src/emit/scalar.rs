@@ -9,6 +9,7 @@ use super::helpers::{Names, float_import, index, xu_leaf};
 use crate::emit::codegen::emit;
 use crate::front::signature::Signature;
 use crate::ir::graph::{Graph, Id};
+use crate::mechanics::HessianVector;
 
 /// The bodies of the value, gradient and Hessian methods of a scalar function of the jet,
 /// in `(x, u)`: shared by `Lagrangian` and `JetFunction`.
@@ -105,20 +106,25 @@ pub(crate) fn scalar_bodies(
 }
 
 /// The body of a `hessian` method from the Hessian-vector product `hv` (entry `j * n + i` of
-/// H d for the direction d, `Var::Direction`, named `__d`): straight-line code for H d,
-/// evaluated at run time for each unit vector d = e_b (column b of H); the entries on and
-/// above the diagonal are kept and mirrored, so that the Hessian is exactly symmetric.
-pub(crate) fn hessian_by_columns(g: &Graph, sig: &Signature, hv: &[Id]) -> TokenStream {
+/// H d for the direction d, `Var::Direction`, named `__d`): its hoisted nodes evaluated once
+/// (`__h`), then straight-line code for H d evaluated for each unit vector d = e_b (column b
+/// of H); the entries on and above the diagonal are kept and mirrored, so that the Hessian is
+/// exactly symmetric.
+pub(crate) fn hessian_by_columns(g: &Graph, sig: &Signature, hv: &HessianVector) -> TokenStream {
     let (n, k) = (sig.dim, sig.order);
     let core = quote!(::retract::__private::retract_core);
     let float = float_import();
     let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
     let xu = Names { sig, jet: &in_xu };
-    let code = emit(g, hv, &xu);
+    let hoisted = emit(g, &hv.hoisted, &xu);
+    let (h_stmts, h_exprs, h_len) = (&hoisted.stmts, &hoisted.exprs, index(hv.hoisted.len()));
+    let code = emit(g, &hv.column, &xu);
     let (stmts, exprs) = (&code.stmts, &code.exprs);
     let (n_lit, k_lit, dim) = (index(n), index(k), index(n * (k + 1)));
     quote! {
         #float
+        #h_stmts
+        let __h: [f64; #h_len] = [#(#h_exprs),*];
         let mut __out = #core::Hessian::zeros();
         for __b in 0..#dim {
             let mut __d = [0.0f64; #dim];

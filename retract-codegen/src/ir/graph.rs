@@ -44,6 +44,9 @@ pub enum Var {
     /// Component `index` (`j * n + i` for q^(j)_i) of a direction d in the jet (x, u), for a
     /// Hessian-vector product H d.
     Direction(u32),
+    /// Value `index` of the nodes evaluated once before a run-time loop (named `__h`), in
+    /// code that the loop repeats (the Hessian's columns).
+    Hoisted(u32),
 }
 
 /// A unary function.

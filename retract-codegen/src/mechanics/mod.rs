@@ -48,15 +48,81 @@ pub struct Mechanics {
     /// Hessian over the same index, full and symmetric (shared ids); where
     /// `hessian_vector` is given, only the rows and columns of u (the x-x block zeros).
     pub hessian: Vec<Vec<Id>>,
-    /// H d for a direction d (`Var::Direction`), entry `j * n + i`: the Hessian's columns
-    /// at run time ([`Derivation::structural`]).
-    pub hessian_vector: Option<Vec<Id>>,
+    /// H d for a direction d: the Hessian's columns at run time
+    /// ([`Derivation::structural`]).
+    pub hessian_vector: Option<HessianVector>,
     /// p_j component i at `j * n + i`, j = 0..k, as functions of q..q^(2k-1).
     pub momenta: Vec<Id>,
     pub legendre_inverse: Option<LegendreInverse>,
     /// The residual and Jacobians of the scheme as nodes; `None` where the emitted scheme
     /// calls the generic functions of `retract_core::lifted` ([`Derivation::structural`]).
     pub scheme: Option<Scheme>,
+}
+
+/// The Hessian-vector product H d (d: `Var::Direction`, entry `j * n + i`) split for a
+/// run-time loop over the directions: `hoisted`, the nodes that H d reads and d does not
+/// change (L's value and gradient below them), evaluated once; `column`, H d with each of
+/// them as `Var::Hoisted(i)`.
+pub struct HessianVector {
+    /// The nodes evaluated before the loop.
+    pub hoisted: Vec<Id>,
+    /// H d, entry `j * n + i`, over `Var::Hoisted`, `Var::Direction` and the jet.
+    pub column: Vec<Id>,
+}
+
+/// `hv` split into the nodes that do not depend on `Var::Direction` and that a node which
+/// does reads (the frontier, hoisted), and `hv` with each frontier node replaced by
+/// `Var::Hoisted(i)`; nothing hoisted where `hv` has a sum over a slice (a node of its body
+/// reads the loop's element).
+fn hoist(g: &mut Graph, hv: &[Id]) -> HessianVector {
+    let mut below: Vec<Id> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let mut stack: Vec<Id> = hv.to_vec();
+    while let Some(id) = stack.pop() {
+        if seen.insert(id) {
+            below.push(id);
+            stack.extend(crate::ir::graph::children(g.node(id)));
+        }
+    }
+    below.sort_unstable();
+    if below
+        .iter()
+        .any(|&id| matches!(g.node(id), crate::ir::graph::Node::Sum { .. }))
+    {
+        return HessianVector {
+            hoisted: Vec::new(),
+            column: hv.to_vec(),
+        };
+    }
+    let mut varying = std::collections::HashSet::new();
+    let mut hoisted = Vec::new();
+    let mut memo = HashMap::new();
+    for &id in &below {
+        let node = g.node(id).clone();
+        let kids = crate::ir::graph::children(&node);
+        let on = match node {
+            crate::ir::graph::Node::Var(v) => matches!(v, Var::Direction(_)),
+            _ => kids.iter().any(|c| varying.contains(c)),
+        };
+        if !on {
+            continue;
+        }
+        varying.insert(id);
+        for c in kids {
+            let leaf = crate::ir::graph::children(g.node(c)).is_empty();
+            if !varying.contains(&c) && !leaf && !memo.contains_key(&c) {
+                let placeholder = g.var(Var::Hoisted(hoisted.len() as u32));
+                memo.insert(c, placeholder);
+                hoisted.push(c);
+            }
+        }
+    }
+    let unchanged = |_: &mut Graph, _: Var| None;
+    let column = hv
+        .iter()
+        .map(|&id| substitute(g, id, &unchanged, &mut memo))
+        .collect();
+    HessianVector { hoisted, column }
 }
 
 /// The lifted theta-scheme as graph nodes.
@@ -145,7 +211,8 @@ fn derivatives_with(g: &mut Graph, f: Id, n: usize, k: usize, reverse: bool) -> 
             }
             _ => None,
         };
-        directional(g, &gradient, &along)
+        let hv = directional(g, &gradient, &along);
+        hoist(g, &hv)
     });
     Derivatives {
         d,
@@ -161,7 +228,7 @@ struct Derivatives {
     d: Differentiator,
     gradient: Vec<Id>,
     hessian: Vec<Vec<Id>>,
-    hessian_vector: Option<Vec<Id>>,
+    hessian_vector: Option<HessianVector>,
 }
 
 /// Builds the mechanics of L = `lagrangian` of order k on R^n.
