@@ -8,11 +8,12 @@
 //! system, a function of tau(q, q', q'')): the gradient by reverse accumulation (O(nodes)),
 //! the Hessian-vector product H d as the derivative of that gradient along a symbolic
 //! direction d (O(nodes); the emitted Hessian evaluates it for each unit vector d, column
-//! by column, forward over reverse, exact), the rows of u of the Hessian alone as nodes
-//! (for the Legendre inverse), the total time derivatives of the momenta in one directional
-//! sweep, and no symbolic scheme: the emitted
-//! residual and Jacobians call `retract_core::lifted`'s generic functions, which evaluate
-//! the same formulas from the gradient and Hessian at the evaluation point.
+//! by column, forward over reverse, exact; the nodes it reads that d does not change are
+//! hoisted out of that loop), the rows of u of the Hessian alone as nodes (for the Legendre
+//! inverse), the total time derivatives of the momenta in one directional sweep, and no
+//! symbolic scheme: the emitted residual and Jacobians call `retract_core::lifted`'s generic
+//! functions, which evaluate the same formulas from the gradient and Hessian at the
+//! evaluation point.
 
 pub(crate) mod euler_lagrange;
 pub(crate) mod lift;
