@@ -104,7 +104,10 @@ pub mod __private {
     pub use crate::mechanical::{MechanicalSystem, TorqueComponent};
     pub use crate::numeric::linalg::solve;
     pub use crate::numeric::special::stumpff;
-    pub use crate::scheme::lifted::{hamiltonian, legendre, predictor, step_cost, vector_field};
+    pub use crate::scheme::lifted::{
+        hamiltonian, jacobian, jacobian_initial, legendre, predictor, residual, step_cost,
+        vector_field,
+    };
     pub use crate::scheme::map::{CovectorHessian, DiscretizationMap, MapJacobians};
     pub use crate::scheme::reduced::{
         ClosedForm, ReducedFactors, ReducedScheme, two_product, two_sum,

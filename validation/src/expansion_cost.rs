@@ -2,13 +2,17 @@
 //! emitted code, all methods including the domain check and the reduced step with its
 //! closed-form factors) of a second-order Lagrangian on $\mathbb{R}^n$ with unrolled barrier
 //! terms ([`retract_codegen::samples::obstacle_field`]), timed as the best of several
-//! expansions, with the lines of the formatted expansion.
+//! expansions, with the lines of the formatted expansion; and the same of
+//! `#[mechanical_system]` on the n-link chain written as T - V
+//! ([`retract_codegen::samples::energy_chain`]), one line each,
+//! `chain n=<n> expand_ms=<t> lines=<l>`.
 
 use std::io::Write;
 use std::time::Instant;
 
-use retract_codegen::samples::obstacle_field;
-use retract_codegen::try_expand;
+use proc_macro2::TokenStream;
+use retract_codegen::samples::{energy_chain, obstacle_field};
+use retract_codegen::{try_expand, try_expand_mechanical_system};
 
 use crate::Error;
 
@@ -39,6 +43,29 @@ pub struct Expansion {
     pub seconds: f64,
 }
 
+/// The chain lengths of [`chain_expansions`].
+pub const CHAIN_LINKS: [usize; 5] = [3, 5, 7, 9, 12];
+
+/// The best time of `rounds` (at least one) expansions of the sample `sample()` by `expand`
+/// and the lines of its formatted expansion, or `None` if it does not expand or parse.
+fn best_expansion(
+    rounds: usize,
+    sample: impl Fn() -> (TokenStream, TokenStream),
+    expand: fn(TokenStream, TokenStream) -> syn::Result<TokenStream>,
+) -> Option<(f64, usize)> {
+    let mut seconds = f64::INFINITY;
+    let mut tokens = None;
+    for _ in 0..rounds.max(1) {
+        let (attr, item) = sample();
+        let start = Instant::now();
+        let expanded = expand(attr, item);
+        seconds = seconds.min(start.elapsed().as_secs_f64());
+        tokens = Some(expanded);
+    }
+    let file = syn::parse2::<syn::File>(tokens?.ok()?).ok()?;
+    Some((seconds, prettyplease::unparse(&file).lines().count()))
+}
+
 /// Every case of [`CASES`], each expanded `rounds` times (at least once).
 ///
 /// # Errors
@@ -47,20 +74,9 @@ pub fn expansions(rounds: usize) -> Result<Vec<Expansion>, Error> {
     CASES
         .iter()
         .map(|&(n, obstacles)| {
-            let mut seconds = f64::INFINITY;
-            let mut tokens = None;
-            for _ in 0..rounds.max(1) {
-                let (attr, item) = obstacle_field(n, obstacles);
-                let start = Instant::now();
-                let expanded = try_expand(attr, item);
-                seconds = seconds.min(start.elapsed().as_secs_f64());
-                tokens = Some(expanded);
-            }
-            let file = tokens
-                .and_then(Result::ok)
-                .and_then(|t| syn::parse2::<syn::File>(t).ok())
-                .ok_or(Error::Domain("an obstacle field that does not expand"))?;
-            let lines = prettyplease::unparse(&file).lines().count();
+            let (seconds, lines) =
+                best_expansion(rounds, || obstacle_field(n, obstacles), try_expand)
+                    .ok_or(Error::Domain("an obstacle field that does not expand"))?;
             Ok(Expansion {
                 n,
                 obstacles,
@@ -69,6 +85,50 @@ pub fn expansions(rounds: usize) -> Result<Vec<Expansion>, Error> {
             })
         })
         .collect()
+}
+
+/// The chain from T - V for each length of [`CHAIN_LINKS`], each expanded `rounds` times (at
+/// least once); `obstacles` is 0.
+///
+/// # Errors
+/// [`Error::Domain`] if a chain does not expand or its expansion does not parse as a file.
+pub fn chain_expansions(rounds: usize) -> Result<Vec<Expansion>, Error> {
+    CHAIN_LINKS
+        .iter()
+        .map(|&n| {
+            let (seconds, lines) =
+                best_expansion(rounds, || energy_chain(n), try_expand_mechanical_system)
+                    .ok_or(Error::Domain("a chain from T - V that does not expand"))?;
+            Ok(Expansion {
+                n,
+                obstacles: 0,
+                lines,
+                seconds,
+            })
+        })
+        .collect()
+}
+
+/// Writes the chain's expansions, one line each: `chain n=<n> expand_ms=<t> lines=<l>`.
+///
+/// # Errors
+/// [`Error::Io`].
+pub fn write_chain_expansions(out: &mut dyn Write, rows: &[Expansion]) -> Result<(), Error> {
+    writeln!(
+        out,
+        "
+Compile-time cost: `#[mechanical_system]` on the n-link chain written as T - V:\n"
+    )?;
+    for row in rows {
+        writeln!(
+            out,
+            "chain n={} expand_ms={:.1} lines={}",
+            row.n,
+            row.seconds * 1e3,
+            row.lines
+        )?;
+    }
+    Ok(())
 }
 
 /// Writes the expansions as a markdown table.

@@ -12,7 +12,8 @@
 //! at N = 400, the optimizer against the root finder with the line
 //! `ratios: one-disc cold <r>x, one-disc warm <r>x, se2 cold <r>x, se2 warm <r>x (target <= 1.2)`,
 //! and Richardson extrapolation; and the compile-time cost of the expansion
-//! ([`crate::expansion_cost`]).
+//! ([`crate::expansion_cost`]), with the lines `chain n=<n> expand_ms=<t> lines=<l>` of the
+//! n-link chain written as T - V.
 
 use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
@@ -128,6 +129,8 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     batch_speed::write_batches(out, &batches)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
+    let chains = expansion_cost::chain_expansions(size.expansion_rounds)?;
+    expansion_cost::write_chain_expansions(out, &chains)?;
     let seconds = started.elapsed().as_secs_f64();
     writeln!(out, "\nreport: {seconds:.1} s")?;
     Ok(Summary {

@@ -63,6 +63,14 @@ impl Leaves for Names<'_> {
             }
             Var::Step => quote!(h),
             Var::Theta => quote!(theta),
+            Var::Direction(a) => {
+                let a = self::index(a as usize);
+                quote!(__d[#a])
+            }
+            Var::Hoisted(i) => {
+                let i = self::index(i as usize);
+                quote!(__h[#i])
+            }
         }
     }
 

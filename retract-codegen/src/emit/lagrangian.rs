@@ -9,8 +9,9 @@ use quote::quote;
 
 use super::Emission;
 use super::helpers::{Names, index, xu_leaf};
-use super::scalar::{ScalarBodies, scalar_bodies};
+use super::scalar::{ScalarBodies, hessian_by_columns, scalar_bodies};
 use crate::emit::codegen::{constant, emit};
+use crate::ir::graph::Id;
 use crate::mechanics::LegendreInverse;
 
 /// `impl Lagrangian<n, k>`.
@@ -29,11 +30,27 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
         ..
     } = e;
     let header = e.impl_header(quote!(Lagrangian<#n_lit, #k_lit>));
+    // (with a Hessian-vector product, the Hessian's nodes are the rows of u alone: not emitted)
+    let entries: &[Vec<Id>] = match mech.hessian_vector {
+        Some(_) => &[],
+        None => &mech.hessian,
+    };
     let ScalarBodies {
         value: l_body,
         gradient: g_body,
         hessian: h_body,
-    } = scalar_bodies(g, sig, mech.lagrangian, &mech.gradient, &mech.hessian);
+    } = scalar_bodies(g, sig, mech.lagrangian, &mech.gradient, entries);
+    let (h_body, h_doc) = match &mech.hessian_vector {
+        Some(hv) => (
+            hessian_by_columns(g, sig, hv),
+            "The Hessian of L in (x, u), column by column: the Hessian-vector product (the \
+             derivative of the gradient along a direction) at each unit vector.",
+        ),
+        None => (
+            h_body,
+            "The Hessian of L in (x, u); structural zeros are not computed.",
+        ),
+    };
     let (p_stmts, p_sets) = momenta(e);
     let top_derivative = mech
         .legendre_inverse
@@ -52,7 +69,7 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
                 #g_body
             }
 
-            /// The Hessian of L in (x, u); structural zeros are not computed.
+            #[doc = #h_doc]
             fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
                 #h_body
             }

@@ -1,7 +1,10 @@
 //! The `LiftedSystem` impl: the lifted theta-scheme of the Lagrangian on the Hamiltonian
 //! state z = (x, p) of size s = 2nk with the Newton unknowns w = (z_1, u) of size
 //! m = 2nk + n (formulas in `retract_core::LiftedSystem`). Its residual F(z0, w) and the
-//! Jacobians dF/dw and dF/dz0 are straight-line code over their structural nonzeros; the
+//! Jacobians dF/dw and dF/dz0 are straight-line code over their structural nonzeros (where
+//! the mechanics were built structurally, `mechanics::Derivation`, calls to the generic
+//! `retract_core::lifted::{residual, jacobian, jacobian_initial}`, which evaluate the same
+//! formulas from the `Lagrangian` impl's gradient and Hessian at the evaluation point); the
 //! Hamiltonian, the vector field, the Legendre map, the step cost and the predictor call the
 //! generic implementations in `retract_core::lifted`; `check_domain` is emitted by `domain`.
 
@@ -34,18 +37,38 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
         ..
     } = e;
     let header = e.impl_header(quote!(LiftedSystem<#s_lit, #m_lit>));
-    let residual = emit(g, &mech.residual, &e.scheme());
-    let r_stmts = residual.stmts;
-    let r_sets = mech.residual.iter().enumerate().filter_map(|(r, &id)| {
-        if g.is_const(id, 0.0) {
-            return None;
+    let generic = |f: TokenStream| quote!(#core::#f::<Self, #n_lit, #k_lit, #s_lit, #m_lit>(self, z0, w, h, theta));
+    let (residual, jacobian, jacobian_initial) = match &mech.scheme {
+        Some(scheme) => {
+            let residual = emit(g, &scheme.residual, &e.scheme());
+            let r_stmts = residual.stmts;
+            let r_sets = scheme.residual.iter().enumerate().filter_map(|(r, &id)| {
+                if g.is_const(id, 0.0) {
+                    return None;
+                }
+                let v = &residual.exprs[r];
+                let r = index(r);
+                Some(quote!(__out[#r] = #v;))
+            });
+            let residual = quote! {
+                #float
+                #r_stmts
+                let mut __out = #vec_m_path::zeros();
+                #(#r_sets)*
+                __out
+            };
+            (
+                residual,
+                e.matrix_body(&scheme.jacobian, *m),
+                e.matrix_body(&scheme.jacobian_initial, *s),
+            )
         }
-        let v = &residual.exprs[r];
-        let r = index(r);
-        Some(quote!(__out[#r] = #v;))
-    });
-    let jacobian = e.matrix_body(&mech.jacobian, *m);
-    let jacobian_initial = e.matrix_body(&mech.jacobian_initial, *s);
+        None => (
+            generic(quote!(residual)),
+            generic(quote!(jacobian)),
+            generic(quote!(jacobian_initial)),
+        ),
+    };
     let check_domain = check_domain(e);
     let check_parameters = check_parameters(e);
 
@@ -69,13 +92,9 @@ pub(crate) fn lifted_system_impl(e: &Emission<'_>) -> TokenStream {
                 #core::legendre::<Self, #n_lit, #k_lit, #s_lit>(self, jet)
             }
 
-            /// F(z0, w) of the lifted theta-scheme, straight-line.
+            /// F(z0, w) of the lifted theta-scheme.
             fn residual(&self, z0: &#vec_s, w: &#vec_m, h: f64, theta: f64) -> #vec_m {
-                #float
-                #r_stmts
-                let mut __out = #vec_m_path::zeros();
-                #(#r_sets)*
-                __out
+                #residual
             }
 
             /// dF/dw of the lifted theta-scheme; structural zeros are not computed.

@@ -2,7 +2,10 @@
 //!
 //! Forward mode with a memo keyed by (node, variable): a gradient over m variables costs
 //! O(m * nodes), and every derivative is itself hash-consed, so shared subexpressions of the
-//! gradient and Hessian are built once.
+//! gradient and Hessian are built once. Two sweeps cost O(nodes) instead: the derivative
+//! along one direction ([`directional`], e.g. the total time derivative of many functions at
+//! once) and the gradient of one scalar by reverse accumulation ([`reverse_gradient`]); the
+//! three share one chain rule per node kind ([`chain_rule`]).
 
 use std::collections::{HashMap, HashSet};
 
@@ -47,140 +50,137 @@ impl Differentiator {
         self.memo[&(node, var)]
     }
 
-    /// One arm per node kind.
+    /// The derivative of `node` from those of its children (already memoised).
     fn rule(&mut self, g: &mut Graph, node: Id, var: Var) -> Id {
-        match g.node(node).clone() {
-            Node::Const(_) | Node::Named(_) => g.constant(0.0),
-            Node::Var(v) => g.constant(if v == var { 1.0 } else { 0.0 }),
-            Node::Add(a, b) => {
-                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
-                g.add_op(da, db)
-            }
-            Node::Sub(a, b) => {
-                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
-                g.sub(da, db)
-            }
-            Node::Mul(a, b) => {
-                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
-                let l = g.mul(da, b);
-                let r = g.mul(a, db);
-                g.add_op(l, r)
-            }
-            Node::Div(a, b) => {
-                // (a/b)' = a'/b - (a/b) b'/b
-                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
-                let l = g.div(da, b);
-                let ratio = g.mul(node, db);
-                let r = g.div(ratio, b);
-                g.sub(l, r)
-            }
-            Node::Neg(a) => {
-                let da = self.diff(g, a, var);
-                g.neg(da)
-            }
-            Node::Powi(a, n) => {
-                let da = self.diff(g, a, var);
-                if g.is_const(da, 0.0) {
-                    return da;
-                }
-                // a^(n-1), or a^n / a where n - 1 is below i32::MIN
-                let p = match n.checked_sub(1) {
-                    Some(m) => g.powi(a, m),
-                    None => g.div(node, a),
-                };
-                let c = g.constant(n as f64);
-                let cp = g.mul(c, p);
-                g.mul(cp, da)
-            }
-            Node::Powf(a, b) => {
-                // exponent b does not depend on the jet: (a^b)' = b a^(b-1) a'
-                let da = self.diff(g, a, var);
-                if g.is_const(da, 0.0) {
-                    return da;
-                }
-                let one = g.constant(1.0);
-                let bm1 = g.sub(b, one);
-                let p = g.powf(a, bm1);
-                let bp = g.mul(b, p);
-                g.mul(bp, da)
-            }
-            Node::Unary(f, a) => {
-                let da = self.diff(g, a, var);
-                if g.is_const(da, 0.0) {
-                    return da;
-                }
-                let outer = match f {
-                    // 1 / (2 sqrt a)
-                    Func::Sqrt => {
-                        let two = g.constant(2.0);
-                        let den = g.mul(two, node);
-                        let one = g.constant(1.0);
-                        g.div(one, den)
-                    }
-                    Func::Exp => node,
-                    Func::Ln => {
-                        let one = g.constant(1.0);
-                        g.div(one, a)
-                    }
-                    Func::Sin => g.unary(Func::Cos, a),
-                    Func::Cos => {
-                        let s = g.unary(Func::Sin, a);
-                        g.neg(s)
-                    }
-                    // 1 + tan^2, 1 - tanh^2
-                    Func::Tan => {
-                        let one = g.constant(1.0);
-                        let sq = g.powi(node, 2);
-                        g.add_op(one, sq)
-                    }
-                    Func::Tanh => {
-                        let one = g.constant(1.0);
-                        let sq = g.powi(node, 2);
-                        g.sub(one, sq)
-                    }
-                    Func::Abs => g.unary(Func::Signum, a),
-                    Func::Signum => return g.constant(0.0),
-                    // c_k' = (k c_{k+2} - c_{k+1}) / 2
-                    Func::Stumpff(k) => {
-                        let next = g.unary(Func::Stumpff(k + 1), a);
-                        let after = g.unary(Func::Stumpff(k + 2), a);
-                        let scaled = g.constant(f64::from(k));
-                        let scaled = g.mul(scaled, after);
-                        let difference = g.sub(scaled, next);
-                        let half = g.constant(0.5);
-                        g.mul(half, difference)
-                    }
-                    _ => inverse_and_hyperbolic(g, f, node, a),
-                };
-                g.mul(outer, da)
-            }
-            Node::Atan2(y, x) => {
-                // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
-                let (dy, dx) = (self.diff(g, y, var), self.diff(g, x, var));
-                let xdy = g.mul(x, dy);
-                let ydx = g.mul(y, dx);
-                let num = g.sub(xdy, ydx);
-                if g.is_const(num, 0.0) {
-                    return num;
-                }
-                let x2 = g.powi(x, 2);
-                let y2 = g.powi(y, 2);
-                let den = g.add_op(x2, y2);
-                g.div(num, den)
-            }
-            Node::Hypot(a, b) => {
-                // (a da + b db) / hypot(a, b)
-                let (da, db) = (self.diff(g, a, var), self.diff(g, b, var));
-                let l = g.mul(a, da);
-                let r = g.mul(b, db);
-                let num = g.add_op(l, r);
-                g.div(num, node)
-            }
-            Node::Sum { param, body } => {
-                let db = self.diff(g, body, var);
-                g.sum(param, db)
-            }
+        let tangents: Vec<Id> = match g.node(node) {
+            Node::Var(v) => return g.constant(if *v == var { 1.0 } else { 0.0 }),
+            other => children(other),
         }
+        .into_iter()
+        .map(|c| self.memo[&(c, var)])
+        .collect();
+        chain_rule(g, node, &tangents)
+    }
+}
+
+/// The tangent of `node` (not a symbol) from the tangents of its children, in the order of
+/// [`children`]: one arm per node kind, linear in the tangents (so that a tangent that is
+/// zero drops its term, which the reverse mode uses to take one child's share).
+pub fn chain_rule(g: &mut Graph, node: Id, tangents: &[Id]) -> Id {
+    let t = |i: usize| tangents.get(i).copied();
+    let zero = g.constant(0.0);
+    let (da, db) = (t(0).unwrap_or(zero), t(1).unwrap_or(zero));
+    match g.node(node).clone() {
+        Node::Const(_) | Node::Named(_) | Node::Var(_) => zero,
+        Node::Add(..) => g.add_op(da, db),
+        Node::Sub(..) => g.sub(da, db),
+        Node::Mul(a, b) => {
+            let l = g.mul(da, b);
+            let r = g.mul(a, db);
+            g.add_op(l, r)
+        }
+        Node::Div(_, b) => {
+            // (a/b)' = a'/b - (a/b) b'/b
+            let l = g.div(da, b);
+            let ratio = g.mul(node, db);
+            let r = g.div(ratio, b);
+            g.sub(l, r)
+        }
+        Node::Neg(..) => g.neg(da),
+        Node::Powi(a, n) => {
+            if g.is_const(da, 0.0) {
+                return da;
+            }
+            // a^(n-1), or a^n / a where n - 1 is below i32::MIN
+            let p = match n.checked_sub(1) {
+                Some(m) => g.powi(a, m),
+                None => g.div(node, a),
+            };
+            let c = g.constant(n as f64);
+            let cp = g.mul(c, p);
+            g.mul(cp, da)
+        }
+        Node::Powf(a, b) => {
+            // exponent b does not depend on the jet: (a^b)' = b a^(b-1) a'
+            if g.is_const(da, 0.0) {
+                return da;
+            }
+            let one = g.constant(1.0);
+            let bm1 = g.sub(b, one);
+            let p = g.powf(a, bm1);
+            let bp = g.mul(b, p);
+            g.mul(bp, da)
+        }
+        Node::Unary(f, a) => {
+            if g.is_const(da, 0.0) {
+                return da;
+            }
+            let outer = match f {
+                // 1 / (2 sqrt a)
+                Func::Sqrt => {
+                    let two = g.constant(2.0);
+                    let den = g.mul(two, node);
+                    let one = g.constant(1.0);
+                    g.div(one, den)
+                }
+                Func::Exp => node,
+                Func::Ln => {
+                    let one = g.constant(1.0);
+                    g.div(one, a)
+                }
+                Func::Sin => g.unary(Func::Cos, a),
+                Func::Cos => {
+                    let s = g.unary(Func::Sin, a);
+                    g.neg(s)
+                }
+                // 1 + tan^2, 1 - tanh^2
+                Func::Tan => {
+                    let one = g.constant(1.0);
+                    let sq = g.powi(node, 2);
+                    g.add_op(one, sq)
+                }
+                Func::Tanh => {
+                    let one = g.constant(1.0);
+                    let sq = g.powi(node, 2);
+                    g.sub(one, sq)
+                }
+                Func::Abs => g.unary(Func::Signum, a),
+                Func::Signum => return g.constant(0.0),
+                // c_k' = (k c_{k+2} - c_{k+1}) / 2
+                Func::Stumpff(k) => {
+                    let next = g.unary(Func::Stumpff(k + 1), a);
+                    let after = g.unary(Func::Stumpff(k + 2), a);
+                    let scaled = g.constant(f64::from(k));
+                    let scaled = g.mul(scaled, after);
+                    let difference = g.sub(scaled, next);
+                    let half = g.constant(0.5);
+                    g.mul(half, difference)
+                }
+                _ => inverse_and_hyperbolic(g, f, node, a),
+            };
+            g.mul(outer, da)
+        }
+        Node::Atan2(y, x) => {
+            // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), dy = da, dx = db
+            let xdy = g.mul(x, da);
+            let ydx = g.mul(y, db);
+            let num = g.sub(xdy, ydx);
+            if g.is_const(num, 0.0) {
+                return num;
+            }
+            let x2 = g.powi(x, 2);
+            let y2 = g.powi(y, 2);
+            let den = g.add_op(x2, y2);
+            g.div(num, den)
+        }
+        Node::Hypot(a, b) => {
+            // (a da + b db) / hypot(a, b)
+            let l = g.mul(a, da);
+            let r = g.mul(b, db);
+            let num = g.add_op(l, r);
+            g.div(num, node)
+        }
+        Node::Sum { param, .. } => g.sum(param, da),
     }
 }
 
@@ -310,6 +310,108 @@ fn rebuild(
     };
     memo.insert(node, out);
     out
+}
+
+/// The derivatives of `roots` along the direction in which each symbol `v` moves at the rate
+/// `seed(v)` (a symbol without one is fixed): one forward sweep over the nodes below the
+/// roots, D f = sum_v df/dv seed(v), each node's tangent built once for all roots.
+pub fn directional(
+    g: &mut Graph,
+    roots: &[Id],
+    seed: &dyn Fn(&mut Graph, Var) -> Option<Id>,
+) -> Vec<Id> {
+    let mut tangent: HashMap<Id, Id> = HashMap::new();
+    let mut out = Vec::with_capacity(roots.len());
+    for &root in roots {
+        for n in pending_below(g, root, |n| !tangent.contains_key(&n)) {
+            let t = match g.node(n).clone() {
+                Node::Var(v) => seed(g, v).unwrap_or_else(|| g.constant(0.0)),
+                other => {
+                    let tangents: Vec<Id> = children(&other).iter().map(|c| tangent[c]).collect();
+                    chain_rule(g, n, &tangents)
+                }
+            };
+            tangent.insert(n, t);
+        }
+        out.push(tangent[&root]);
+    }
+    out
+}
+
+/// The total time derivatives D f of `roots` over jets up to q^(top) on R^n
+/// ([`total_derivative`]), as one [`directional`] sweep: q^(j) moves at the rate q^(j+1).
+pub fn total_derivatives(g: &mut Graph, roots: &[Id], n: usize, top: usize) -> Vec<Id> {
+    let next = |g: &mut Graph, v: Var| match v {
+        Var::Jet { order, index } if usize::from(order) < top && (index as usize) < n => {
+            Some(g.var(Var::Jet {
+                order: order + 1,
+                index,
+            }))
+        }
+        _ => None,
+    };
+    directional(g, roots, &next)
+}
+
+/// The gradient of the scalar `f` in `vars` by reverse accumulation: the adjoint of each node
+/// is the sum over its parents of the parent's adjoint times the parent's partial derivative
+/// in it (the parent's [`chain_rule`] with that child's tangent set to the parent's adjoint,
+/// the others zero), swept from `f` down; O(nodes) new nodes for the whole gradient. `None`
+/// where `f` has a sum over a slice parameter (its body is a function of the loop's element:
+/// [`Differentiator`] differentiates it).
+pub fn reverse_gradient(g: &mut Graph, f: Id, vars: &[Var]) -> Option<Vec<Id>> {
+    let nodes = pending_below(g, f, |_| true);
+    // the nodes through which some variable of `vars` reaches f (the others get no adjoint)
+    let mut varying: HashSet<Id> = HashSet::new();
+    for &n in &nodes {
+        let node = g.node(n);
+        if matches!(node, Node::Sum { .. }) {
+            return None;
+        }
+        let on = match node {
+            Node::Var(v) => vars.contains(v),
+            other => children(other).iter().any(|c| varying.contains(c)),
+        };
+        if on {
+            varying.insert(n);
+        }
+    }
+    let zero = g.constant(0.0);
+    let mut adjoint: HashMap<Id, Id> = HashMap::new();
+    adjoint.insert(f, g.constant(1.0));
+    for &n in nodes.iter().rev() {
+        let Some(&a) = adjoint.get(&n) else {
+            continue;
+        };
+        let kids = children(g.node(n));
+        for (i, &c) in kids.iter().enumerate() {
+            // (a child that appears twice takes both shares at once)
+            if !varying.contains(&c) || kids[..i].contains(&c) {
+                continue;
+            }
+            let tangents: Vec<Id> = kids
+                .iter()
+                .map(|&k| if k == c { a } else { zero })
+                .collect();
+            let share = chain_rule(g, n, &tangents);
+            if g.is_const(share, 0.0) {
+                continue;
+            }
+            let sum = match adjoint.get(&c) {
+                Some(&before) => g.add_op(before, share),
+                None => share,
+            };
+            adjoint.insert(c, sum);
+        }
+    }
+    Some(
+        vars.iter()
+            .map(|&v| {
+                let id = g.var(v);
+                adjoint.get(&id).copied().unwrap_or(zero)
+            })
+            .collect(),
+    )
 }
 
 /// The total time derivative $D f = \sum_{j < top} \sum_i \partial f/\partial q^{(j)}_i \thinspace q^{(j+1)}_i$

@@ -41,6 +41,12 @@ pub enum Var {
     /// Component `index` of block `block` of the covector w1 (`side` 0) or w2 (`side` 1)
     /// that contracts a discretization map's points (`#[discretization_map]`).
     Covector { side: u8, block: u8, index: u32 },
+    /// Component `index` (`j * n + i` for q^(j)_i) of a direction d in the jet (x, u), for a
+    /// Hessian-vector product H d.
+    Direction(u32),
+    /// Value `index` of the nodes evaluated once before a run-time loop (named `__h`), in
+    /// code that the loop repeats (the Hessian's columns).
+    Hoisted(u32),
 }
 
 /// A unary function.

@@ -1,6 +1,19 @@
 //! The mechanics of a Lagrangian, as graph nodes: gradient and Hessian in (x, u), the
 //! Ostrogradsky momenta, the Legendre inversion when L is quadratic in u, and the residual
 //! and Jacobians of the lifted theta-scheme (formulas in `retract_core::LiftedSystem`).
+//!
+//! Built in one of two ways ([`Derivation`]): by forward differentiation throughout, the
+//! scheme's Jacobians differentiated symbolically (`#[higher_order_lagrangian]`); or
+//! structurally, for a Lagrangian whose expression is large (the effort of a mechanical
+//! system, a function of tau(q, q', q'')): the gradient by reverse accumulation (O(nodes)),
+//! the Hessian-vector product H d as the derivative of that gradient along a symbolic
+//! direction d (O(nodes); the emitted Hessian evaluates it for each unit vector d, column
+//! by column, forward over reverse, exact; the nodes it reads that d does not change are
+//! hoisted out of that loop), the rows of u of the Hessian alone as nodes (for the Legendre
+//! inverse), the total time derivatives of the momenta in one directional sweep, and no
+//! symbolic scheme: the emitted residual and Jacobians call `retract_core::lifted`'s generic
+//! functions, which evaluate the same formulas from the gradient and Hessian at the
+//! evaluation point.
 
 pub(crate) mod euler_lagrange;
 pub(crate) mod lift;
@@ -11,7 +24,9 @@ use std::collections::HashMap;
 
 use crate::front::lower::Guard;
 use crate::front::signature::Signature;
-use crate::ir::diff::{Differentiator, substitute, total_derivative};
+use crate::ir::diff::{
+    Differentiator, directional, reverse_gradient, substitute, total_derivative, total_derivatives,
+};
 use crate::ir::graph::{Graph, Id, Var};
 
 /// u = A^{-1} (p_{k-1} - b(x)) where L is quadratic in u: A = d2L/du2 does not depend on u,
@@ -31,17 +46,105 @@ pub struct Mechanics {
     pub lagrangian: Id,
     /// dL/dq^(j)_i at `j * n + i`, j = 0..=k.
     pub gradient: Vec<Id>,
-    /// Hessian over the same index, full and symmetric (shared ids).
+    /// Hessian over the same index, full and symmetric (shared ids); where
+    /// `hessian_vector` is given, only the rows and columns of u (the x-x block zeros).
     pub hessian: Vec<Vec<Id>>,
+    /// H d for a direction d: the Hessian's columns at run time
+    /// ([`Derivation::structural`]).
+    pub hessian_vector: Option<HessianVector>,
     /// p_j component i at `j * n + i`, j = 0..k, as functions of q..q^(2k-1).
     pub momenta: Vec<Id>,
     pub legendre_inverse: Option<LegendreInverse>,
+    /// The residual and Jacobians of the scheme as nodes; `None` where the emitted scheme
+    /// calls the generic functions of `retract_core::lifted` ([`Derivation::structural`]).
+    pub scheme: Option<Scheme>,
+}
+
+/// The Hessian-vector product H d (d: `Var::Direction`, entry `j * n + i`) split for a
+/// run-time loop over the directions: `hoisted`, the nodes that H d reads and d does not
+/// change (L's value and gradient below them), evaluated once; `column`, H d with each of
+/// them as `Var::Hoisted(i)`.
+pub struct HessianVector {
+    /// The nodes evaluated before the loop.
+    pub hoisted: Vec<Id>,
+    /// H d, entry `j * n + i`, over `Var::Hoisted`, `Var::Direction` and the jet.
+    pub column: Vec<Id>,
+}
+
+/// `hv` split into the nodes that do not depend on `Var::Direction` and that a node which
+/// does reads (the frontier, hoisted), and `hv` with each frontier node replaced by
+/// `Var::Hoisted(i)`; nothing hoisted where `hv` has a sum over a slice (a node of its body
+/// reads the loop's element).
+fn hoist(g: &mut Graph, hv: &[Id]) -> HessianVector {
+    let mut below: Vec<Id> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let mut stack: Vec<Id> = hv.to_vec();
+    while let Some(id) = stack.pop() {
+        if seen.insert(id) {
+            below.push(id);
+            stack.extend(crate::ir::graph::children(g.node(id)));
+        }
+    }
+    below.sort_unstable();
+    if below
+        .iter()
+        .any(|&id| matches!(g.node(id), crate::ir::graph::Node::Sum { .. }))
+    {
+        return HessianVector {
+            hoisted: Vec::new(),
+            column: hv.to_vec(),
+        };
+    }
+    let mut varying = std::collections::HashSet::new();
+    let mut hoisted = Vec::new();
+    let mut memo = HashMap::new();
+    for &id in &below {
+        let node = g.node(id).clone();
+        let kids = crate::ir::graph::children(&node);
+        let on = match node {
+            crate::ir::graph::Node::Var(v) => matches!(v, Var::Direction(_)),
+            _ => kids.iter().any(|c| varying.contains(c)),
+        };
+        if !on {
+            continue;
+        }
+        varying.insert(id);
+        for c in kids {
+            let leaf = crate::ir::graph::children(g.node(c)).is_empty();
+            if !varying.contains(&c) && !leaf && !memo.contains_key(&c) {
+                let placeholder = g.var(Var::Hoisted(hoisted.len() as u32));
+                memo.insert(c, placeholder);
+                hoisted.push(c);
+            }
+        }
+    }
+    let unchanged = |_: &mut Graph, _: Var| None;
+    let column = hv
+        .iter()
+        .map(|&id| substitute(g, id, &unchanged, &mut memo))
+        .collect();
+    HessianVector { hoisted, column }
+}
+
+/// The lifted theta-scheme as graph nodes.
+pub struct Scheme {
     /// F(z0, w), M = 2nk + n entries.
     pub residual: Vec<Id>,
     /// dF/dw, row-major M x M.
     pub jacobian: Vec<Id>,
     /// dF/dz0, row-major M x S.
     pub jacobian_initial: Vec<Id>,
+}
+
+/// How [`build_with`] derives the mechanics (module docs).
+#[derive(Clone, Copy, Default)]
+pub struct Derivation {
+    /// Accept a constant singular A = d2L/du2 (no Legendre inverse then): an
+    /// optimal-control cost whose singular directions the stage equalities fix, as the
+    /// effort of an underactuated mechanical system.
+    pub singular_allowed: bool,
+    /// The structural build (module docs); else forward differentiation throughout.
+    pub structural: bool,
 }
 
 /// Why the mechanics cannot be built.
@@ -70,39 +173,84 @@ pub fn derivatives(
     n: usize,
     k: usize,
 ) -> (Differentiator, Vec<Id>, Vec<Vec<Id>>) {
+    let built = derivatives_with(g, f, n, k, false);
+    (built.d, built.gradient, built.hessian)
+}
+
+/// [`derivatives`]; where `reverse`, the gradient by reverse accumulation
+/// (`ir::diff::reverse_gradient`; forward where f sums over a slice), only the rows and
+/// columns of u of the Hessian, and the Hessian-vector product H d (`Var::Direction`) as the
+/// derivative of the gradient along d.
+fn derivatives_with(g: &mut Graph, f: Id, n: usize, k: usize, reverse: bool) -> Derivatives {
     let mut d = Differentiator::default();
     let vars: Vec<Var> = (0..=k)
         .flat_map(|j| (0..n).map(move |i| jet(j, i)))
         .collect();
-    let gradient: Vec<Id> = vars.iter().map(|&v| d.diff(g, f, v)).collect();
+    let gradient: Vec<Id> = match reverse.then(|| reverse_gradient(g, f, &vars)).flatten() {
+        Some(gradient) => gradient,
+        None => vars.iter().map(|&v| d.diff(g, f, v)).collect(),
+    };
     let m = vars.len();
     let mut hessian = vec![vec![g.constant(0.0); m]; m];
     for a in 0..m {
-        for b in a..m {
-            let h = d.diff(g, gradient[a], vars[b]);
+        // (structural: the rows of u only, each entry the derivative of dL/du_b)
+        let first = if reverse { a.max(k * n) } else { a };
+        for b in first..m {
+            let h = if reverse {
+                d.diff(g, gradient[b], vars[a])
+            } else {
+                d.diff(g, gradient[a], vars[b])
+            };
             hessian[a][b] = h;
             hessian[b][a] = h;
         }
     }
-    (d, gradient, hessian)
+    let hessian_vector = reverse.then(|| {
+        let along = |g: &mut Graph, v: Var| match v {
+            Var::Jet { order, index } => {
+                Some(g.var(Var::Direction(u32::from(order) * n as u32 + index)))
+            }
+            _ => None,
+        };
+        let hv = directional(g, &gradient, &along);
+        hoist(g, &hv)
+    });
+    Derivatives {
+        d,
+        gradient,
+        hessian,
+        hessian_vector,
+    }
+}
+
+/// What [`derivatives_with`] builds.
+struct Derivatives {
+    /// The differentiator, its memo for later derivatives.
+    d: Differentiator,
+    gradient: Vec<Id>,
+    hessian: Vec<Vec<Id>>,
+    hessian_vector: Option<HessianVector>,
 }
 
 /// Builds the mechanics of L = `lagrangian` of order k on R^n.
 pub fn build(g: &mut Graph, lagrangian: Id, n: usize, k: usize) -> Result<Mechanics, Degenerate> {
-    build_with(g, lagrangian, n, k, false)
+    build_with(g, lagrangian, n, k, Derivation::default())
 }
 
-/// [`build`], where `singular_allowed` accepts a constant singular A = d2L/du2 (no Legendre
-/// inverse then): an optimal-control cost whose singular directions the stage equalities
-/// fix, as the effort of an underactuated mechanical system.
+/// [`build`], derived as `how` says.
 pub fn build_with(
     g: &mut Graph,
     lagrangian: Id,
     n: usize,
     k: usize,
-    singular_allowed: bool,
+    how: Derivation,
 ) -> Result<Mechanics, Degenerate> {
-    let (mut d, gradient, hessian) = derivatives(g, lagrangian, n, k);
+    let Derivatives {
+        mut d,
+        gradient,
+        hessian,
+        hessian_vector,
+    } = derivatives_with(g, lagrangian, n, k, how.structural);
 
     // Degeneracy in the top derivative.
     let top = k * n;
@@ -121,26 +269,32 @@ pub fn build_with(
     let mut momenta = vec![g.constant(0.0); n * k];
     momenta[(k - 1) * n..].copy_from_slice(&gradient[top..top + n]);
     for j in (1..k).rev() {
-        for i in 0..n {
-            let dp = total_derivative(g, &mut d, momenta[j * n + i], n, 2 * k - 1);
+        let block = j * n..(j + 1) * n;
+        let dp: Vec<Id> = if how.structural {
+            total_derivatives(g, &momenta[block], n, 2 * k - 1)
+        } else {
+            block
+                .map(|a| total_derivative(g, &mut d, momenta[a], n, 2 * k - 1))
+                .collect()
+        };
+        for (i, dp) in dp.into_iter().enumerate() {
             momenta[(j - 1) * n + i] = g.sub(gradient[j * n + i], dp);
         }
     }
 
     let legendre_inverse = match legendre_inverse(g, &mut d, &a, &gradient[top..], n, k) {
-        Err(Degenerate::Singular) if singular_allowed => None,
+        Err(Degenerate::Singular) if how.singular_allowed => None,
         other => other?,
     };
-    let (residual, jacobian, jacobian_initial) = scheme(g, &mut d, &gradient, n, k);
+    let scheme = (!how.structural).then(|| scheme(g, &mut d, &gradient, n, k));
     Ok(Mechanics {
         lagrangian,
         gradient,
         hessian,
+        hessian_vector,
         momenta,
         legendre_inverse,
-        residual,
-        jacobian,
-        jacobian_initial,
+        scheme,
     })
 }
 
@@ -329,13 +483,7 @@ fn jacobians(
 }
 
 /// Residual F(z0, w) of the theta-scheme and its Jacobians.
-fn scheme(
-    g: &mut Graph,
-    d: &mut Differentiator,
-    gradient: &[Id],
-    n: usize,
-    k: usize,
-) -> (Vec<Id>, Vec<Id>, Vec<Id>) {
+fn scheme(g: &mut Graph, d: &mut Differentiator, gradient: &[Id], n: usize, k: usize) -> Scheme {
     let s = 2 * n * k;
     let m = s + n;
     let (x_th, p_th) = evaluation_point(g, n, k);
@@ -349,7 +497,11 @@ fn scheme(
     let g_at = gradient_at(g, gradient, &at);
     let f = residual_from(g, &g_at, &p_th, &x_th, n, k);
     let (jacobian, jacobian_initial) = jacobians(g, d, &f, m, s);
-    (f, jacobian, jacobian_initial)
+    Scheme {
+        residual: f,
+        jacobian,
+        jacobian_initial,
+    }
 }
 
 /// The reduced step: F(z0, w) = A w + B z0 + n(y), with y the values at the evaluation point
@@ -492,6 +644,11 @@ pub fn reduce(
     let (s, m) = (2 * n * k, 2 * n * k + n);
     let vars = n * (k + 1);
     let varying = |g: &Graph, id: Id| depends_on(g, id, &|v| matches!(v, Var::Jet { .. }));
+    // (the rows of u first: one that varies rules the reduction out before the others are
+    // searched)
+    if (k * n..vars).any(|a| (0..vars).any(|b| varying(g, hessian[a][b]))) {
+        return None;
+    }
     let core: Vec<usize> = (0..vars)
         .filter(|&a| (0..vars).any(|b| varying(g, hessian[a][b])))
         .collect();
