@@ -1308,8 +1308,10 @@ mod hostile_json {
             "{json}"
         );
         assert_eq!((read.theta, read.tolerance), (plan.theta, plan.tolerance));
-        let mut bvp = crate::bvp::BvpOptions::default();
-        bvp.residual_tolerance = f64::NEG_INFINITY;
+        let bvp = crate::bvp::BvpOptions {
+            residual_tolerance: f64::NEG_INFINITY,
+            ..Default::default()
+        };
         let json = serde_json::to_string(&bvp).unwrap();
         let read: crate::bvp::BvpOptions = serde_json::from_str(&json).unwrap();
         assert_eq!(read, bvp, "{json}");
