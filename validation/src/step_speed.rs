@@ -324,3 +324,107 @@ pub fn write_runs(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<()
     )?;
     Ok(())
 }
+
+/// The reduced stepper, each step with a step size it has not factorised recently.
+pub const CHANGING_REDUCED: &str = "generated reduced, new step size each step";
+/// The general step with the same step sizes.
+pub const CHANGING_GENERAL: &str = "generated general, same step sizes";
+/// The factors alone of the same step sizes.
+pub const CHANGING_FACTORS: &str = "factors of each step size (`ReducedFactors::new`)";
+
+/// How many distinct step sizes [`changing_step_sizes`] cycles through: four times the
+/// stepper's cache of 16, so that every step misses it (checked).
+const DISTINCT_SIZES: usize = 64;
+
+/// The step sizes of [`changing_step_sizes`]: `DISTINCT_SIZES` sizes within 3 % of [`H`],
+/// as an adaptive controller would choose them.
+fn step_sizes() -> [f64; DISTINCT_SIZES] {
+    core::array::from_fn(|k| H * (0.97 + 0.06 * k as f64 / DISTINCT_SIZES as f64))
+}
+
+/// One step from `z` with a step size that changes from call to call (every call of the
+/// reduced stepper computes new factors), for the reduced stepper, the general step and the
+/// factors alone: `rounds` interleaved rounds of `calls` calls each; with the reduced
+/// stepper's factorisations per step over one cycle of the sizes (1: every step a cache miss).
+///
+/// # Errors
+/// A step that fails (each size checked once before timing, the two steps agreeing to 1e-12).
+pub fn changing_step_sizes(
+    system: &RigidBody,
+    z: &Z,
+    rounds: usize,
+    calls: usize,
+) -> Result<(Vec<Row>, f64), Error> {
+    let options = StepOptions::default();
+    let sizes = step_sizes();
+    let mut stepper = ReducedStepper::new(system);
+    for &h in &sizes {
+        let (general, reduced) = (
+            step(system, z, h, &options)?.0,
+            stepper.step(z, h, &options)?.0,
+        );
+        let difference = (general - reduced).amax();
+        if difference >= 1e-12 {
+            return Err(Error::Disagree {
+                variant: CHANGING_REDUCED,
+                difference,
+            });
+        }
+    }
+    // a second cycle through the sizes factorises on every step again
+    let before = stepper.factorisations();
+    for &h in &sizes {
+        stepper.step(z, h, &options)?;
+    }
+    let misses = (stepper.factorisations() - before) as f64 / DISTINCT_SIZES as f64;
+    let (mut k_reduced, mut k_general, mut k_factors) = (0, 0, 0);
+    let next = |k: &mut usize| {
+        *k = (*k + 1) % DISTINCT_SIZES;
+        sizes[*k]
+    };
+    let rows = interleaved(
+        rounds,
+        &mut [
+            Timed::new(CHANGING_REDUCED, calls, &mut || {
+                let h = next(&mut k_reduced);
+                black_box(stepper.step(black_box(z), h, &options).map(|s| s.0[0]).ok());
+            }),
+            Timed::new(CHANGING_GENERAL, calls, &mut || {
+                let h = next(&mut k_general);
+                black_box(step(system, black_box(z), h, &options).map(|s| s.0[0]).ok());
+            }),
+            Timed::new(CHANGING_FACTORS, calls, &mut || {
+                let h = next(&mut k_factors);
+                black_box(ReducedFactors::new(system, black_box(h), 0.5).ok());
+            }),
+        ],
+    );
+    Ok((rows, misses))
+}
+
+/// Writes the table of [`changing_step_sizes`] and the ratio of the reduced stepper's time to
+/// the general step's.
+///
+/// # Errors
+/// [`Error::Io`].
+pub fn write_changing(
+    out: &mut dyn Write,
+    rows: &[Row],
+    misses: f64,
+    rounds: usize,
+) -> Result<(), Error> {
+    writeln!(
+        out,
+        "\nOne step with a new step size each step ({DISTINCT_SIZES} sizes within 3 % of \
+         h = 0.01, SE(2) obstacle system near its closest approach; best of {rounds} \
+         interleaved rounds):\n"
+    )?;
+    write_rows(out, "one step", rows)?;
+    writeln!(
+        out,
+        "\nreduced/general with changing step sizes: {:.2}x (factorisations per reduced step: \
+         {misses})",
+        best_of(rows, CHANGING_REDUCED) / best_of(rows, CHANGING_GENERAL)
+    )?;
+    Ok(())
+}

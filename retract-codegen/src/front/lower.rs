@@ -185,6 +185,9 @@ pub struct Lower<'a> {
     unrolled: usize,
     /// Whether "loop too long to unroll" was reported (once, not per outer iteration).
     too_long: bool,
+    /// Whether a `powf` exponent that depends on the jet was reported (once per expansion,
+    /// not per call: a chain of such calls is one mistake).
+    variable_powf: bool,
     /// The components of the local arrays ([`Binding::Array`]).
     arrays: Vec<Vec<Id>>,
     /// The helper functions defined in the body, by name.
@@ -252,6 +255,7 @@ impl<'a> Lower<'a> {
             guards: Vec::new(),
             unrolled: 0,
             too_long: false,
+            variable_powf: false,
             arrays: Vec::new(),
             helpers: HashMap::new(),
             inlining: Vec::new(),
@@ -1295,10 +1299,15 @@ impl<'a> Lower<'a> {
             "powf" => {
                 let e = self.expr(args[0]);
                 if self.depends_on_jet(e) {
+                    if self.variable_powf {
+                        return self.g.constant(0.0);
+                    }
+                    self.variable_powf = true;
                     return self.error(
                         args[0].span(),
                         "the exponent of `powf` must not depend on the jet (q, q', ...): write \
-                         `(b * a.ln()).exp()` for a variable exponent",
+                         `(b * a.ln()).exp()` for a variable exponent (reported at the first \
+                         such call only)",
                     );
                 }
                 match self.g.as_const(e) {

@@ -241,3 +241,24 @@ fn a_recurrence_unrolled_to_the_limit_expands_on_a_small_stack() {
     let length = run.join().expect("no stack overflow").expect("expands");
     assert!(length > 1_000_000, "{length} bytes");
 }
+
+#[test]
+fn a_variable_powf_exponent_is_reported_once_per_expansion() {
+    // a chain of 1250 calls whose exponent depends on the jet: one error, at the first call
+    let chain = ".powf(q)".repeat(1250);
+    let err = expand("order = 1", &scalar(&format!("acc += (q + 2.0){chain};"))).unwrap_err();
+    assert_eq!(err.lines().count(), 1, "{}", &err[..err.len().min(400)]);
+    assert!(
+        err.contains("the exponent of `powf` must not depend on the jet"),
+        "{err}"
+    );
+    // separate calls in one body, and a variable exponent through a let: still once
+    let err = expand(
+        "order = 1",
+        &scalar("let e = dq * 2.0; acc += q.powf(dq); acc += (q + 1.0).powf(e);"),
+    )
+    .unwrap_err();
+    assert_eq!(err.matches("the exponent of `powf`").count(), 1, "{err}");
+    // a constant exponent still expands
+    assert!(expand("order = 1", &scalar("acc += (q * q + 1.0).powf(2.5);")).is_ok());
+}

@@ -13,13 +13,16 @@ use super::plan::Plan;
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PlanOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub theta: f64,
     /// Converged when the relative stationarity ([`Certificate::stationarity`](super::Certificate::stationarity)) and the
     /// constraint violation are both below this.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub tolerance: f64,
     /// Accepted instead of `tolerance` when the line search has made only rounding-level
     /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
     /// acceptable level; the certificate reports the residuals reached.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub acceptable: f64,
     /// Iteration budget; 3000 by default (IPOPT's): the hard problems of the constrained
     /// suite need a few hundred to a few thousand iterations (`examples/constrained.rs`).
@@ -34,17 +37,20 @@ pub struct PlanOptions {
     /// The chord of a step longer than this (max-norm of $x_{i+1} - x_i$) is checked by the
     /// singularity guard in pieces of at most this length, as
     /// [`crate::StepOptions::chord_spacing`]; 0.02 by default.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub chord_spacing: f64,
     /// The most pieces a step's chord is cut into, as
     /// [`crate::StepOptions::max_chord_pieces`]; 16 by default.
     pub max_chord_pieces: u32,
     /// Armijo constant of the line search.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub armijo: f64,
     /// Step halvings per line search.
     pub max_backtracks: usize,
     /// Initial barrier parameter $\mu_0$ of the inequalities, in the units of the transcribed
     /// problem (IPOPT's `mu_init`, whose default 0.1 it shares): its barrier term is $\mu_0
     /// \sum \ln s$ over the slacks of every inequality at every node and step.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub initial_barrier: f64,
     /// Also compute [`Certificate::min_reduced_hessian_eig`](super::Certificate::min_reduced_hessian_eig) (Lanczos on the final
     /// factorisation, less than one iteration's time); on by default, off in

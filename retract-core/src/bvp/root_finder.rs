@@ -44,12 +44,15 @@ use condense::{Linearized, ReducedStepMap, StepMap, general_step_map};
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BvpOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub theta: f64,
     /// Converged when $|R|_\infty \le$ this.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub residual_tolerance: f64,
     /// Newton iteration cap.
     pub max_iterations: usize,
     /// Armijo constant of the backtracking line search.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub armijo: f64,
     /// Step halvings per iteration.
     pub max_backtracks: usize,

@@ -40,16 +40,36 @@ pub trait Problem<const M: usize> {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NewtonOptions {
     /// Absolute tolerance on $\Vert F\Vert_\infty$.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub residual_abs: f64,
     /// Tolerance on $\Vert F\Vert_\infty$ relative to the initial residual.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub residual_rel: f64,
     /// Absolute tolerance on the Newton step $\Vert\Delta\Vert_\infty$.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub step_abs: f64,
     /// Tolerance on $\Vert\Delta\Vert_\infty$ relative to $\Vert w\Vert_\infty$.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub step_rel: f64,
     /// Maximum number of Newton iterations (Jacobian factorisations).
     pub max_iterations: usize,
     /// Armijo constant $c$ of the sufficient-decrease test.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub armijo: f64,
     /// Maximum number of step halvings per iteration.
     pub max_backtracks: usize,
@@ -225,10 +245,21 @@ pub(crate) fn lane_sum(entries: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
 }
 
-/// $\max_i |m_i|$ (NaN entries are skipped, as by nalgebra's `amax`).
+/// $\max_i |m_i|$ (NaN entries are skipped, as by nalgebra's `amax`), in four lanes as
+/// [`lane_sum`] (a single running maximum is a chain of dependent comparisons).
 #[inline]
 pub(crate) fn max_abs<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
-    m.as_slice().iter().fold(0.0, |max, v| max.max(v.abs()))
+    let mut lanes = [0.0f64; 4];
+    let mut chunks = m.as_slice().chunks_exact(4);
+    for chunk in &mut chunks {
+        for (lane, &v) in lanes.iter_mut().zip(chunk) {
+            *lane = lane.max(v.abs());
+        }
+    }
+    for (lane, &v) in lanes.iter_mut().zip(chunks.remainder()) {
+        *lane = lane.max(v.abs());
+    }
+    lanes[0].max(lanes[1]).max(lanes[2].max(lanes[3]))
 }
 
 /// Solves $F(w) = 0$ from the guess `w0` (module docs give the method).

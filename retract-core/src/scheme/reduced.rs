@@ -257,7 +257,7 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
             let core = Sys::CORE[m];
             theta * t[(core, c)] + if c == core { 1.0 - theta } else { 0.0 }
         });
-        let largest = t.amax().max(a_inv.amax());
+        let largest = max_abs(&t).max(max_abs(&a_inv));
         Self {
             h,
             theta,
@@ -329,49 +329,31 @@ fn corrections<Sys, const S: usize, const M: usize, const R: usize>(
 where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
-    // the nonzeros of each row of A (A is sparse: a few per row)
-    let mut nonzeros = [[0usize; M]; M];
-    let mut counts = [0usize; M];
-    for (i, (row, count)) in nonzeros.iter_mut().zip(counts.iter_mut()).enumerate() {
-        for k in 0..M {
-            if a[(i, k)] != 0.0 {
-                row[*count] = k;
-                *count += 1;
-            }
-        }
-    }
-    // entry (i, c) of A X - Y over the nonzeros of row i of A, compensated
-    let residual = |i: usize, x: &[f64], y: f64| {
-        let mut sum = Dot2::exact(-y);
-        for &k in &nonzeros[i][..counts[i]] {
-            if x[k] != 0.0 {
-                sum.add_product(a[(i, k)], x[k]);
-            }
-        }
-        sum.value()
-    };
+    let rows = SparseRows::new(a);
     // A T + B, column by column (a zero column of T stays one of T_lo)
     let mut t_residual = SMatrix::<f64, M, S>::zeros();
     for c in 0..S {
         let column = t.column(c);
-        if column.iter().any(|&v| v != 0.0) {
+        if column.as_slice().iter().any(|&v| v != 0.0) {
+            let column = Split::column(column.as_slice());
             for i in 0..M {
-                t_residual[(i, c)] = residual(i, column.as_slice(), -b[(i, c)]);
+                t_residual[(i, c)] = rows.residual(i, &column, -b[(i, c)]);
             }
         }
     }
     // A a_inv - E at the forced columns
     let mut inverse_residual = SMatrix::<f64, M, M>::zeros();
     for &q in Sys::FORCED {
-        let column = a_inv.column(q);
+        let column = Split::column(a_inv.column(q).as_slice());
         for i in 0..M {
             let unit = if i == q { 1.0 } else { 0.0 };
-            inverse_residual[(i, q)] = residual(i, column.as_slice(), unit);
+            inverse_residual[(i, q)] = rows.residual(i, &column, unit);
         }
     }
     if t_residual
+        .as_slice()
         .iter()
-        .chain(inverse_residual.iter())
+        .chain(inverse_residual.as_slice())
         .all(|&v| v == 0.0)
     {
         return Ok((SMatrix::zeros(), SMatrix::zeros()));
@@ -512,18 +494,106 @@ pub fn two_sum(a: f64, b: f64) -> (f64, f64) {
 #[inline(always)]
 pub fn two_product(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
-    #[cfg(all(feature = "std", target_feature = "fma"))]
-    let e = a.mul_add(b, -p);
+    (p, Split::new(a).product_error(Split::new(b), p))
+}
+
+/// A double $x$ with its Veltkamp halves $x = x_{hi} + x_{lo}$, $x_{hi}$ the upper 26
+/// significant bits (where `std` and the target's `fma` feature give a fused multiply-add,
+/// only $x$: the halves are not needed). Splitting an operand once saves the split in every
+/// product it enters.
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    value: f64,
     #[cfg(not(all(feature = "std", target_feature = "fma")))]
-    let e = {
-        // 2^27 + 1 splits a double into two halves of at most 26 significant bits each
-        const SPLIT: f64 = 134_217_729.0;
-        let (ca, cb) = (SPLIT * a, SPLIT * b);
-        let (a_hi, b_hi) = (ca - (ca - a), cb - (cb - b));
-        let (a_lo, b_lo) = (a - a_hi, b - b_hi);
-        ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
-    };
-    (p, if e.is_finite() { e } else { 0.0 })
+    hi: f64,
+    #[cfg(not(all(feature = "std", target_feature = "fma")))]
+    lo: f64,
+}
+
+impl Split {
+    /// $x$ and its halves: $x_{hi} = c - (c - x)$ with $c = (2^{27} + 1) x$, $x_{lo} = x - x_{hi}$.
+    #[inline(always)]
+    fn new(value: f64) -> Self {
+        #[cfg(not(all(feature = "std", target_feature = "fma")))]
+        {
+            // 2^27 + 1 splits a double into two halves of at most 26 significant bits each
+            const SPLIT: f64 = 134_217_729.0;
+            let c = SPLIT * value;
+            let hi = c - (c - value);
+            Self {
+                value,
+                hi,
+                lo: value - hi,
+            }
+        }
+        #[cfg(all(feature = "std", target_feature = "fma"))]
+        Self { value }
+    }
+
+    /// Every entry of `column` split ([`Self::new`]).
+    #[inline(always)]
+    fn column<const M: usize>(column: &[f64]) -> [Self; M] {
+        core::array::from_fn(|k| Self::new(column[k]))
+    }
+
+    /// $x y - p$ for $p = \mathrm{fl}(x y)$: exact (Dekker:
+    /// $((x_{hi} y_{hi} - p) + x_{hi} y_{lo} + x_{lo} y_{hi}) + x_{lo} y_{lo}$, or one fused
+    /// multiply-add) unless it underflows; 0 where it is not finite.
+    #[inline(always)]
+    fn product_error(self, other: Self, p: f64) -> f64 {
+        #[cfg(all(feature = "std", target_feature = "fma"))]
+        let e = self.value.mul_add(other.value, -p);
+        #[cfg(not(all(feature = "std", target_feature = "fma")))]
+        let e = ((self.hi * other.hi - p) + self.hi * other.lo + self.lo * other.hi)
+            + self.lo * other.lo;
+        if e.is_finite() { e } else { 0.0 }
+    }
+}
+
+/// The nonzeros of each row of a square matrix (a few per row for $A$), split once
+/// ([`Split`]), for the compensated residuals of [`corrections`].
+struct SparseRows<const M: usize> {
+    /// Row $i$'s nonzeros: their columns and values, the first `counts[i]` used.
+    columns: [[usize; M]; M],
+    values: [[Split; M]; M],
+    counts: [usize; M],
+}
+
+impl<const M: usize> SparseRows<M> {
+    fn new(a: &SMatrix<f64, M, M>) -> Self {
+        let mut rows = Self {
+            columns: [[0; M]; M],
+            values: [[Split::new(0.0); M]; M],
+            counts: [0; M],
+        };
+        for i in 0..M {
+            for k in 0..M {
+                let v = a[(i, k)];
+                if v != 0.0 {
+                    let n = rows.counts[i];
+                    rows.columns[i][n] = k;
+                    rows.values[i][n] = Split::new(v);
+                    rows.counts[i] = n + 1;
+                }
+            }
+        }
+        rows
+    }
+
+    /// $\sum_k a_{ik} x_k - y$ over the nonzeros of row $i$, compensated as [`Dot2`]
+    /// (every product's and addition's error summed apart, added once at the end).
+    #[inline(always)]
+    fn residual(&self, i: usize, x: &[Split; M], y: f64) -> f64 {
+        let mut sum = Dot2::exact(-y);
+        let n = self.counts[i];
+        for (&k, &a) in self.columns[i][..n].iter().zip(&self.values[i][..n]) {
+            let x = x[k];
+            if x.value != 0.0 {
+                sum.add_split_product(a, x);
+            }
+        }
+        sum.value()
+    }
 }
 
 /// A compensated sum of products (Dot2 of Ogita, Rump and Oishi, "Accurate sum and dot
@@ -546,9 +616,11 @@ impl Dot2 {
         }
     }
 
-    /// Adds the product $a b$.
-    fn add_product(&mut self, a: f64, b: f64) {
-        let (p, product_error) = two_product(a, b);
+    /// Adds the product $a b$ of two split operands.
+    #[inline(always)]
+    fn add_split_product(&mut self, a: Split, b: Split) {
+        let p = a.value * b.value;
+        let product_error = a.product_error(b, p);
         let (sum, error) = two_sum(self.sum, p);
         self.sum = sum;
         self.error += error + product_error;
@@ -919,7 +991,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{Dot2, two_product, two_sum};
+    use super::{Dot2, Split, two_product, two_sum};
 
     #[test]
     fn the_error_free_transformations_are_exact() {
@@ -944,8 +1016,13 @@ mod tests {
         assert_eq!(two_product(1e300, 1e300).1, 0.0);
         // a sum that cancels to its rounding errors: Dot2 finds -2^-104, a plain sum 0
         let mut sum = Dot2::exact(1.0);
-        sum.add_product(1.0 + f64::EPSILON, 1.0 - f64::EPSILON);
-        sum.add_product(-1.0, 2.0);
+        let split = |a: f64, b: f64| (Split::new(a), Split::new(b));
+        let ((a, b), (c, d)) = (
+            split(1.0 + f64::EPSILON, 1.0 - f64::EPSILON),
+            split(-1.0, 2.0),
+        );
+        sum.add_split_product(a, b);
+        sum.add_split_product(c, d);
         assert_eq!(sum.value(), -f64::EPSILON * f64::EPSILON);
     }
 }

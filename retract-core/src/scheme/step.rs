@@ -16,6 +16,10 @@ use crate::{Error, LiftedSystem};
 pub struct StepOptions {
     /// $\theta \in [0, 1]$; $1/2$ (the default) is the lifted midpoint rule, order 2;
     /// 0 and 1 are the two symplectic Euler methods, order 1.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub theta: f64,
     /// Options of the Newton solve.
     pub newton: NewtonOptions,
@@ -48,6 +52,10 @@ pub struct StepOptions {
     /// ([`LiftedSystem::guards_quadratic`], e.g. $x^2 + y^2 - r^2$ of a disc), the three points
     /// decide the chord exactly (the quadratic through them is the expression) and no piece
     /// is checked.
+    #[cfg_attr(
+        all(feature = "serde", feature = "std"),
+        serde(with = "crate::serde_float")
+    )]
     pub chord_spacing: f64,
     /// The most pieces a step's chord is cut into (see [`Self::chord_spacing`]); 16 by
     /// default, at most [`MAX_CHORD_PIECES`]; 0 or 1 check only the three points.
@@ -1226,6 +1234,87 @@ mod hostile_json {
                 "{json}"
             );
         }
+    }
+
+    #[test]
+    fn non_finite_options_round_trip_and_hostile_floats_are_refused() {
+        let system = PlanarBarrier {
+            tau: 1e-2,
+            radius: 1.0,
+            mass: 1.0,
+        };
+        let z0 = start(&system);
+        // an infinite chord spacing (three points only) is written as "inf" and read back
+        let options = StepOptions::default().with_chord_check(f64::INFINITY, 16);
+        let json = serde_json::to_string(&options).unwrap();
+        assert!(json.contains(r#""chord_spacing":"inf""#), "{json}");
+        let read: StepOptions = serde_json::from_str(&json).unwrap();
+        assert_eq!(read, options);
+        assert!(step(&system, &z0, 0.01, &read).is_ok());
+        // NaN, written as "NaN" (or null by older files), reads back as NaN and is refused
+        let nan = serde_json::to_value(StepOptions::default().with_chord_check(f64::NAN, 16));
+        let nan = nan.unwrap();
+        assert_eq!(nan["chord_spacing"], "NaN");
+        let valid = serde_json::to_value(StepOptions::default()).unwrap();
+        let mut null = valid.clone();
+        null["chord_spacing"] = serde_json::Value::Null;
+        let refused: [(&str, Edit); 2] = [
+            ("newton.residual_abs = -inf", |v| {
+                v["newton"]["residual_abs"] = "-inf".into()
+            }),
+            ("theta = NaN", |v| v["theta"] = "NaN".into()),
+        ];
+        let mut values = vec![("chord_spacing = NaN", nan), ("chord_spacing = null", null)];
+        for (what, edit) in refused {
+            let mut value = valid.clone();
+            edit(&mut value);
+            values.push((what, value));
+        }
+        for (what, value) in values {
+            let read: StepOptions = serde_json::from_value(value)
+                .unwrap_or_else(|e| panic!("{what}: the JSON reads ({e})"));
+            let result = step(&system, &z0, 0.01, &read);
+            assert!(
+                matches!(result, Err(Error::InvalidArgument { .. })),
+                "{what}: {result:?}"
+            );
+        }
+        // strings other than the three names, and other types, are errors of the reading
+        let unreadable: [(&str, Edit); 4] = [
+            ("chord_spacing = \"infinity\"", |v| {
+                v["chord_spacing"] = "infinity".into()
+            }),
+            ("chord_spacing = \"0.02\"", |v| {
+                v["chord_spacing"] = "0.02".into()
+            }),
+            ("theta = []", |v| v["theta"] = serde_json::json!([])),
+            ("newton.step_rel = {}", |v| {
+                v["newton"]["step_rel"] = serde_json::json!({})
+            }),
+        ];
+        for (what, edit) in unreadable {
+            let mut value = valid.clone();
+            edit(&mut value);
+            let read = serde_json::from_value::<StepOptions>(value);
+            assert!(read.is_err(), "{what}: {read:?}");
+        }
+        // the solvers' options: every float round-trips, infinite or NaN
+        let mut plan = crate::bvp::PlanOptions::default();
+        (plan.chord_spacing, plan.acceptable) = (f64::INFINITY, f64::NAN);
+        let json = serde_json::to_string(&plan).unwrap();
+        let read: crate::bvp::PlanOptions = serde_json::from_str(&json).unwrap();
+        assert!(
+            read.chord_spacing == f64::INFINITY && read.acceptable.is_nan(),
+            "{json}"
+        );
+        assert_eq!((read.theta, read.tolerance), (plan.theta, plan.tolerance));
+        let bvp = crate::bvp::BvpOptions {
+            residual_tolerance: f64::NEG_INFINITY,
+            ..Default::default()
+        };
+        let json = serde_json::to_string(&bvp).unwrap();
+        let read: crate::bvp::BvpOptions = serde_json::from_str(&json).unwrap();
+        assert_eq!(read, bvp, "{json}");
     }
 
     #[test]
