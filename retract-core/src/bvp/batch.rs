@@ -4,8 +4,10 @@
 //!
 //! With the `parallel` feature (on by default) the solves run on rayon's current thread
 //! pool: the global one (as many threads as cores), or the pool a caller enters with
-//! `rayon::ThreadPool::install` to choose the thread count. Each worker solves in its own
-//! [`Workspace`], reused from one solve to the next; without the feature the same functions
+//! `rayon::ThreadPool::install` to choose the thread count. Each piece of work rayon hands a
+//! thread (a run of consecutive jobs) solves in its own [`Workspace`], reused from one solve
+//! of the run to the next ([`solve_stream`]: one per job of a chunk, kept across chunks);
+//! without the feature the same functions
 //! solve one problem after the other in one workspace. The results come back in input order,
 //! each with its own status (a failure does not stop the others), and are the same as the
 //! sequential solves': a solve does not depend on the thread that runs it.
