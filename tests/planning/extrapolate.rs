@@ -167,3 +167,26 @@ fn extrapolated_spline_cost_is_the_exact_cost() {
     assert!((extrapolated.cost - exact).abs() < 1e-10 * exact);
     assert!((extrapolated.cost - exact).abs() <= extrapolated.cost_error);
 }
+
+/// `solve_extrapolated_with` in one workspace, twice (the second time in the workspace the
+/// first sized), gives the extrapolation of `solve_extrapolated` bit for bit: the cost, its
+/// estimate and the three plans.
+#[test]
+fn an_extrapolation_in_a_kept_workspace_is_the_same() {
+    let (x, u) = disc_bump_guess(40);
+    let guess = PlanGuess::Path { x: &x, u: &u };
+    let problem = disc_problem(40);
+    let fresh = problem.solve_extrapolated(guess).unwrap();
+    let mut workspace = retract::bvp::Workspace::new();
+    for round in 0..2 {
+        let kept = problem
+            .solve_extrapolated_with(guess, &mut workspace)
+            .unwrap();
+        assert_eq!(kept.cost.to_bits(), fresh.cost.to_bits(), "round {round}");
+        assert_eq!(kept.cost_error.to_bits(), fresh.cost_error.to_bits());
+        for (a, b) in kept.plans.iter().zip(&fresh.plans) {
+            assert_eq!(a.x, b.x, "round {round}");
+            assert_eq!(a.iterations, b.iterations);
+        }
+    }
+}

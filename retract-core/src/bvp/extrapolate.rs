@@ -8,6 +8,7 @@ use nalgebra::SVector;
 use super::options::PlanGuess;
 use super::plan::{Failure, Plan, PlanError};
 use super::problem::OptimalControlProblem;
+use super::workspace::Workspace;
 use crate::{Error, Lagrangian, LiftedSystem};
 
 /// A plan extrapolated to $h \to 0$ from the plans with $N$, $2N$ and $4N$ steps
@@ -248,6 +249,24 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
+        self.solve_extrapolated_with(guess, &mut Workspace::new())
+    }
+
+    /// [`Self::solve_extrapolated`] with its three solves in `workspace`
+    /// ([`Self::solve_with`]): sized by the $4N$ solve, it serves a later extrapolation of
+    /// the same size without growing (the refined guesses and the finer problems are still
+    /// allocated on each call).
+    ///
+    /// # Errors
+    /// As [`Self::solve_extrapolated`].
+    pub fn solve_extrapolated_with<const S: usize, const M: usize>(
+        &self,
+        guess: PlanGuess<'_, N, X>,
+        workspace: &mut Workspace<N, X>,
+    ) -> Result<Extrapolated<N, X>, PlanError<N, X>>
+    where
+        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
+    {
         let started = Instant::now();
         let theta = self.options.theta;
         if theta != 0.5 {
@@ -269,18 +288,18 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 last: None,
             });
         }
-        let coarse = self.solve::<S, M>(guess)?;
+        let coarse = self.solve_with::<S, M>(guess, workspace)?;
         let steps = self.steps;
         let x2 = refine(&coarse.x, 0.0, 2 * steps + 1);
         let u2 = refine(&coarse.u, theta, 2 * steps);
         let fine = self
             .with_more_steps(2, started)?
-            .solve::<S, M>(PlanGuess::Path { x: &x2, u: &u2 })?;
+            .solve_with::<S, M>(PlanGuess::Path { x: &x2, u: &u2 }, workspace)?;
         let x4 = refine(&corrected(&fine.x, &x2), 0.0, 4 * steps + 1);
         let u4 = refine(&corrected(&fine.u, &u2), theta, 4 * steps);
         let finest = self
             .with_more_steps(4, started)?
-            .solve::<S, M>(PlanGuess::Path { x: &x4, u: &u4 })?;
+            .solve_with::<S, M>(PlanGuess::Path { x: &x4, u: &u4 }, workspace)?;
         Extrapolated::from_plans([coarse, fine, finest])
     }
 }
