@@ -64,17 +64,29 @@ pub fn solve_batch<
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + Sync,
 {
-    let solve = |workspace: &mut Workspace<N, X>, (problem, guess): &Job<'_, '_, Sys, N, K, X>| {
+    map_in_workspaces(jobs, |workspace, (problem, guess)| {
         problem.solve_with::<S, M>(*guess, workspace)
-    };
+    })
+}
+
+/// `solve(workspace, item)` for every item, in order: on rayon's pool with a workspace per
+/// run of items a thread takes (`map_init`) with the `parallel` feature, else one after the
+/// other in one workspace.
+fn map_in_workspaces<T: Sync, R: Send, const N: usize, const X: usize>(
+    items: &[T],
+    solve: impl Fn(&mut Workspace<N, X>, &T) -> R + Sync + Send,
+) -> Vec<R> {
     #[cfg(feature = "parallel")]
     {
-        jobs.par_iter().map_init(Workspace::new, solve).collect()
+        items.par_iter().map_init(Workspace::new, solve).collect()
     }
     #[cfg(not(feature = "parallel"))]
     {
         let mut workspace = Workspace::new();
-        jobs.iter().map(|job| solve(&mut workspace, job)).collect()
+        items
+            .iter()
+            .map(|item| solve(&mut workspace, item))
+            .collect()
     }
 }
 
@@ -126,16 +138,9 @@ where
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
-        let solve = |workspace: &mut Workspace<N, X>, guess: &PlanGuess<'_, N, X>| {
+        let outcomes = map_in_workspaces(guesses, |workspace, guess| {
             self.solve_with::<S, M>(*guess, workspace)
-        };
-        #[cfg(feature = "parallel")]
-        let outcomes = guesses.par_iter().map_init(Workspace::new, solve).collect();
-        #[cfg(not(feature = "parallel"))]
-        let outcomes = {
-            let mut workspace = Workspace::new();
-            guesses.iter().map(|g| solve(&mut workspace, g)).collect()
-        };
+        });
         MultiStart::new(outcomes)
     }
 }
