@@ -13,7 +13,7 @@ use syn::ItemFn;
 
 use crate::front::lower::Lower;
 use crate::front::signature::{self, Attribute, Signature};
-use crate::ir::graph::{Graph, Id};
+use crate::ir::graph::{Graph, Id, MAX_NODES};
 
 /// The passes of one attribute, chained by [`run`].
 pub(crate) trait Passes {
@@ -70,12 +70,32 @@ pub(crate) fn run<P: Passes>(
     let lowered = {
         let mut lower = Lower::new(&mut graph, &sig);
         let lowered = passes.lower(&mut lower, &function, &sig);
+        check_size(lower.g, &function)?;
         lower.errors.check()?;
         lowered
     };
     let (sig, lowered) = passes.charts(&mut graph, sig, lowered);
-    let derived = passes.mechanics(&mut graph, &sig, lowered)?;
-    Ok(passes.emit(&function, &sig, &graph, derived))
+    let derived = passes.mechanics(&mut graph, &sig, lowered);
+    check_size(&graph, &function)?;
+    Ok(passes.emit(&function, &sig, &graph, derived?))
+}
+
+/// The error at `function`'s name when `graph` outgrew [`MAX_NODES`].
+fn check_size(graph: &Graph, function: &ItemFn) -> syn::Result<()> {
+    if !graph.overflowed() {
+        return Ok(());
+    }
+    Err(syn::Error::new(
+        function.sig.ident.span(),
+        format!(
+            "the expansion of `{}` needs more than {MAX_NODES} expression nodes (the \
+             function, its derivatives and the scheme), more than rustc could compile in \
+             reasonable time; make the function smaller: fewer unrolled loop iterations \
+             (a `for` over a slice parameter is not unrolled) or shorter chains of nested \
+             calls",
+            function.sig.ident
+        ),
+    ))
 }
 
 /// `roots` (a function and its guarded expressions) composed with the chart of `sig`'s space

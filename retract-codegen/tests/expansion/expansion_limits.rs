@@ -170,6 +170,40 @@ fn sizes_beyond_the_limits_are_errors() {
     }
 }
 
+#[test]
+fn an_expansion_past_the_node_limit_is_one_error_at_the_name() {
+    // 2000 distinct unrolled terms, each a chain of 20 calls in q and dq on R^4 at order 2:
+    // the function is about 40 000 nodes, its Hessian in 12 variables tens of millions
+    let chain = ".sin().atan2(q[1]).cos().atan2(dq[2]).tanh()".repeat(4);
+    let item = format!(
+        "fn big(q: [f64; 4], dq: [f64; 4], ddq: [f64; 4]) -> f64 {{ let mut acc = 0.0; \
+         for i in 0..2000 {{ acc += (q[0] * (i as f64) + dq[3]){chain}; }} \
+         0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1] + ddq[2] * ddq[2] + ddq[3] * ddq[3]) + acc }}"
+    );
+    let start = Instant::now();
+    let (result, stats) = on_rustc_stack(move || {
+        let (result, stats) =
+            retract_codegen::expansion_stats("order = 2".parse().unwrap(), item.parse().unwrap());
+        (
+            result
+                .map(|_| ())
+                .map_err(|e| e.into_iter().collect::<Vec<_>>()),
+            stats,
+        )
+    });
+    let elapsed = start.elapsed();
+    let errors = result.expect_err("expanded past the limit");
+    assert_eq!(errors.len(), 1, "one error: {errors:?}");
+    let message = errors[0].to_string();
+    assert!(
+        message.contains("needs more than 1000000 expression nodes") && message.contains("`big`"),
+        "{message}"
+    );
+    assert!(stats.graph_nodes <= 1_000_000, "{stats:?}");
+    // the graph stops at the limit: seconds, where the full expansion took minutes
+    assert!(elapsed < Duration::from_secs(60), "{elapsed:?}");
+}
+
 /// The work of expanding an order-1 Lagrangian on R^2 ending in `+ tail`, on rustc's stack:
 /// graph nodes and the length of the code, or the error messages.
 fn work(tail: String) -> Result<(usize, usize), String> {

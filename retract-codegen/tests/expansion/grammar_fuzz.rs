@@ -7,7 +7,8 @@
 //! the work bounded in expression-graph nodes (`expansion_stats`), not wall time.
 //!
 //! Each run takes `CASES` cases from a fixed seed and `CASES` from a random one (printed; set
-//! `RETRACT_FUZZ_SEED` to replay it, `RETRACT_FUZZ_CASES` for more cases per seed). The
+//! `RETRACT_FUZZ_SEED` to replay it, `RETRACT_FUZZ_CASES` for more cases per seed,
+//! `RETRACT_FUZZ_SHOW=<case>` to print one case's source). The
 //! generated bodies include helper fns (some recursive: an error) and deep nesting. A sample of well-behaved Lagrangians from the fixed
 //! seed is compiled in the workspace's `tests/integrators/fuzz_corpus.rs`, whose derivatives are checked
 //! against finite differences there; `the_compiled_corpus_is_the_fixed_seed_sample`
@@ -30,6 +31,10 @@ fn cases() -> usize {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(CASES)
+}
+/// The case that `RETRACT_FUZZ_SHOW` names, if any: its source is printed.
+fn show_case() -> Option<usize> {
+    std::env::var("RETRACT_FUZZ_SHOW").ok()?.parse().ok()
 }
 const FIXED_SEED: u64 = 0x5eed_0014_0010;
 /// Compiled sample size.
@@ -541,6 +546,12 @@ fn run(seed: u64) -> (usize, usize) {
     for i in 0..cases {
         let smooth = rng.chance(0.2);
         let case = generate(&mut rng, smooth, &format!("l{i}"));
+        if show_case() == Some(i) {
+            println!(
+                "case {i}: #[higher_order_lagrangian({})] {}",
+                case.attr, case.item
+            );
+        }
         let start = std::time::Instant::now();
         let (ok, stats) = check_case(&case, seed, i);
         let elapsed = start.elapsed();
