@@ -42,8 +42,13 @@ pub fn cart_pole_lagrangian(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64,
 
 /// The cart-pole as its energy l = T - V: cart x, pole angle th from the downward vertical,
 /// point mass mp at length l; only the cart is driven (`actuated = [0]`), so the generated
-/// cost is 1/2 F^2 with F = tau_0 and the pole's tau_1 = 0 is the stage equality.
-#[mechanical_system(actuated = [0], helpers = [cart_pole_lagrangian])]
+/// cost is 1/2 F^2 with F = tau_0 and the pole's tau_1 = 0 is the stage equality; the force
+/// F is also a function of the jet (`input_functions()`), for bounds on it.
+#[mechanical_system(
+    actuated = [0],
+    input_functions = true,
+    helpers = [cart_pole_lagrangian]
+)]
 pub fn cart_pole_energy(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
     cart_pole_lagrangian(q, dq, mc, mp, l, g)
 }
@@ -57,7 +62,11 @@ pub fn cart_push() -> [f64; 2] {
 /// The cart-pole driven through its actuation matrix B = (1, 0) (`cart_push`) instead of
 /// `actuated = [0]`: u = (B^T B)^{-1} B^T tau = tau_0 and the passive equality
 /// a^T tau = -tau_1 (a = (det B_(0), -det B_(1)) = (0, -1)), the same problem.
-#[mechanical_system(input_matrix = cart_push, helpers = [cart_pole_lagrangian])]
+#[mechanical_system(
+    input_matrix = cart_push,
+    input_functions = true,
+    helpers = [cart_pole_lagrangian]
+)]
 pub fn pushed_cart_pole(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
     cart_pole_lagrangian(q, dq, mc, mp, l, g)
 }

@@ -101,7 +101,7 @@ pub mod __private {
     pub use crate::manifold::se3::Se3System;
     pub use crate::manifold::so3::So3System;
     pub use crate::manifold::sphere::SphereSystem;
-    pub use crate::mechanical::{MechanicalSystem, TorqueComponent};
+    pub use crate::mechanical::{InputComponent, MechanicalSystem, TorqueComponent};
     pub use crate::numeric::linalg::solve;
     pub use crate::numeric::special::stumpff;
     pub use crate::scheme::lifted::{
@@ -128,7 +128,7 @@ pub use bvp::{
 };
 pub use compose::composed_step;
 pub use error::{DomainKind, DomainViolation, Error};
-pub use mechanical::{MechanicalSystem, TorqueComponent};
+pub use mechanical::{InputComponent, MechanicalSystem, TorqueComponent};
 pub use newton::NewtonOptions;
 pub use reduced::{ClosedForm, ReducedFactors, ReducedScheme, ReducedStepper};
 pub use state::{Jet, State};

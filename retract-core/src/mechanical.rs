@@ -1,6 +1,7 @@
 //! A mechanical system written as its energy, $l(q, q') = T - V$, seen by the optimizer:
 //! the trait [`MechanicalSystem`] that `#[mechanical_system]` implements, and
-//! [`TorqueComponent`], one component of its Euler-Lagrange operator as a stage equality.
+//! [`TorqueComponent`], one component of its Euler-Lagrange operator as a stage equality, and
+//! [`InputComponent`], one component of the input it needs, for bounds on the inputs.
 //!
 //! The Euler-Lagrange operator of $l$, with the non-conservative forces $Q_{nc}$,
 //!
@@ -59,6 +60,35 @@ pub trait MechanicalSystem<const N: usize> {
         u: &SVector<f64, N>,
     ) -> Hessian<N, 2>;
 
+    /// The input $u_j(x, u)$ the motion needs (the type's `input`), where the system was
+    /// generated with `input_functions = true`; NaN otherwise or for $j \ge m$.
+    fn input_value(&self, j: usize, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> f64 {
+        let _ = (j, x, u);
+        f64::NAN
+    }
+
+    /// The gradient of $u_j$ in $(x, u)$ (`input_functions = true`; zero otherwise).
+    fn input_gradient(
+        &self,
+        j: usize,
+        x: &[SVector<f64, N>; 2],
+        u: &SVector<f64, N>,
+    ) -> Gradient<N, 2> {
+        let _ = (j, x, u);
+        Gradient::zeros()
+    }
+
+    /// The Hessian of $u_j$ in $(x, u)$ (`input_functions = true`; zero otherwise).
+    fn input_hessian(
+        &self,
+        j: usize,
+        x: &[SVector<f64, N>; 2],
+        u: &SVector<f64, N>,
+    ) -> Hessian<N, 2> {
+        let _ = (j, x, u);
+        Hessian::zeros()
+    }
+
     /// The system's type name, for messages.
     fn system_name(&self) -> &'static str {
         "mechanical system"
@@ -90,6 +120,38 @@ impl<S: MechanicalSystem<N> + ?Sized, const N: usize> JetFunction<N, 2> for Torq
 
     fn hessian(&self, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> Hessian<N, 2> {
         self.system.torque_hessian(self.index, x, u)
+    }
+
+    fn name(&self) -> &'static str {
+        self.system.system_name()
+    }
+}
+
+/// The input component $u_j$ of `system` ([`MechanicalSystem::input_value`]: the $j$-th
+/// input the motion needs, $\tau_{a_j}$ on the $j$-th actuated coordinate or the $j$-th
+/// component of the solution of $B u = \tau$) as a [`JetFunction`] $g(x, q'') = u_j$, for
+/// bounds on the inputs: `with_function_bounds(&inputs[j], lower, upper)` keeps
+/// lower $\le u_j \le$ upper at every step. The generated method `input_functions()` (with
+/// `#[mechanical_system(input_functions = true)]`) returns one per input.
+#[derive(Clone, Copy, Debug)]
+pub struct InputComponent<'a, S: ?Sized> {
+    /// The system.
+    pub system: &'a S,
+    /// The input's index $j$, below the number of inputs $m$.
+    pub index: usize,
+}
+
+impl<S: MechanicalSystem<N> + ?Sized, const N: usize> JetFunction<N, 2> for InputComponent<'_, S> {
+    fn value(&self, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> f64 {
+        self.system.input_value(self.index, x, u)
+    }
+
+    fn gradient(&self, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> Gradient<N, 2> {
+        self.system.input_gradient(self.index, x, u)
+    }
+
+    fn hessian(&self, x: &[SVector<f64, N>; 2], u: &SVector<f64, N>) -> Hessian<N, 2> {
+        self.system.input_hessian(self.index, x, u)
     }
 
     fn name(&self) -> &'static str {

@@ -116,7 +116,10 @@ pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
 /// generated type (named after the function in UpperCamelCase, or `name = ...`; the
 /// parameters are its public fields, as for `#[higher_order_lagrangian]`) has the methods
 /// `tau(&q, &dq, &ddq)`, `mass_matrix(&q, &dq)`, `nonconservative_force(&q, &dq)`,
-/// `input(&q, &dq, &ddq)` (the u the motion needs) and `input_force(&q, &u)` (B(q) u), and is
+/// `input(&q, &dq, &ddq)` (the u the motion needs) and `input_force(&q, &u)` (B(q) u), with
+/// `input_functions = true` also `input_functions()` (each u_j a `retract::InputComponent`, a
+/// `JetFunction` with its gradient and Hessian, for bounds on the inputs through
+/// `with_function_bounds`; off by default, as each costs a symbolic Hessian), and is
 /// itself the optimal-control Lagrangian of order 2 (`retract::Lagrangian<n, 2>`,
 /// `LiftedSystem`, for `retract::OptimalControlProblem`)
 ///
@@ -150,7 +153,8 @@ pub fn discretization_map(attr: TokenStream, item: TokenStream) -> TokenStream {
 /// `fn thrust(q: [f64; 3], r: f64) -> ([f64; 3], [f64; 3])` the columns of B (`[f64; n]`
 /// for one input), `fn effort(q: [f64; 2], u: [f64; 1], k: f64) -> f64` the cost. Options:
 /// `actuated = [i, ...]` or `input_matrix = f`, `forces = f`, `cost = f`, `weight = R` (a
-/// positive literal, 1 by default), `name = TypeName`, `guard = false`, `helpers = [...]`,
+/// positive literal, 1 by default), `input_functions = true`, `name = TypeName`,
+/// `guard = false`, `helpers = [...]`,
 /// `order = 1` (the only order). Errors at the span: an order other than 1 or an argument that
 /// looks like q'' (`ddq`), an actuated index out of range or repeated, `actuated` with
 /// `input_matrix`, a function that is not a helper, takes an argument the system does not

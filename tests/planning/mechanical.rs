@@ -14,7 +14,8 @@ use retract::{
 };
 
 use crate::cart_pole::{
-    CartPole, CartPoleEnergy, DampedCartPole, PoleTorque, PushedCartPole, cart_force, pole_torque,
+    CartForce, CartPole, CartPoleEnergy, DampedCartPole, PoleTorque, PushedCartPole, cart_force,
+    pole_torque,
 };
 use crate::common::{Noise, fd};
 use crate::mechanical_models::{DoublePendulumEnergy, QuadrotorEnergy};
@@ -214,6 +215,118 @@ fn the_cart_pole_swing_up_from_its_energy_is_the_hand_written_plan() {
     let (cost_gap, state_gap) = plan_gaps(&through_b, &got);
     assert!(cost_gap <= 1e-10, "through B, cost: {cost_gap:e}");
     assert!(state_gap <= 1e-9, "through B, states: {state_gap:e}");
+}
+
+/// The inputs as functions of the jet (`input_functions = true`): their values are `input`,
+/// their gradients and Hessians those of finite differences, with actuated coordinates and
+/// through the actuation matrix.
+#[test]
+fn the_input_functions_are_the_input_with_its_derivatives() {
+    let actuated = CartPoleEnergy::new(1.0, 0.3, 0.5, 9.81);
+    let through_b = PushedCartPole::new(1.0, 0.3, 0.5, 9.81);
+    let (first, second) = (actuated.input_functions(), through_b.input_functions());
+    let functions: [&dyn JetFunction<2, 2>; 2] = [&first[0], &second[0]];
+    let mut noise = Noise::new(17);
+    for _ in 0..50 {
+        let [q, dq, ddq] = point(&mut noise).map(SVector::from);
+        let x = [q, dq];
+        let want = actuated.input(&q, &dq, &ddq)[0];
+        assert!((want - cart_force(q.into(), dq.into(), ddq.into(), 1.0, 0.3, 0.5)).abs() < 1e-12);
+        for (which, f) in functions.iter().enumerate() {
+            assert!(
+                (f.value(&x, &ddq) - want).abs() <= 1e-12 * (1.0 + want.abs()),
+                "{which}"
+            );
+            // the jet (q, q', q'') as one vector of 6: the value, the gradient and the Hessian
+            // there, flattened in that order
+            let split = |v: &[f64; 6]| {
+                let x = [SVector::from([v[0], v[1]]), SVector::from([v[2], v[3]])];
+                (x, SVector::from([v[4], v[5]]))
+            };
+            let gradient_at = |v: &[f64; 6]| {
+                let (x, u) = split(v);
+                let g = f.gradient(&x, &u);
+                [g.x[0][0], g.x[0][1], g.x[1][0], g.x[1][1], g.u[0], g.u[1]]
+            };
+            let v0 = [q[0], q[1], dq[0], dq[1], ddq[0], ddq[1]];
+            let hessian = f.hessian(&x, &ddq);
+            let block = |i: usize, j: usize| match (i / 2, j / 2) {
+                (2, 2) => hessian.uu[(i % 2, j % 2)],
+                (a, 2) => hessian.xu[a][(i % 2, j % 2)],
+                (2, b) => hessian.xu[b][(j % 2, i % 2)],
+                (a, b) => hessian.xx[a][b][(i % 2, j % 2)],
+            };
+            let moved = |i: usize, e: f64| {
+                let mut v = v0;
+                v[i] += e;
+                v
+            };
+            for (i, &generated) in gradient_at(&v0).iter().enumerate() {
+                let g_fd = fd(
+                    |e| {
+                        let (x, u) = split(&moved(i, e));
+                        f.value(&x, &u)
+                    },
+                    1e-4,
+                );
+                assert!(
+                    (generated - g_fd).abs() <= 1e-7 * (1.0 + g_fd.abs()),
+                    "{which} d{i}: {generated} vs {g_fd}"
+                );
+                for j in 0..6 {
+                    let h_fd = fd(|e| gradient_at(&moved(j, e))[i], 1e-4);
+                    assert!(
+                        (block(i, j) - h_fd).abs() <= 1e-6 * (1.0 + h_fd.abs()),
+                        "{which} d{i}d{j}: {} vs {h_fd}",
+                        block(i, j)
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A bound on the cart force written through the generated input function is the bound on
+/// the hand-written force: the same plan (the constrained suite's |F| <= 12 at T = 2, fewer
+/// steps), with the bound active.
+#[test]
+fn a_bound_on_the_generated_input_is_the_hand_written_bound() {
+    let (t_end, steps, limit) = (2.0, 50, 12.0);
+    let goal = [0.0, PI, 0.0, 0.0];
+    let (hand, hand_torque, hand_force) = (
+        CartPole::new(1.0, 0.3, 0.5),
+        PoleTorque::new(0.3, 0.5, 9.81),
+        CartForce::new(1.0, 0.3, 0.5),
+    );
+    let want = OptimalControlProblem::new(&hand, &[0.0; 4], &goal, t_end, steps)
+        .with_equality(&hand_torque)
+        .with_function_bounds(&hand_force, -limit, limit)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let system = CartPoleEnergy::new(1.0, 0.3, 0.5, 9.81);
+    let (passive, inputs) = (system.unactuated_torques(), system.input_functions());
+    let got = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, steps)
+        .with_equalities(&passive)
+        .with_function_bounds(&inputs[0], -limit, limit)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let (cost_gap, state_gap) = plan_gaps(&got, &want);
+    assert!(cost_gap <= 1e-10, "cost: {cost_gap:e}");
+    assert!(state_gap <= 1e-9, "states: {state_gap:e}");
+    // the bound is active and holds at every step's midpoint
+    let forces: Vec<f64> = (0..steps)
+        .map(|i| {
+            let x = (got.x[i] + got.x[i + 1]) * 0.5;
+            let (q, dq) = (SVector::from([x[0], x[1]]), SVector::from([x[2], x[3]]));
+            system.input(&q, &dq, &got.u[i])[0]
+        })
+        .collect();
+    let largest = forces.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+    assert!(largest <= limit + 1e-6, "largest force {largest}");
+    assert!(
+        largest >= limit - 1e-3,
+        "the bound is not active: {largest}"
+    );
 }
 
 /// The double pendulum's swing-up planned from its energy is the plan of the hand-written

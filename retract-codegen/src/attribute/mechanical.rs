@@ -173,12 +173,18 @@ impl Passes for MechanicalPasses {
             Some(columns) => Inputs::Matrix(columns),
             None => Inputs::Coordinates(&actuated),
         };
-        let euler_lagrange =
-            euler_lagrange::build(graph, lowered.root, n, lowered.forces.as_deref(), inputs)
-                .map_err(|reason| match reason {
-                    Ok(reason) => not_mechanical(sig, reason),
-                    Err(bad) => bad_input_matrix(&self.actuation, bad, n),
-                })?;
+        let euler_lagrange = euler_lagrange::build(
+            graph,
+            lowered.root,
+            n,
+            lowered.forces.as_deref(),
+            inputs,
+            self.actuation.input_functions,
+        )
+        .map_err(|reason| match reason {
+            Ok(reason) => not_mechanical(sig, reason),
+            Err(bad) => bad_input_matrix(&self.actuation, bad, n),
+        })?;
         // the user's cost and every guard with u_j in place of its placeholder
         let input = euler_lagrange.input.clone();
         let with_input = |_: &mut Graph, v: Var| match v {
@@ -440,12 +446,24 @@ mod tests {
         ] {
             assert!(out.contains(item), "{item} missing:\n{out}");
         }
+        // the input functions only where asked for (each costs a symbolic Hessian)
+        assert!(!out.contains("fn input_functions(") && !out.contains("fn input_value("));
         // fully actuated by default: no equality
         let out = expand("", "", ENERGY).unwrap();
         assert!(
             out.contains("pub const UNACTUATED: [usize; 0] = []"),
             "{out}"
         );
+        let out = expand("actuated = [1], input_functions = true", "", ENERGY).unwrap();
+        for item in [
+            "pub fn input_functions(",
+            "InputComponent<'_, Self>; 1]",
+            "fn input_value(",
+            "fn input_gradient(",
+            "fn input_hessian(",
+        ] {
+            assert!(out.contains(item), "{item} missing:\n{out}");
+        }
     }
 
     #[test]
@@ -462,6 +480,7 @@ mod tests {
         assert!(err("actuated = []", "", ENERGY).contains("at least one"));
         assert!(err("actuated = [a]", "", ENERGY).contains("integer literals"));
         assert!(err("weight = -1.0", "", ENERGY).contains("positive finite"));
+        assert!(err("input_functions = 1", "", ENERGY).contains("`true` or `false`"));
         assert!(err("sphere", "", ENERGY).contains("unsupported option"));
         assert!(err("", "", "q[0].cos()").contains("no kinetic energy"));
         assert!(err("", "", "dq[0] + q[0]").contains("linear in `dq`"));

@@ -1,10 +1,10 @@
 //! The items of a mechanical system (`#[mechanical_system]`) beyond those of its order-2
 //! optimal-control Lagrangian: the inherent methods `tau` (inverse dynamics), `mass_matrix`,
-//! `nonconservative_force`, `input` (the u a motion needs) and `unactuated_torques` with the
-//! constants `INPUTS`, `PASSIVE` (and `ACTUATED`, `UNACTUATED` where the actuation names
-//! coordinates), `plant` and `input_force`, and the impl of `retract_core::MechanicalSystem`
-//! (each passive equality with its gradient and Hessian in (x, u), for the optimizer's stage
-//! equalities).
+//! `nonconservative_force`, `input` (the u a motion needs), `unactuated_torques` and, where
+//! asked for, `input_functions` with the constants `INPUTS`, `PASSIVE` (and `ACTUATED`,
+//! `UNACTUATED` where the actuation names coordinates), `plant` and `input_force`, and the
+//! impl of `retract_core::MechanicalSystem` (each passive equality and each input function
+//! with its gradient and Hessian in (x, u), for the optimizer's stage constraints).
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -13,7 +13,7 @@ use super::Emission;
 use super::helpers::{Names, ParamTokens, index};
 use super::scalar::{ScalarBodies, scalar_bodies};
 use crate::emit::codegen::emit;
-use crate::mechanics::euler_lagrange::EulerLagrange;
+use crate::mechanics::euler_lagrange::{Component, EulerLagrange};
 
 /// The inherent impl and the `MechanicalSystem` impl of the system `e` with the
 /// Euler-Lagrange operator `el` and the actuated coordinates `actuated`.
@@ -86,6 +86,21 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
     let components = passive.iter().map(|&c| {
         let c = index(c);
         quote!(#core::TorqueComponent { system: self, index: #c })
+    });
+    let input_functions = (!el.input_functions.is_empty()).then(|| {
+        let each = (0..el.input.len()).map(|j| {
+            let j = index(j);
+            quote!(#core::InputComponent { system: self, index: #j })
+        });
+        quote! {
+            /// The inputs u_j(q, q', q'') (`input`) as functions of the jet, each with its
+            /// gradient and Hessian, for bounds on the inputs:
+            /// `OptimalControlProblem::with_function_bounds(&inputs[j], lower, upper)`.
+            #[must_use]
+            pub fn input_functions(&self) -> [#core::InputComponent<'_, Self>; #m_lit] {
+                [#(#each),*]
+            }
+        }
     });
     let coordinates = actuated.map(|actuated| {
         let a_len = index(actuated.len());
@@ -160,6 +175,8 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
             pub fn unactuated_torques(&self) -> [#core::TorqueComponent<'_, Self>; #p_len] {
                 [#(#components),*]
             }
+
+            #input_functions
         }
     }
 }
@@ -215,14 +232,15 @@ fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, el: &EulerLagrange) -> 
     }
 }
 
-/// `impl MechanicalSystem<n>`: the unactuated components of tau in (x, u).
-fn mechanical_system_impl(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenStream {
-    let (core, n_lit, vec_n, jet_blocks) = (&e.core, &e.n_lit, &e.vec_n, &e.jet_blocks);
-    let header = e.impl_header(quote!(MechanicalSystem<#n_lit>));
+/// The `match` arms of the value, the gradient and the Hessian of `components`, by label.
+fn component_arms(
+    e: &Emission<'_>,
+    components: &[Component],
+) -> (Vec<TokenStream>, Vec<TokenStream>, Vec<TokenStream>) {
     let mut values = Vec::new();
     let mut gradients = Vec::new();
     let mut hessians = Vec::new();
-    for component in &el.unactuated {
+    for component in components {
         let ScalarBodies {
             value,
             gradient,
@@ -239,6 +257,51 @@ fn mechanical_system_impl(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usiz
         gradients.push(quote!(#c => { #gradient }));
         hessians.push(quote!(#c => { #hessian }));
     }
+    (values, gradients, hessians)
+}
+
+/// The `input_value`, `input_gradient` and `input_hessian` methods of the input functions
+/// (none where they were not asked for: the trait's defaults, NaN and zeros).
+fn input_methods(e: &Emission<'_>, el: &EulerLagrange) -> Option<TokenStream> {
+    if el.input_functions.is_empty() {
+        return None;
+    }
+    let (core, n_lit, vec_n, jet_blocks) = (&e.core, &e.n_lit, &e.vec_n, &e.jet_blocks);
+    let (values, gradients, hessians) = component_arms(e, &el.input_functions);
+    Some(quote! {
+        /// u_j(x, u), straight-line code (NaN for j >= m).
+        fn input_value(&self, j: usize, x: &#jet_blocks, u: &#vec_n) -> f64 {
+            match j {
+                #(#values)*
+                _ => f64::NAN,
+            }
+        }
+
+        /// The gradient of u_j (zero for j >= m).
+        fn input_gradient(&self, j: usize, x: &#jet_blocks, u: &#vec_n) -> #core::Gradient<#n_lit, 2> {
+            match j {
+                #(#gradients)*
+                _ => #core::Gradient::zeros(),
+            }
+        }
+
+        /// The Hessian of u_j (zero for j >= m).
+        fn input_hessian(&self, j: usize, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, 2> {
+            match j {
+                #(#hessians)*
+                _ => #core::Hessian::zeros(),
+            }
+        }
+    })
+}
+
+/// `impl MechanicalSystem<n>`: the unactuated components of tau and the input functions in
+/// (x, u).
+fn mechanical_system_impl(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usize]) -> TokenStream {
+    let (core, n_lit, vec_n, jet_blocks) = (&e.core, &e.n_lit, &e.vec_n, &e.jet_blocks);
+    let header = e.impl_header(quote!(MechanicalSystem<#n_lit>));
+    let (values, gradients, hessians) = component_arms(e, &el.unactuated);
+    let inputs = input_methods(e, el);
     let a_list = actuated.iter().map(|&i| index(i));
     let u_list = el.unactuated.iter().map(|u| index(u.index));
     let name = e.sig.type_name.to_string();
@@ -275,6 +338,8 @@ fn mechanical_system_impl(e: &Emission<'_>, el: &EulerLagrange, actuated: &[usiz
                     _ => #core::Hessian::zeros(),
                 }
             }
+
+            #inputs
 
             fn system_name(&self) -> &'static str {
                 #name

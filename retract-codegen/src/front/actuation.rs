@@ -2,7 +2,9 @@
 //! actuators drive (`actuated = [i, ...]`, all of them by default) or the actuation matrix
 //! B(q) (`input_matrix = f`, a helper returning its columns), the weight R of the effort
 //! 1/2 R |u|^2 (`weight = R`, 1 by default), the non-conservative generalized forces
-//! Q_nc(q, q') (`forces = f`) and a cost C(q, q', u) added to the effort (`cost = f`), each
+//! Q_nc(q, q') (`forces = f`), a cost C(q, q', u) added to the effort (`cost = f`) and
+//! whether the inputs are emitted as functions of the jet with their derivatives, for bounds
+//! on them (`input_functions = true`, false by default: each costs a symbolic Hessian), each
 //! error at its span. The functions are helpers (`#[helper]` before the system, or `fn`s in
 //! its body) whose arguments are taken by name (`front::lower`'s `call_by_name`).
 
@@ -12,7 +14,14 @@ use syn::spanned::Spanned;
 use crate::util::ErrorContext;
 
 /// The options this module reads (`front::signature` skips them).
-pub(crate) const OPTIONS: [&str; 5] = ["actuated", "weight", "forces", "input_matrix", "cost"];
+pub(crate) const OPTIONS: [&str; 6] = [
+    "actuated",
+    "weight",
+    "forces",
+    "input_matrix",
+    "cost",
+    "input_functions",
+];
 
 /// The actuation of a mechanical system, as written.
 pub(crate) struct Actuation {
@@ -26,6 +35,8 @@ pub(crate) struct Actuation {
     pub input_matrix: Option<syn::Ident>,
     /// The helper returning the cost C(q, q', u) as an `f64`.
     pub cost: Option<syn::Ident>,
+    /// Whether u_j(q, q', q'') is emitted with its gradient and Hessian (`input_functions()`).
+    pub input_functions: bool,
 }
 
 impl Actuation {
@@ -66,7 +77,7 @@ impl Actuation {
     }
 }
 
-/// Reads `actuated` and `weight` from the attribute's options, skipping the others.
+/// Reads the options of this module (`OPTIONS`) from the attribute's, skipping the others.
 pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
     let mut out = Actuation {
         actuated: None,
@@ -74,6 +85,7 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
         forces: None,
         input_matrix: None,
         cost: None,
+        input_functions: false,
     };
     let parser = syn::meta::parser(|meta| {
         if meta.path.is_ident("actuated") {
@@ -122,6 +134,22 @@ pub(crate) fn parse(attr: TokenStream) -> syn::Result<Actuation> {
                     ),
                 )
             })?);
+        } else if meta.path.is_ident("input_functions") {
+            let value: syn::Expr = meta.value()?.parse()?;
+            out.input_functions = match &value {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Bool(b),
+                    ..
+                }) => b.value,
+                _ => {
+                    return Err(syn::Error::new(
+                        value.span(),
+                        "`input_functions` is `true` or `false`: whether each input u_j is \
+                         emitted as a function of the jet with its derivatives \
+                         (`input_functions()`, for bounds on the inputs)",
+                    ));
+                }
+            };
         } else if meta.path.is_ident("weight") {
             let value: syn::Expr = meta.value()?.parse()?;
             let weight = match &value {

@@ -47,6 +47,8 @@ pub struct EulerLagrange {
     /// The passive equalities: with actuated coordinates, tau_c of each unactuated c
     /// (labelled c), ascending; with an actuation matrix, a^T tau (labelled 0) where m = n - 1.
     pub unactuated: Vec<Component>,
+    /// The inputs u_j with their derivatives (labelled j), where asked for; else empty.
+    pub input_functions: Vec<Component>,
 }
 
 /// How the inputs drive the coordinates.
@@ -57,12 +59,12 @@ pub enum Inputs<'a> {
     Matrix(Vec<Vec<Id>>),
 }
 
-/// A component tau_c with its gradient and Hessian in (q, q', q'') (as
-/// `mechanics::derivatives` orders them).
+/// A function of the jet (a passive equality tau_c, or an input u_j) with its gradient and
+/// Hessian in (q, q', q'') (as `mechanics::derivatives` orders them).
 pub struct Component {
-    /// The coordinate c.
+    /// The label: the coordinate c, or the input j.
     pub index: usize,
-    /// tau_c.
+    /// Its value.
     pub value: Id,
     /// Its gradient.
     pub gradient: Vec<Id>,
@@ -93,14 +95,16 @@ pub enum BadInputMatrix {
 }
 
 /// The Euler-Lagrange operator of `l` on R^n with the forces `forces` (Q_nc, n entries) and
-/// the inputs `inputs` (module docs), or why M cannot be a mass matrix (`Err(Ok(_))`) or B
-/// cannot be an actuation matrix (`Err(Err(_))`).
+/// the inputs `inputs` (module docs), with the derivatives of the inputs where
+/// `input_functions`, or why M cannot be a mass matrix (`Err(Ok(_))`) or B cannot be an
+/// actuation matrix (`Err(Err(_))`).
 pub fn build(
     g: &mut Graph,
     l: Id,
     n: usize,
     forces: Option<&[Id]>,
     inputs: Inputs<'_>,
+    input_functions: bool,
 ) -> Result<EulerLagrange, Result<NotMechanical, BadInputMatrix>> {
     let mut d = Differentiator::default();
     let jet = |order: u8, i: usize| Var::Jet {
@@ -158,18 +162,21 @@ pub fn build(
             )
         }
     };
-    let unactuated = passive
-        .into_iter()
-        .map(|(index, value)| {
-            let (_, gradient, hessian) = derivatives(g, value, n, 2);
-            Component {
-                index,
-                value,
-                gradient,
-                hessian,
-            }
-        })
-        .collect();
+    let mut component = |(index, value): (usize, Id)| {
+        let (_, gradient, hessian) = derivatives(g, value, n, 2);
+        Component {
+            index,
+            value,
+            gradient,
+            hessian,
+        }
+    };
+    let unactuated = passive.into_iter().map(&mut component).collect();
+    let input_functions = if input_functions {
+        input.iter().copied().enumerate().map(component).collect()
+    } else {
+        Vec::new()
+    };
     Ok(EulerLagrange {
         tau,
         mass,
@@ -177,6 +184,7 @@ pub fn build(
         input,
         input_matrix,
         unactuated,
+        input_functions,
     })
 }
 
