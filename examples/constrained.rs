@@ -1,8 +1,11 @@
-//! The constrained suite C1-C4 of `../shared/BENCHMARKS.md`, solved by the optimizer at its
+//! The constrained suite C1-C5 of `../shared/BENCHMARKS.md`, solved by the optimizer at its
 //! default options from the suite's first guesses: the cart-pole with a force bound, the planar
-//! quadrotor past a disc with thrust limits, parallel parking in a slot and chains of 3 and 7
-//! links with joint limits. One line per problem:
-//! `<name> J=<J> iterations=<n> time_ms=<t> max_violation=<v> min_reduced_hessian_eig=<e>`.
+//! quadrotor past a disc with thrust limits, parallel parking in a slot, chains of 3 and 7
+//! links with joint limits, and the cart-pole's minimum-time swing-up (a free final time,
+//! from its energy). One line per problem:
+//! `<name> J=<J> iterations=<n> time_ms=<t> max_violation=<v> min_reduced_hessian_eig=<e>`,
+//! with `T=<T>` after `J` for the free final time (its `iterations` those of all its
+//! fixed-horizon solves).
 //!
 //! Run: `cargo run --release --example constrained` (add `-- quick` for a smaller version of
 //! each problem: a tenth of the steps; `cargo test --example constrained` runs that as a test,
@@ -11,12 +14,12 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use retract::bvp::{Curve, OptimalControlProblem, Plan, PlanError, PlanGuess};
+use retract::bvp::{Curve, FreeTime, OptimalControlProblem, Plan, PlanError, PlanGuess, Variable};
 use retract::{higher_order_lagrangian, jet_function};
 
 #[path = "common/cart_pole.rs"]
 mod cart_pole;
-use cart_pole::{CartForce, CartPole, PoleTorque};
+use cart_pole::{CartForce, CartPole, MinTimeCartPole, PoleTorque};
 
 const G: f64 = 9.81;
 
@@ -183,6 +186,40 @@ fn cart_pole_suite(quick: bool) -> Outcome {
     outcome
 }
 
+/// C5: the cart-pole from rest hanging to rest upright in the least T + int 0.01 1/2 F^2,
+/// T in [0.5, 5], |F| <= 10 at the midpoints, |x| <= 1 at nodes and midpoints, N = 100, from
+/// the smoothstep of T = 3.
+fn min_time_suite(quick: bool) -> Outcome {
+    let system = MinTimeCartPole::new(1.0, 0.3, 0.5, G);
+    let (passive, force) = (system.unactuated_torques(), system.input_functions());
+    let steps = if quick { 10 } else { 100 };
+    let start = Instant::now();
+    let result = OptimalControlProblem::new(&system, &[0.0; 4], &[0.0, PI, 0.0, 0.0], 3.0, steps)
+        .with_equalities(&passive)
+        .with_function_bounds(&force[0], -10.0, 10.0)
+        .with_bounds(Variable::Jet(0), -1.0, 1.0)
+        .solve_free_time(FreeTime::new(0.5, 5.0, 1.0), PlanGuess::Spline);
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    match result {
+        Ok(free) => {
+            println!(
+                "cartpole-mintime J={:.8} T={:.8} iterations={} time_ms={ms:.1} \
+                 max_violation={:.1e} min_reduced_hessian_eig={:.3e}",
+                free.cost,
+                free.t_end,
+                free.iterations,
+                free.plan.violations.imposed(),
+                free.plan.certificate.min_reduced_hessian_eig
+            );
+            Ok(())
+        }
+        Err(e) => {
+            println!("cartpole-mintime failed after {ms:.1} ms: {e}");
+            Err(format!("cartpole-mintime: {e}").into())
+        }
+    }
+}
+
 fn quadrotor_suite(quick: bool) -> Outcome {
     // (every problem runs; the first failure is returned)
     let mut outcome: Outcome = Ok(());
@@ -277,11 +314,12 @@ fn main() {
     let quick = std::env::args().any(|a| a == "quick");
     let only = std::env::args().nth(1).filter(|a| a != "quick");
     let mut failed = false;
-    let suites: [(&str, Suite); 4] = [
+    let suites: [(&str, Suite); 5] = [
         ("cartpole", cart_pole_suite),
         ("quadrotor", quadrotor_suite),
         ("parking", parking_suite),
         ("chain", chain_suite),
+        ("mintime", min_time_suite),
     ];
     for (name, suite) in suites {
         if only.as_ref().is_none_or(|o| o == name) {
@@ -302,7 +340,13 @@ mod tests {
     /// violated beyond the tolerance where it is imposed).
     #[test]
     fn the_suite_is_certified_at_a_tenth_of_its_steps() {
-        for suite in [cart_pole_suite, quadrotor_suite, parking_suite, chain_suite] {
+        for suite in [
+            cart_pole_suite,
+            quadrotor_suite,
+            parking_suite,
+            chain_suite,
+            min_time_suite,
+        ] {
             if let Err(e) = suite(true) {
                 panic!("{e}");
             }

@@ -2,8 +2,8 @@
 //! mass mp at length l, q = (x, theta) with theta from the downward vertical; the cart force
 //! F is actuated, the pole's torque must vanish: the hand-written cost and constraint, and the
 //! same system written as its energy T - V (`#[mechanical_system]`). Shared by
-//! `examples/swing_up.rs`, `examples/constrained.rs`, `examples/cartpole_energy.rs` and the
-//! tests (by path).
+//! `examples/swing_up.rs`, `examples/constrained.rs` (C1 and C5), `examples/cartpole_energy.rs`
+//! and the tests (by path).
 #![allow(dead_code)] // each user takes a subset
 
 use retract::{helper, higher_order_lagrangian, jet_function, mechanical_system};
@@ -50,6 +50,19 @@ pub fn cart_pole_lagrangian(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64,
     helpers = [cart_pole_lagrangian]
 )]
 pub fn cart_pole_energy(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
+    cart_pole_lagrangian(q, dq, mc, mp, l, g)
+}
+
+/// The cart-pole of the minimum-time problem (C5 of `../shared/BENCHMARKS.md`): the effort
+/// 0.01 * 1/2 F^2 (`weight = 0.01`), with the cart force as a function of the jet
+/// (`input_functions()`) for its bound.
+#[mechanical_system(
+    actuated = [0],
+    weight = 0.01,
+    input_functions = true,
+    helpers = [cart_pole_lagrangian]
+)]
+pub fn min_time_cart_pole(q: [f64; 2], dq: [f64; 2], mc: f64, mp: f64, l: f64, g: f64) -> f64 {
     cart_pole_lagrangian(q, dq, mc, mp, l, g)
 }
 

@@ -15,6 +15,7 @@ mod car;
 mod degenerate;
 mod extrapolate;
 mod free_end;
+mod free_time;
 mod inequalities;
 mod mechanical;
 mod mpc;

@@ -45,7 +45,8 @@
 //! 8. `sqp/`: the iteration, one module per phase (`models`, `direction`, `line_search` with
 //!    `filter`, `termination`, `second_order`) over `state`, and the loop in `mod.rs`.
 //! 9. `solve` (the solve front: [`OptimalControlProblem::solve`] and its variants, the first
-//!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]).
+//!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]), `free_time` (the
+//!    horizon as a decision variable, [`FreeTime`], [`FreeTimePlan`]).
 //! 10. `realtime` (real-time iterations in a preparation and a feedback phase,
 //!     [`RealTimeIteration`]).
 //! 11. `batch` (many plans at once: [`solve_batch`], [`solve_stream`],
@@ -111,6 +112,7 @@ mod constraints;
 mod curve;
 mod dynamics;
 mod extrapolate;
+mod free_time;
 mod guess;
 mod iterate;
 mod kkt;
@@ -127,6 +129,7 @@ pub use batch::{Job, MultiStart, Outcome, Stream, solve_batch, solve_stream};
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
+pub use free_time::{FreeTime, FreeTimePlan};
 pub use options::{MAX_INTERIOR_SAMPLES, PlanGuess, PlanOptions};
 pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
