@@ -21,6 +21,10 @@ use retract::{higher_order_lagrangian, jet_function};
 mod cart_pole;
 use cart_pole::{CartForce, CartPole, MinTimeCartPole, PoleTorque};
 
+#[path = "common/parking.rs"]
+mod parking;
+use parking::{CarEffort, SideSlip, Turning};
+
 const G: f64 = 9.81;
 
 /// What a suite returns: an error for its first failure.
@@ -65,26 +69,6 @@ fn rotors(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: 
 #[jet_function(order = 2)]
 fn clearance(q: [f64; 3], _dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
     (q[0] - 1.0).powi(2) + (q[1] - 0.5).powi(2) - 0.09
-}
-
-/// The car's cost 1/2 |q''|^2, q = (x, y, psi).
-#[higher_order_lagrangian(order = 2)]
-fn car_effort(_q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3]) -> f64 {
-    0.5 * (ddq[0] * ddq[0] + ddq[1] * ddq[1] + ddq[2] * ddq[2])
-}
-
-/// No side slip: v_x sin(psi) - v_y cos(psi).
-#[jet_function(order = 2)]
-fn side_slip(q: [f64; 3], dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
-    dq[0] * q[2].sin() - dq[1] * q[2].cos()
-}
-
-/// Turning radius at least 1: s^2 - psi'^2 with the forward speed
-/// s = v_x cos(psi) + v_y sin(psi).
-#[jet_function(order = 2)]
-fn turning(q: [f64; 3], dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
-    let speed = dq[0] * q[2].cos() + dq[1] * q[2].sin();
-    speed * speed - dq[2] * dq[2]
 }
 
 /// The planar n-link chain's cost 1/2 |tau|^2, tau the Euler-Lagrange torques of T - V (unit
@@ -255,14 +239,7 @@ fn parking_suite(quick: bool) -> Outcome {
     let (slip, turn) = (SideSlip::new(), Turning::new());
     let t_end = 6.0;
     let times = [0.0, 1.5, 3.0, 4.5, 6.0];
-    let knots = [
-        [0.0, 0.0, 0.0],
-        [0.3, 0.1, 0.4],
-        [0.4, 0.25, 0.0],
-        [0.2, 0.4, -0.4],
-        [0.0, 0.5, 0.0],
-    ];
-    let guess = Curve::through_waypoints(&times, &knots)?;
+    let guess = Curve::through_waypoints(&times, &parking::WAYPOINTS)?;
     for xbox in [0.8, 0.4] {
         let name = format!("parking-x{xbox}");
         let start = Instant::now();

@@ -1,8 +1,10 @@
 //! Degenerate constraints: a stage equality that leaves a combination of the coordinates
 //! without control authority, so the goal's conditions on it are not independent of the
-//! dynamics (a rank-deficient constraint Jacobian).
+//! dynamics (a rank-deficient constraint Jacobian); and an inequality whose gradient vanishes
+//! where it is active (the parking car's turning radius near rest).
 
-use retract::bvp::{Failure, OptimalControlProblem, PlanGuess};
+use crate::parking::{CarEffort, SideSlip, Turning, WAYPOINTS};
+use retract::bvp::{Curve, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, Variable};
 use retract::{higher_order_lagrangian, jet_function};
 
 #[higher_order_lagrangian(order = 2)]
@@ -64,4 +66,52 @@ fn a_goal_the_equality_cannot_reach_is_named_unreachable() {
     );
     let last = err.last.expect("the last iterate");
     assert!(last.iterations < 20, "{}", last.iterations);
+}
+
+/// Parking (C3 of `BENCHMARKS.md`) in the slot |x| <= 0.8 (T = 6, N = 60) from the suite's
+/// waypoints with x scaled by `x_scale` and psi by `psi_scale`.
+fn park(x_scale: f64, psi_scale: f64) -> Result<Plan<3, 6>, PlanError<3, 6>> {
+    let times = [0.0, 1.5, 3.0, 4.5, 6.0];
+    let knots = WAYPOINTS.map(|[x, y, psi]| [x * x_scale, y, psi * psi_scale]);
+    let guess = Curve::through_waypoints(&times, &knots).expect("waypoints in time order");
+    let goal = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0];
+    OptimalControlProblem::new(&CarEffort::new(), &[0.0; 6], &goal, 6.0, 60)
+        .with_equality(&SideSlip::new())
+        .with_inequality(&Turning::new())
+        .with_bounds(Variable::Jet(0), -0.8, 0.8)
+        .solve(PlanGuess::Curve(&guess))
+}
+
+/// From the waypoints with x scaled by 1.25 the turning constraint is active along the first
+/// arc, where speed and turn rate both vanish toward the start: its slacks used to collapse
+/// (by the fraction to the boundary each step, to 1e-25, with the constraint's value still
+/// positive) until its barrier weight left the Riccati pivots singular at every inertia
+/// correction, and the solve ended in the inertia correction's failure (reported as a stall
+/// at an infeasible point). Now it ends at a certified minimum.
+#[test]
+fn a_degenerate_active_inequality_does_not_end_the_solve() {
+    let plan = park(1.25, 1.0).unwrap_or_else(|e| panic!("{e}"));
+    let c = &plan.certificate;
+    assert_eq!(c.negative_directions, 0);
+    assert!(c.min_reduced_hessian_eig > 0.0, "{c:?}");
+    assert!(c.stationarity <= 1e-6 && c.feasibility <= 1e-9, "{c:?}");
+    assert!(plan.violations.imposed() <= 1e-9, "{:?}", plan.violations);
+}
+
+/// From the suite's waypoints with x scaled by 0.5 to 1.25 and psi by 0.5 to 1.5, no solve
+/// ends in the inertia correction's failure or a stall, and every failure's last iterate
+/// reports a finite stationarity (a saddle may be refused as not a minimum).
+#[test]
+fn parking_from_twelve_guesses_never_fails_the_inertia_correction() {
+    for x_scale in [0.5, 0.75, 1.0, 1.25] {
+        for psi_scale in [0.5, 1.0, 1.5] {
+            let Err(e) = park(x_scale, psi_scale) else {
+                continue;
+            };
+            let case = format!("x * {x_scale}, psi * {psi_scale}: {e}");
+            assert!(matches!(e.failure, Failure::NotAMinimum { .. }), "{case}");
+            let last = e.last.as_ref().expect("the last iterate");
+            assert!(last.certificate.stationarity.is_finite(), "{case}");
+        }
+    }
 }

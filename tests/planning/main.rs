@@ -39,6 +39,10 @@ mod cart_pole;
 #[path = "../../examples/common/car.rs"]
 mod car_models;
 
+// the parking car of the constrained suite, shared with `examples/constrained.rs`
+#[path = "../../examples/common/parking.rs"]
+mod parking;
+
 // the double pendulum's models and receding-horizon loop, shared with the examples
 #[path = "../../examples/common/pendulum.rs"]
 mod pendulum;

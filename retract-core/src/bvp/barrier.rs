@@ -30,6 +30,14 @@ use super::kkt::riccati::Direction;
 /// The smallest slack of a warm start ([`Barrier::warm`]).
 pub(super) const WARM_SLACK_PUSH: f64 = 1e-3;
 
+/// IPOPT's $\kappa_\Sigma$: the multipliers are kept in $[\mu / (\kappa_\Sigma s),
+/// \kappa_\Sigma \mu / s]$.
+const KAPPA_SIGMA: f64 = 1e10;
+
+/// The ratio $s / g$ below which a slack is reset to its inequality's value $g > 0$
+/// ([`Barrier::reset_slacks`]).
+const SLACK_RESET: f64 = 1e-3;
+
 /// Barrier parameter, slacks and multipliers: `count` per step (step-major), then `nodes`
 /// per interior node $x_1, \dots, x_{N-1}$ (node-major).
 pub(super) struct Barrier {
@@ -423,8 +431,33 @@ impl Barrier {
             self.y[k] += alpha * (self.z[k] + dzk - self.y[k]);
             self.s[k] += alpha * ds[k];
             let s = self.s[k];
-            self.z[k] = (self.z[k] + alpha_z * dzk).clamp(self.mu / (1e10 * s), 1e10 * self.mu / s);
+            self.z[k] = (self.z[k] + alpha_z * dzk)
+                .clamp(self.mu / (KAPPA_SIGMA * s), KAPPA_SIGMA * self.mu / s);
         }
+    }
+
+    /// The slack reset after a step (as KNITRO's, Waltz, Morales, Nocedal and Orban, Math.
+    /// Program. 107, 2006): where a slack has fallen below [`SLACK_RESET`] times its
+    /// inequality's value $g_k > 0$ at the new iterate (`values`), $s_k \leftarrow g_k$ and
+    /// $z_k$ is clipped to $[\mu / (\kappa_\Sigma s_k), \kappa_\Sigma \mu / s_k]$. That
+    /// lowers both the violation $|g - s|$ and the barrier term $-h \mu \ln s$. Without it
+    /// the slack of a degenerate inequality (its gradient vanishing where it is active, as
+    /// $v^2 - \omega^2 \ge 0$ near rest) shrinks by the fraction to the boundary at every
+    /// step while $g$ stays positive, and its weight $h (z/s) \nabla g \nabla g^T$ in the stage
+    /// Hessians grows past $10^{16}$ times the rest: the Riccati pivots are then singular in
+    /// floating point at every inertia correction below $10^{-13}$ of that weight. Returns
+    /// the number of slacks reset.
+    pub fn reset_slacks(&mut self, values: &[f64]) -> usize {
+        let mut reset = 0;
+        for (k, g) in values.iter().enumerate() {
+            if self.s[k] < SLACK_RESET * g {
+                let s = *g;
+                self.s[k] = s;
+                self.z[k] = self.z[k].clamp(self.mu / (KAPPA_SIGMA * s), KAPPA_SIGMA * self.mu / s);
+                reset += 1;
+            }
+        }
+        reset
     }
 
     /// Lowers $\mu$ towards `floor` by IPOPT's monotone rule on the transcribed problem's

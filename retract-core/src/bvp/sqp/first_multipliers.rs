@@ -36,6 +36,33 @@ where
         models: &Models<N, X>,
         barrier: &Barrier,
     ) -> Option<Direction<N, X>> {
+        let direction = self.least_squares_direction(models, barrier)?;
+        let largest = direction
+            .multipliers
+            .iter()
+            .flat_map(|y| y.iter())
+            .fold(0.0_f64, |m, y| {
+                if y.is_finite() {
+                    m.max(y.abs())
+                } else {
+                    f64::INFINITY
+                }
+            });
+        if largest <= MAX_FIRST_MULTIPLIER {
+            Some(direction)
+        } else {
+            direction.recycle(&mut *self.pool.borrow_mut());
+            None
+        }
+    }
+
+    /// The solution of [`Self::least_squares_multipliers`]' system, whatever the size of its
+    /// multipliers; `None` if its factorisation is not positive definite.
+    pub(super) fn least_squares_direction(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+    ) -> Option<Direction<N, X>> {
         let h = self.dynamics.h;
         let mut pool = self.pool.borrow_mut();
         let mut gradients = pool.gradients.take(models.cost_gradient.len());
@@ -68,23 +95,6 @@ where
         pool.stages.give(stages);
         pool.gradients.give(gradients);
         pool.jets.give(nodes);
-        let direction = direction?;
-        let largest = direction
-            .multipliers
-            .iter()
-            .flat_map(|y| y.iter())
-            .fold(0.0_f64, |m, y| {
-                if y.is_finite() {
-                    m.max(y.abs())
-                } else {
-                    f64::INFINITY
-                }
-            });
-        if largest <= MAX_FIRST_MULTIPLIER {
-            Some(direction)
-        } else {
-            direction.recycle(&mut *pool);
-            None
-        }
+        direction
     }
 }

@@ -170,7 +170,8 @@ where
     }
 
     /// Moves to the `accepted` point along `direction` with slack steps `ds` (or along its
-    /// corrected step): the iterate; the slacks and the multipliers $z$ by its step length;
+    /// corrected step): the iterate; the slacks and the multipliers $z$ by its step length
+    /// (then the slacks far below their inequality's value reset, [`Barrier::reset_slacks`]);
     /// the stage equalities' multipliers `y` toward the direction's by the same primal step
     /// length. Returns the step length, whether the decrease was at rounding level and
     /// whether the step was the direction itself (not a correction).
@@ -189,6 +190,12 @@ where
         let left = core::mem::replace(iterate, accepted.trial);
         self.give_iterate(left);
         barrier.update(ds, alpha);
+        if !barrier.s.is_empty() {
+            let mut values = self.pool.borrow_mut().reals.take(barrier.s.len());
+            self.inequality_values(iterate, &mut values);
+            barrier.reset_slacks(&values);
+            self.pool.borrow_mut().reals.give(values);
+        }
         for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
             *yi += (target - *yi) * alpha;
         }

@@ -264,8 +264,7 @@ where
             let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
                 Ok(sub) => sub,
                 Err(failure) => {
-                    let mut partial = super::plan::certificate::unknown_certificate();
-                    partial.feasibility = models.violation_max();
+                    let partial = self.failure_certificate(&models, &st.barrier);
                     let failure = self.name_infeasibility(failure, &st.iterate);
                     return Err(fail(failure, models.cost, partial, vec![]));
                 }

@@ -102,6 +102,17 @@ where
         Some((hessian, SVector::zeros()))
     }
 
+    /// The values of every inequality at `iterate` into `values`, in the barrier's order:
+    /// those at the steps (step-major), then those at the interior nodes (node-major).
+    pub(super) fn inequality_values(&self, iterate: &Iterate<N, X>, values: &mut Vec<f64>) {
+        values.clear();
+        for (i, u) in iterate.u.iter().enumerate() {
+            let xt = self.x_theta(iterate, i);
+            values.extend(self.at_steps.iter().map(|c| c.value(&xt, u)));
+        }
+        self.node_values(iterate, values);
+    }
+
     /// Appends the values of the node inequalities at the interior nodes (node-major).
     pub(super) fn node_values(&self, iterate: &Iterate<N, X>, values: &mut Vec<f64>) {
         let zero = SVector::<f64, N>::zeros();

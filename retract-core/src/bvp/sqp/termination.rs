@@ -97,6 +97,30 @@ where
         (momenta, certificate, scale)
     }
 
+    /// The certificate at the iterate of `models` where no subproblem could be solved (the
+    /// inertia-corrected factorisation failed): the residuals with the least-squares
+    /// multipliers ([`Self::least_squares_direction`]: the stationarity is the smallest the
+    /// equalities' multipliers allow there), or where those cannot be computed (a
+    /// rank-deficient Jacobian of the equalities) a stationarity of $\infty$; never NaN.
+    pub(super) fn failure_certificate(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+    ) -> Certificate {
+        let Some(direction) = self.least_squares_direction(models, barrier) else {
+            let mut certificate = crate::bvp::plan::certificate::unknown_certificate();
+            certificate.stationarity = f64::INFINITY;
+            certificate.feasibility = models.violation_max();
+            certificate.complementarity = barrier.complementarity().0;
+            return certificate;
+        };
+        let (momenta, certificate, _) = self.residuals(models, barrier, 0, &direction, &barrier.z);
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(momenta);
+        direction.recycle(&mut *pool);
+        certificate
+    }
+
     /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
     /// `barrier_error`) at the models' iterate with the subproblem's solution `direction`:
     /// the smaller of its values with the predicted inequality multipliers `z` and with the
