@@ -91,7 +91,7 @@ impl Default for BvpOptions {
 impl BvpOptions {
     /// Whether these are options at all (options read back from a file hold whatever numbers
     /// they were given): $\theta \in [0, 1]$, `max_iterations` $\ge 1$, a finite
-    /// `residual_tolerance` $\ge 0$ and $0 <$ `armijo` $< 1/2$. Every solve runs it first.
+    /// `residual_tolerance` $\ge 0$ and $0 <$ `armijo` $\le 1/2$. Every solve runs it first.
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] named `theta` for $\theta$, `options` for the others, its
@@ -108,8 +108,9 @@ impl BvpOptions {
                 "need max_iterations >= 1 and a finite tolerance >= 0",
             );
         }
-        if !(self.armijo > 0.0 && self.armijo < 0.5) {
-            return invalid("options", "need 0 < armijo < 1/2");
+        // (the test is |R|^2 <= (1 - 2 armijo alpha) |R_0|^2: past 1/2 no step passes)
+        if !(self.armijo > 0.0 && self.armijo <= 0.5) {
+            return invalid("options", "need 0 < armijo <= 1/2");
         }
         Ok(())
     }
