@@ -49,20 +49,27 @@ use crate::{Error, Lagrangian, LiftedSystem};
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Extrapolated<const N: usize, const X: usize> {
     /// The coarse step $h = T/N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub h: f64,
     /// The extrapolated cost.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub cost: f64,
     /// Its error estimate.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub cost_error: f64,
     /// The extrapolated jets at the coarse nodes $t_i = i h$, $i = 0, \dots, N$ (from the
     /// nodes $i$, $2i$ and $4i$ of the three plans).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub x: Vec<SVector<f64, X>>,
     /// Their error estimates (at the fixed ends at the level of the solves' feasibility).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub x_error: Vec<SVector<f64, X>>,
     /// The extrapolated momenta at the coarse nodes; `momenta[0]` and `momenta[N]` are the
     /// boundary momenta $p(0)$ and $p(T)$ ([`Extrapolated::boundary_momenta`]).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub momenta: Vec<SVector<f64, X>>,
     /// Their error estimates.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub momenta_error: Vec<SVector<f64, X>>,
     /// The plans with $N$, $2N$ and $4N$ steps.
     pub plans: [Plan<N, X>; 3],
@@ -72,24 +79,46 @@ impl<const N: usize, const X: usize> Extrapolated<N, X> {
     /// The extrapolation of the three plans (with $N$, $2N$ and $4N$ steps, in this order).
     ///
     /// # Errors
-    /// [`Failure::Invalid`] if the plans' lengths are not those of $N$, $2N$ and $4N$ steps.
+    /// [`Failure::Invalid`] if a plan fails [`Plan::validate`] (e.g. read back from a damaged
+    /// file), if the plans' lengths are not those of $N$, $2N$ and $4N$ steps with their
+    /// momenta, if their steps are not $h$, $h/2$ and $h/4$ (to a relative $10^{-12}$) or
+    /// their $\theta$ not $1/2$ (the expansion above), or if a cost is not finite.
     pub fn from_plans(plans: [Plan<N, X>; 3]) -> Result<Self, PlanError<N, X>> {
+        let invalid = |error| PlanError {
+            failure: Failure::Invalid(error),
+            last: None,
+        };
+        let wrong = |requirement| {
+            invalid(Error::InvalidArgument {
+                name: "plans",
+                requirement,
+            })
+        };
         let [coarse, fine, finest] = &plans;
+        for plan in &plans {
+            plan.validate().map_err(invalid)?;
+        }
         let steps = coarse.u.len();
         let lengths = |plan: &Plan<N, X>, factor: usize| {
             plan.u.len() == factor * steps
                 && plan.x.len() == factor * steps + 1
                 && plan.momenta.len() == factor * steps + 1
         };
-        if steps == 0 || !(lengths(coarse, 1) && lengths(fine, 2) && lengths(finest, 4)) {
-            return Err(PlanError {
-                failure: Failure::Invalid(Error::InvalidArgument {
-                    name: "plans",
-                    requirement: "extrapolation needs plans with N, 2N and 4N steps and their \
-                                  momenta",
-                }),
-                last: None,
-            });
+        if !(lengths(coarse, 1) && lengths(fine, 2) && lengths(finest, 4)) {
+            return Err(wrong(
+                "extrapolation needs plans with N, 2N and 4N steps and their momenta",
+            ));
+        }
+        let step = |plan: &Plan<N, X>, factor: f64| {
+            (plan.h * factor - coarse.h).abs() <= 1e-12 * coarse.h && plan.theta == 0.5
+        };
+        if !(step(coarse, 1.0) && step(fine, 2.0) && step(finest, 4.0)) {
+            return Err(wrong(
+                "extrapolation needs plans with steps h, h/2 and h/4 and theta = 1/2",
+            ));
+        }
+        if !plans.iter().all(|plan| plan.cost.is_finite()) {
+            return Err(wrong("extrapolation needs plans with finite costs"));
         }
         let nodes = |field: fn(&Plan<N, X>) -> &Vec<SVector<f64, X>>| {
             let (values, errors): (Vec<_>, Vec<_>) = field(coarse)
@@ -341,6 +370,105 @@ mod tests {
         // the estimate is the first level's h^4 error
         let first_fine = (4.0 * q(0.025) - q(0.05)) / 3.0;
         assert!((error - (first_fine - 1.5).abs()).abs() < 1e-14);
+    }
+
+    /// A plan of `steps` steps over $T = 1$ at rest at 0, its cost $1 + h^2$.
+    fn rest(steps: usize) -> Plan<1, 2> {
+        let h = 1.0 / steps as f64;
+        Plan::<1, 2> {
+            h,
+            theta: 0.5,
+            x: vec![SVector::zeros(); steps + 1],
+            u: vec![SVector::zeros(); steps],
+            momenta: vec![SVector::zeros(); steps + 1],
+            cost: 1.0 + h * h,
+            iterations: 0,
+            certificate: super::super::plan::certificate::unknown_certificate(),
+            violations: Default::default(),
+            duals: Default::default(),
+        }
+    }
+
+    /// The three plans of [`rest`] with 3, 6 and 12 steps, `edit` applied to them.
+    fn edited(edit: impl FnOnce(&mut [Plan<1, 2>; 3])) -> [Plan<1, 2>; 3] {
+        let mut plans = [rest(3), rest(6), rest(12)];
+        edit(&mut plans);
+        plans
+    }
+
+    /// Plans that cannot be plans, or not the three of one extrapolation, are refused, not
+    /// extrapolated to NaN or to a number of nothing (issue 33, item 7).
+    #[test]
+    fn plans_that_do_not_fit_an_extrapolation_are_refused() {
+        let valid = Extrapolated::from_plans(edited(|_| ())).expect("three fitting plans");
+        // 1 + h^2 extrapolates to 1
+        assert!((valid.cost - 1.0).abs() < 1e-14, "{}", valid.cost);
+        type Edit = fn(&mut [Plan<1, 2>; 3]);
+        let hostile: [(&str, Edit); 9] = [
+            ("h = 1e308", |p| p[2].h = 1e308),
+            ("h NaN", |p| p[0].h = f64::NAN),
+            ("steps not halved", |p| p[1].h = 0.2),
+            ("theta 0.3", |p| {
+                for plan in p {
+                    plan.theta = 0.3;
+                }
+            }),
+            ("one theta 1", |p| p[1].theta = 1.0),
+            ("a NaN cost", |p| p[1].cost = f64::NAN),
+            ("an infinite jet", |p| p[0].x[1][0] = f64::INFINITY),
+            ("no momenta", |p| p[2].momenta.clear()),
+            ("a jet missing", |p| {
+                p[1].x.pop();
+            }),
+        ];
+        for (what, edit) in hostile {
+            let error = Extrapolated::from_plans(edited(edit)).expect_err(what);
+            assert!(
+                matches!(
+                    error.failure,
+                    Failure::Invalid(Error::InvalidArgument {
+                        name: "plans" | "plan",
+                        ..
+                    })
+                ),
+                "{what}: {error}"
+            );
+        }
+    }
+
+    /// Plans read back from hostile JSON are refused by the extrapolation; the extrapolation
+    /// itself round-trips, NaN estimates included.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn plans_from_hostile_json_are_refused_by_the_extrapolation() {
+        let json = |plan: &Plan<1, 2>| serde_json::to_value(plan).unwrap();
+        let read = |value: serde_json::Value| -> Plan<1, 2> {
+            serde_json::from_value(value).expect("the JSON reads")
+        };
+        type Edit = fn(&mut serde_json::Value);
+        let hostile: [(&str, Edit); 4] = [
+            ("h = 1e308", |v| v["h"] = 1e308.into()),
+            ("cost = \"inf\"", |v| v["cost"] = "inf".into()),
+            ("theta = -0.5", |v| v["theta"] = (-0.5).into()),
+            ("a NaN momentum", |v| v["momenta"][2][1] = "NaN".into()),
+        ];
+        for (what, edit) in hostile {
+            let mut value = json(&rest(6));
+            edit(&mut value);
+            let plans = [rest(3), read(value), rest(12)];
+            let result = Extrapolated::from_plans(plans);
+            assert!(
+                matches!(&result, Err(e) if matches!(e.failure, Failure::Invalid(_))),
+                "{what}: {result:?}"
+            );
+        }
+        let mut valid = Extrapolated::from_plans(edited(|_| ())).expect("three fitting plans");
+        valid.cost_error = f64::NAN;
+        valid.momenta_error[1][0] = f64::INFINITY;
+        let text = serde_json::to_string(&valid).unwrap();
+        let back: Extrapolated<1, 2> = serde_json::from_str(&text).unwrap();
+        assert!(back.cost_error.is_nan() && back.momenta_error[1][0] == f64::INFINITY);
+        assert_eq!(serde_json::to_string(&back).unwrap(), text);
     }
 
     #[test]

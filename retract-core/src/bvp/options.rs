@@ -6,6 +6,7 @@ use nalgebra::SVector;
 
 use super::curve::Curve;
 use super::plan::Plan;
+use crate::Error;
 
 /// Options of [`OptimalControlProblem::solve`](crate::bvp::OptimalControlProblem::solve).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,6 +110,60 @@ impl Default for PlanOptions {
 }
 
 impl PlanOptions {
+    /// Whether these are options at all (options read back from a file hold whatever numbers
+    /// they were given): $\theta \in [0, 1]$, a finite `tolerance` $> 0$, a finite
+    /// `acceptable` $\ge$ `tolerance`, `max_iterations` $\ge 1$, $0 <$ `armijo` $< 1/2$, a
+    /// finite `initial_barrier` $> 0$, `chord_spacing` $> 0$ (infinity: the three points
+    /// only), `max_chord_pieces` at most [`crate::step::MAX_CHORD_PIECES`] and
+    /// `interior_samples` at most [`MAX_INTERIOR_SAMPLES`]. Every solve runs it first (with the
+    /// checks that need the problem: $\mu_0 / h$ finite, interior samples only for orders
+    /// $k \le 4$).
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `theta` for $\theta$, `options` for the others, its
+    /// requirement naming the field.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |name, requirement| Err(Error::InvalidArgument { name, requirement });
+        if !(0.0..=1.0).contains(&self.theta) {
+            return invalid("theta", "theta must lie in [0, 1]");
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) || self.max_iterations == 0 {
+            return invalid(
+                "options",
+                "need a finite tolerance > 0 and max_iterations >= 1",
+            );
+        }
+        if !(self.acceptable.is_finite() && self.acceptable >= self.tolerance) {
+            return invalid(
+                "options",
+                "the acceptable level must be finite and >= the tolerance",
+            );
+        }
+        if !(self.initial_barrier.is_finite() && self.initial_barrier > 0.0) {
+            return invalid(
+                "options",
+                "the initial barrier parameter must be finite and > 0",
+            );
+        }
+        if !(self.armijo > 0.0 && self.armijo < 0.5) {
+            return invalid("options", "need 0 < armijo < 1/2");
+        }
+        if !(self.chord_spacing > 0.0 && self.max_chord_pieces <= crate::step::MAX_CHORD_PIECES) {
+            return invalid(
+                "options",
+                "the chord spacing must be > 0 (infinity: the three points only) and \
+                 max_chord_pieces at most MAX_CHORD_PIECES",
+            );
+        }
+        if self.interior_samples > MAX_INTERIOR_SAMPLES {
+            return invalid(
+                "options",
+                "at most 63 interior samples per step, for orders k <= 4",
+            );
+        }
+        Ok(())
+    }
+
     /// Sets the KKT tolerance.
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;

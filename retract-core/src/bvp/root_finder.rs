@@ -89,6 +89,32 @@ impl Default for BvpOptions {
 }
 
 impl BvpOptions {
+    /// Whether these are options at all (options read back from a file hold whatever numbers
+    /// they were given): $\theta \in [0, 1]$, `max_iterations` $\ge 1$, a finite
+    /// `residual_tolerance` $\ge 0$ and $0 <$ `armijo` $\le 1/2$. Every solve runs it first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `theta` for $\theta$, `options` for the others, its
+    /// requirement naming the field.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |name, requirement| Err(Error::InvalidArgument { name, requirement });
+        if !(0.0..=1.0).contains(&self.theta) {
+            return invalid("theta", "theta must lie in [0, 1]");
+        }
+        let tolerance = self.residual_tolerance;
+        if self.max_iterations == 0 || !(tolerance.is_finite() && tolerance >= 0.0) {
+            return invalid(
+                "options",
+                "need max_iterations >= 1 and a finite tolerance >= 0",
+            );
+        }
+        // (the test is |R|^2 <= (1 - 2 armijo alpha) |R_0|^2: past 1/2 no step passes)
+        if !(self.armijo > 0.0 && self.armijo <= 0.5) {
+            return invalid("options", "need 0 < armijo <= 1/2");
+        }
+        Ok(())
+    }
+
     /// Sets the residual tolerance.
     pub fn with_residual_tolerance(mut self, tolerance: f64) -> Self {
         self.residual_tolerance = tolerance;
@@ -128,24 +154,36 @@ pub enum Guess<'a, const S: usize, const M: usize> {
 }
 
 /// A solved boundary-value problem.
+///
+/// With `serde`, NaN and infinite numbers are written as the strings `"NaN"`, `"inf"` and
+/// `"-inf"` and read back, as in [`super::Certificate`]. A solution read back holds whatever
+/// numbers it was given: its uses ([`Self::shifted`], a warm start
+/// [`Guess::Solution`]) check it first ([`Self::validate`]).
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BvpSolution<const S: usize, const M: usize> {
     /// Step size $h = T/N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub h: f64,
     /// The scheme parameter used.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub theta: f64,
     /// $z_0, \dots, z_N$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub states: Vec<SVector<f64, S>>,
     /// The Newton unknowns $w_i = (z_{i+1}, u_i)$ of each step.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::vectors"))]
     pub unknowns: Vec<SVector<f64, M>>,
     /// $J = \sum_i h\thinspace L(x_{\theta,i}, u_i)$.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub cost: f64,
     /// Minimum clearance to each obstacle over $z_0..z_N$ (empty without a clearance function).
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float::list"))]
     pub clearance: Vec<f64>,
     /// Newton iterations used.
     pub iterations: usize,
     /// $|R|_\infty$ at the solution.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub residual_norm: f64,
 }
 
@@ -171,9 +209,45 @@ impl<const S: usize, const M: usize> BvpSolution<S, M> {
             .map(|w| w.fixed_rows::<N>(S).into_owned())
     }
 
+    /// Whether this is a solution at all (a solution read back from a file holds whatever
+    /// numbers it was given): at least one step, $N + 1$ states for $N$ unknowns, a finite
+    /// step $h > 0$ with $T = N h$ finite, $\theta \in [0, 1]$, and every state and unknown
+    /// finite. The cost, the clearances and the residual describe the solution and are not
+    /// checked. Its uses ([`Self::shifted`], a warm start [`Guess::Solution`]) run it first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `solution`, its requirement saying which condition
+    /// fails.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |requirement| {
+            Err(Error::InvalidArgument {
+                name: "solution",
+                requirement,
+            })
+        };
+        let steps = self.unknowns.len();
+        if steps == 0 || self.states.len() != steps + 1 {
+            return invalid("it needs N >= 1 unknowns and N + 1 states");
+        }
+        if !(self.h > 0.0 && (self.h * steps as f64).is_finite()) {
+            return invalid("its step h must be finite and > 0, and T = N h finite");
+        }
+        if !(0.0..=1.0).contains(&self.theta) {
+            return invalid("its theta must lie in [0, 1]");
+        }
+        if !(self.states.iter().all(|z| all_finite(z.as_slice()))
+            && self.unknowns.iter().all(|w| all_finite(w.as_slice())))
+        {
+            return invalid("its states and unknowns must be finite");
+        }
+        Ok(())
+    }
+
     /// The solution shifted one step forward in time, for a receding-horizon warm start:
     /// $z_i \leftarrow z_{i+1}$, the new last step one integrator step from the old end
-    /// (repeating the last step's unknowns if that step fails).
+    /// (repeating the last step's unknowns if that step fails). A solution that fails
+    /// [`Self::validate`] (e.g. read back from a damaged file) is returned unchanged, and a
+    /// warm start from it is refused in turn.
     pub fn shifted<Sys>(&self, system: &Sys) -> Self
     where
         Sys: LiftedSystem<S, M> + ?Sized,
@@ -182,6 +256,9 @@ impl<const S: usize, const M: usize> BvpSolution<S, M> {
         let (Some(&last_z), Some(&last_w)) = (self.states.last(), self.unknowns.last()) else {
             return out;
         };
+        if self.validate().is_err() {
+            return out;
+        }
         let options = crate::StepOptions::default().with_theta(self.theta);
         let next_w = system
             .predictor(&last_z, self.h, self.theta)
@@ -406,16 +483,7 @@ where
         if !(self.t_end.is_finite() && self.t_end > 0.0) {
             return invalid("t_end", "the horizon must be finite and positive");
         }
-        if !(0.0..=1.0).contains(&self.options.theta) {
-            return invalid("theta", "theta must lie in [0, 1]");
-        }
-        let tolerance = self.options.residual_tolerance;
-        if self.options.max_iterations == 0 || !(tolerance.is_finite() && tolerance >= 0.0) {
-            return invalid(
-                "options",
-                "need max_iterations >= 1 and a finite tolerance >= 0",
-            );
-        }
+        self.options.validate()?;
         // the unknowns, their index arithmetic and the obstacle buffers must be addressable
         // (whether they can be allocated is checked when they are)
         let bytes = self
@@ -463,6 +531,7 @@ where
     }
 
     fn guess_from_solution(&self, guess: &BvpSolution<S, M>) -> Result<Vec<f64>, Error> {
+        guess.validate()?;
         if guess.states.len() != self.steps + 1 || guess.unknowns.len() != self.steps {
             return Err(Error::InvalidArgument {
                 name: "guess",

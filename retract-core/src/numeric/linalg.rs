@@ -80,6 +80,17 @@ pub(crate) fn solve_columns<const M: usize>(
     b: &mut [f64],
     d: &mut [f64],
 ) -> bool {
+    solve_columns_overwriting(&mut a, n, b, d)
+}
+
+/// [`solve_columns`] with `a` overwritten by its factors (no copy of `a`; entries outside the
+/// leading `n x n` block are neither read nor written).
+pub(crate) fn solve_columns_overwriting<const M: usize>(
+    a: &mut SMatrix<f64, M, M>,
+    n: usize,
+    b: &mut [f64],
+    d: &mut [f64],
+) -> bool {
     // column-major storage: entry (r, c) at c * M + r
     let a = a.as_mut_slice();
     let mut inverse_pivots = [0.0; M];

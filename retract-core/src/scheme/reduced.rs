@@ -211,19 +211,9 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let (a, b) = linear_parts(system, h, theta)?;
-        let mut t = SMatrix::<f64, M, S>::zeros();
-        let mut a_inv = SMatrix::<f64, M, M>::zeros();
-        let closed = match system.closed_form_factors(h, theta, &mut t, &mut a_inv) {
-            ClosedForm::None => false,
-            ClosedForm::Polynomial => all_finite(&t) && all_finite(&a_inv),
-            ClosedForm::Rational => solves_linear_part::<Sys, S, M, R>(&a, &b, &t, &a_inv),
-        };
-        if !closed {
-            (t, a_inv) = factorise::<Sys, S, M, R>(&a, &b)?;
-        }
-        let (t_lo, a_inv_lo) = corrections::<Sys, S, M, R>(&a, &b, &t, &a_inv)?;
-        Ok(Self::from_parts::<Sys>(h, theta, t, t_lo, a_inv, a_inv_lo))
+        let mut factors = Self::zeroed(h, theta);
+        factors.compute(system, h, theta, true)?;
+        Ok(factors)
     }
 
     /// The factors by LU of the blocks of $A$, never from the closed form (to check it).
@@ -234,41 +224,102 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let (a, b) = linear_parts(system, h, theta)?;
-        let (t, a_inv) = factorise::<Sys, S, M, R>(&a, &b)?;
-        let (t_lo, a_inv_lo) = corrections::<Sys, S, M, R>(&a, &b, &t, &a_inv)?;
-        Ok(Self::from_parts::<Sys>(h, theta, t, t_lo, a_inv, a_inv_lo))
+        let mut factors = Self::zeroed(h, theta);
+        factors.compute(system, h, theta, false)?;
+        Ok(factors)
     }
 
-    /// $K$ and $G$ from $T$ and $A^{-1}$.
-    fn from_parts<Sys>(
-        h: f64,
-        theta: f64,
-        t: SMatrix<f64, M, S>,
-        t_lo: SMatrix<f64, M, S>,
-        a_inv: SMatrix<f64, M, M>,
-        a_inv_lo: SMatrix<f64, M, M>,
-    ) -> Self
-    where
-        Sys: ReducedScheme<S, M, R> + ?Sized,
-    {
-        let k = SMatrix::<f64, R, M>::from_fn(|m, c| theta * a_inv[(Sys::CORE[m], c)]);
-        let g = SMatrix::<f64, R, S>::from_fn(|m, c| {
-            let core = Sys::CORE[m];
-            theta * t[(core, c)] + if c == core { 1.0 - theta } else { 0.0 }
-        });
-        let largest = max_abs(&t).max(max_abs(&a_inv));
+    /// Factors of zeros for $(h, \theta)$, to be computed ([`Self::compute`]).
+    fn zeroed(h: f64, theta: f64) -> Self {
         Self {
             h,
             theta,
-            a_inv,
-            a_inv_lo,
-            k,
-            g,
-            t,
-            t_lo,
-            finite_below: f64::MAX / (2.0 * largest.max(1.0)),
+            a_inv: SMatrix::zeros(),
+            a_inv_lo: SMatrix::zeros(),
+            k: SMatrix::zeros(),
+            g: SMatrix::zeros(),
+            t: SMatrix::zeros(),
+            t_lo: SMatrix::zeros(),
+            finite_below: 0.0,
         }
+    }
+
+    /// Computes the factors of `system` for $(h, \theta)$ in place (a cached slot is
+    /// overwritten, no copy of the factors): $T$ and $A^{-1}$ from the closed form where
+    /// `closed_form` allows and it is accepted, else by LU of the blocks of $A$, then their
+    /// corrections, $K$, $G$ and the finiteness bound. On an error the factors are
+    /// unspecified.
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    fn compute<Sys>(
+        &mut self,
+        system: &Sys,
+        h: f64,
+        theta: f64,
+        closed_form: bool,
+    ) -> Result<(), Error>
+    where
+        Sys: ReducedScheme<S, M, R> + ?Sized,
+    {
+        let (a, b) = linear_parts(system, h, theta)?;
+        (self.h, self.theta) = (h, theta);
+        // (a slice's fill is one memset; the matrix's own runs entry by entry)
+        for m in [&mut self.t, &mut self.t_lo] {
+            m.as_mut_slice().fill(0.0);
+        }
+        for m in [&mut self.a_inv, &mut self.a_inv_lo] {
+            m.as_mut_slice().fill(0.0);
+        }
+        let closed = closed_form
+            && match system.closed_form_factors(h, theta, &mut self.t, &mut self.a_inv) {
+                ClosedForm::None => false,
+                ClosedForm::Polynomial => all_finite(&self.t) && all_finite(&self.a_inv),
+                ClosedForm::Rational => {
+                    solves_linear_part::<Sys, S, M, R>(&a, &b, &self.t, &self.a_inv)
+                }
+            };
+        if !closed {
+            if closed_form {
+                // (a refused closed form may have written entries)
+                self.t.as_mut_slice().fill(0.0);
+                self.a_inv.as_mut_slice().fill(0.0);
+            }
+            // A T = -B, A a_inv = E (the unit columns at the forced rows)
+            solve_blocks::<Sys, S, M, R>(
+                &a,
+                |r, c| -b[(r, c)],
+                |r, q| if r == q { 1.0 } else { 0.0 },
+                (&mut self.t, &mut self.a_inv),
+            )?;
+        }
+        corrections::<Sys, S, M, R>(
+            &a,
+            &b,
+            (&self.t, &self.a_inv),
+            (&mut self.t_lo, &mut self.a_inv_lo),
+        )?;
+        self.derive::<Sys>();
+        Ok(())
+    }
+
+    /// $K$, $G$ and the finiteness bound from $T$ and $A^{-1}$.
+    fn derive<Sys>(&mut self)
+    where
+        Sys: ReducedScheme<S, M, R> + ?Sized,
+    {
+        let theta = self.theta;
+        for (m, &core) in Sys::CORE.iter().enumerate() {
+            for c in 0..M {
+                self.k[(m, c)] = theta * self.a_inv[(core, c)];
+            }
+            for c in 0..S {
+                let own = if c == core { 1.0 - theta } else { 0.0 };
+                self.g[(m, c)] = theta * self.t[(core, c)] + own;
+            }
+        }
+        let largest = max_abs(&self.t).max(max_abs(&self.a_inv));
+        self.finite_below = f64::MAX / (2.0 * largest.max(1.0));
     }
 }
 
@@ -292,52 +343,36 @@ where
     }
 }
 
-/// $T = -A^{-1} B$ and the columns of $A^{-1}$ at the forced rows by LU with partial pivoting
-/// of each block of $A$.
-fn factorise<Sys, const S: usize, const M: usize, const R: usize>(
-    a: &SMatrix<f64, M, M>,
-    b: &SMatrix<f64, M, S>,
-) -> Result<(SMatrix<f64, M, S>, SMatrix<f64, M, M>), Error>
-where
-    Sys: ReducedScheme<S, M, R> + ?Sized,
-{
-    let unit = SMatrix::<f64, M, M>::from_fn(|i, q| {
-        if i == q && Sys::FORCED.contains(&q) {
-            1.0
-        } else {
-            0.0
-        }
-    });
-    let (minus_t, a_inv) = solve_blocks::<Sys, S, M, R>(a, b, &unit)?;
-    Ok((-minus_t, a_inv))
-}
-
-/// The rounding errors of `t` and `a_inv` as solutions of $A T = -B$ and $A\thinspace a^{-1} = E$
-/// ($E$ the unit columns at the forced rows): $T_{lo} = -A^{-1}(A T + B)$ and
-/// $A^{-1}(E - A\thinspace a^{-1})$. The residuals are summed compensated ([`Dot2`]: one rounding
-/// per entry, so they are the residuals of the rounded factors, not rounding noise), then solved
-/// for by the LU of the blocks of $A$; the corrections' own relative error is that of the
-/// solve, so `t` plus $T_{lo}$ is $-A^{-1} B$ to about $u^2$ (relative, $u$ the unit
-/// roundoff), and the same for $A^{-1}$.
+/// Writes the rounding errors of `t` and `a_inv` as solutions of $A T = -B$ and
+/// $A\thinspace a^{-1} = E$ ($E$ the unit columns at the forced rows) into `t_lo` and
+/// `a_inv_lo` (zero on entry): $T_{lo} = -A^{-1}(A T + B)$ and $A^{-1}(E - A\thinspace a^{-1})$.
+/// The residuals are summed compensated ([`Dot2`]: one rounding per entry, so they are the
+/// residuals of the rounded factors, not rounding noise), then solved for by the LU of the
+/// blocks of $A$; the corrections' own relative error is that of the solve, so `t` plus
+/// $T_{lo}$ is $-A^{-1} B$ to about $u^2$ (relative, $u$ the unit roundoff), and the same for
+/// $A^{-1}$.
 #[allow(clippy::type_complexity)]
 fn corrections<Sys, const S: usize, const M: usize, const R: usize>(
     a: &SMatrix<f64, M, M>,
     b: &SMatrix<f64, M, S>,
-    t: &SMatrix<f64, M, S>,
-    a_inv: &SMatrix<f64, M, M>,
-) -> Result<(SMatrix<f64, M, S>, SMatrix<f64, M, M>), Error>
+    (t, a_inv): (&SMatrix<f64, M, S>, &SMatrix<f64, M, M>),
+    (t_lo, a_inv_lo): (&mut SMatrix<f64, M, S>, &mut SMatrix<f64, M, M>),
+) -> Result<(), Error>
 where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
     let rows = SparseRows::new(a);
     // A T + B, column by column (a zero column of T stays one of T_lo)
     let mut t_residual = SMatrix::<f64, M, S>::zeros();
+    let mut any = false;
     for c in 0..S {
         let column = t.column(c);
         if column.as_slice().iter().any(|&v| v != 0.0) {
             let column = Split::column(column.as_slice());
             for i in 0..M {
-                t_residual[(i, c)] = rows.residual(i, &column, -b[(i, c)]);
+                let r = rows.residual(i, &column, -b[(i, c)]);
+                any |= r != 0.0;
+                t_residual[(i, c)] = r;
             }
         }
     }
@@ -347,37 +382,39 @@ where
         let column = Split::column(a_inv.column(q).as_slice());
         for i in 0..M {
             let unit = if i == q { 1.0 } else { 0.0 };
-            inverse_residual[(i, q)] = rows.residual(i, &column, unit);
+            let r = rows.residual(i, &column, unit);
+            any |= r != 0.0;
+            inverse_residual[(i, q)] = r;
         }
     }
-    if t_residual
-        .as_slice()
-        .iter()
-        .chain(inverse_residual.as_slice())
-        .all(|&v| v == 0.0)
-    {
-        return Ok((SMatrix::zeros(), SMatrix::zeros()));
+    if !any {
+        return Ok(());
     }
-    let (t_lo, minus_inverse_lo) = solve_blocks::<Sys, S, M, R>(a, &t_residual, &inverse_residual)?;
-    Ok((-t_lo, -minus_inverse_lo))
+    solve_blocks::<Sys, S, M, R>(
+        a,
+        |r, c| -t_residual[(r, c)],
+        |r, q| -inverse_residual[(r, q)],
+        (t_lo, a_inv_lo),
+    )
 }
 
-/// $X$ and $Y$ with $A X = B$ and $A Y = D$, by LU with partial pivoting of each block of $A$;
-/// $D$ is read at the forced columns only (the columns of $Y$ outside them are zero).
-#[allow(clippy::type_complexity)]
+/// Writes $X$ and $Y$ with $A X = B$ and $A Y = D$ into `x` and `y` (zero on entry), by LU
+/// with partial pivoting of each block of $A$; $B$ and $D$ are given by their entries
+/// $(r, c)$, $D$ read at the forced columns only (the columns of $Y$ outside them stay
+/// zero).
 fn solve_blocks<Sys, const S: usize, const M: usize, const R: usize>(
     a: &SMatrix<f64, M, M>,
-    b: &SMatrix<f64, M, S>,
-    d: &SMatrix<f64, M, M>,
-) -> Result<(SMatrix<f64, M, S>, SMatrix<f64, M, M>), Error>
+    b: impl Fn(usize, usize) -> f64,
+    d: impl Fn(usize, usize) -> f64,
+    (x, y): (&mut SMatrix<f64, M, S>, &mut SMatrix<f64, M, M>),
+) -> Result<(), Error>
 where
     Sys: ReducedScheme<S, M, R> + ?Sized,
 {
     // A [x, y] = [b, d], block by block: the rows of a block of A, times its columns of the
     // unknowns, give the block's rows of the right-hand sides; only the right-hand-side
-    // columns that are nonzero on those rows are solved for
-    let mut x = SMatrix::<f64, M, S>::zeros();
-    let mut y = SMatrix::<f64, M, M>::zeros();
+    // columns that are nonzero on those rows are solved for (each block's leading n x n
+    // entries and n rows of its columns written before they are read: one buffer each)
     let mut covered = 0;
     let mut block = SMatrix::<f64, M, M>::zeros();
     let mut b_block = SMatrix::<f64, M, S>::zeros();
@@ -388,8 +425,8 @@ where
             return Err(Error::SingularJacobian { iteration: 0 });
         }
         covered += n;
-        for (i, &r) in rows.iter().enumerate() {
-            for (j, &c) in cols.iter().enumerate() {
+        for (j, &c) in cols.iter().enumerate() {
+            for (i, &r) in rows.iter().enumerate() {
                 block[(i, j)] = a[(r, c)];
             }
         }
@@ -397,9 +434,9 @@ where
         let mut b_cols = [0usize; S];
         let mut nb = 0;
         for c in 0..S {
-            if rows.iter().any(|&r| b[(r, c)] != 0.0) {
+            if rows.iter().any(|&r| b(r, c) != 0.0) {
                 for (i, &r) in rows.iter().enumerate() {
-                    b_block[(i, nb)] = b[(r, c)];
+                    b_block[(i, nb)] = b(r, c);
                 }
                 b_cols[nb] = c;
                 nb += 1;
@@ -408,16 +445,16 @@ where
         let mut d_cols = [0usize; M];
         let mut nd = 0;
         for &q in Sys::FORCED {
-            if rows.iter().any(|&r| d[(r, q)] != 0.0) {
+            if rows.iter().any(|&r| d(r, q) != 0.0) {
                 for (i, &r) in rows.iter().enumerate() {
-                    d_block[(i, nd)] = d[(r, q)];
+                    d_block[(i, nd)] = d(r, q);
                 }
                 d_cols[nd] = q;
                 nd += 1;
             }
         }
-        let solved = crate::numeric::linalg::solve_columns(
-            block,
+        let solved = crate::numeric::linalg::solve_columns_overwriting(
+            &mut block,
             n,
             &mut b_block.as_mut_slice()[..nb * M],
             &mut d_block.as_mut_slice()[..nd * M],
@@ -437,7 +474,7 @@ where
     if covered != M {
         return Err(Error::SingularJacobian { iteration: 0 });
     }
-    Ok((x, y))
+    Ok(())
 }
 
 /// Whether `t` and `a_inv` (from [`ReducedScheme::closed_form_factors`]) solve
@@ -551,12 +588,16 @@ impl Split {
 }
 
 /// The nonzeros of each row of a square matrix (a few per row for $A$), split once
-/// ([`Split`]), for the compensated residuals of [`corrections`].
+/// ([`Split`]), for the compensated residuals of [`corrections`]. A row's nonzeros that are
+/// powers of two ($\pm 1$ among them) come first: their products are exact (unless they
+/// underflow), so only their sums are compensated.
 struct SparseRows<const M: usize> {
-    /// Row $i$'s nonzeros: their columns and values, the first `counts[i]` used.
+    /// Row $i$'s nonzeros: their columns and values, the first `counts[i]` used, the first
+    /// `exact[i]` of them powers of two.
     columns: [[usize; M]; M],
     values: [[Split; M]; M],
     counts: [usize; M],
+    exact: [usize; M],
 }
 
 impl<const M: usize> SparseRows<M> {
@@ -565,15 +606,23 @@ impl<const M: usize> SparseRows<M> {
             columns: [[0; M]; M],
             values: [[Split::new(0.0); M]; M],
             counts: [0; M],
+            exact: [0; M],
         };
+        // a normal double with a zero significand field is a power of two
+        let power_of_two = |v: f64| v.is_normal() && v.to_bits() & ((1 << 52) - 1) == 0;
         for i in 0..M {
-            for k in 0..M {
-                let v = a[(i, k)];
-                if v != 0.0 {
-                    let n = rows.counts[i];
-                    rows.columns[i][n] = k;
-                    rows.values[i][n] = Split::new(v);
-                    rows.counts[i] = n + 1;
+            for exact in [true, false] {
+                for k in 0..M {
+                    let v = a[(i, k)];
+                    if v != 0.0 && power_of_two(v) == exact {
+                        let n = rows.counts[i];
+                        rows.columns[i][n] = k;
+                        rows.values[i][n] = Split::new(v);
+                        rows.counts[i] = n + 1;
+                    }
+                }
+                if exact {
+                    rows.exact[i] = rows.counts[i];
                 }
             }
         }
@@ -581,12 +630,17 @@ impl<const M: usize> SparseRows<M> {
     }
 
     /// $\sum_k a_{ik} x_k - y$ over the nonzeros of row $i$, compensated as [`Dot2`]
-    /// (every product's and addition's error summed apart, added once at the end).
+    /// (every product's and addition's error summed apart, added once at the end; the
+    /// products by powers of two have none).
     #[inline(always)]
     fn residual(&self, i: usize, x: &[Split; M], y: f64) -> f64 {
         let mut sum = Dot2::exact(-y);
-        let n = self.counts[i];
-        for (&k, &a) in self.columns[i][..n].iter().zip(&self.values[i][..n]) {
+        let (n, exact) = (self.counts[i], self.exact[i]);
+        let (columns, values) = (&self.columns[i][..n], &self.values[i][..n]);
+        for (&k, a) in columns[..exact].iter().zip(&values[..exact]) {
+            sum.add_exact(a.value * x[k].value);
+        }
+        for (&k, &a) in columns[exact..].iter().zip(&values[exact..]) {
             let x = x[k];
             if x.value != 0.0 {
                 sum.add_split_product(a, x);
@@ -614,6 +668,14 @@ impl Dot2 {
             sum: value,
             error: 0.0,
         }
+    }
+
+    /// Adds a term known exactly (a product by a power of two).
+    #[inline(always)]
+    fn add_exact(&mut self, p: f64) {
+        let (sum, error) = two_sum(self.sum, p);
+        self.sum = sum;
+        self.error += error;
     }
 
     /// Adds the product $a b$ of two split operands.
@@ -813,9 +875,14 @@ where
             }
         }
         self.factorisations = self.factorisations.saturating_add(1);
-        let factors = ReducedFactors::new(self.system, h, theta)?;
+        let system = self.system;
         if let Some(entry) = self.factors.get_mut(slot) {
-            *entry = Some(factors);
+            // computed in the slot itself: no copy of the factors
+            let factors = entry.get_or_insert_with(|| ReducedFactors::zeroed(h, theta));
+            if let Err(error) = factors.compute(system, h, theta, true) {
+                *entry = None;
+                return Err(error);
+            }
         }
         Ok(slot)
     }

@@ -8,7 +8,6 @@ use nalgebra::SVector;
 use super::OptimalControlProblem;
 use crate::bvp::constraints::SAMPLE_MAX_ORDER;
 use crate::bvp::iterate::{Iterate, blocks};
-use crate::bvp::options::MAX_INTERIOR_SAMPLES;
 use crate::{DomainViolation, Error, LiftedSystem};
 
 impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
@@ -60,39 +59,18 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         if !(self.t_end.is_finite() && self.t_end > 0.0) {
             return invalid("t_end", "the horizon must be finite and positive");
         }
-        if !(0.0..=1.0).contains(&o.theta) {
-            return invalid("theta", "theta must lie in [0, 1]");
-        }
-        if !(o.tolerance.is_finite() && o.tolerance > 0.0 && o.acceptable >= o.tolerance)
-            || o.max_iterations == 0
-        {
-            return invalid(
-                "options",
-                "need a finite tolerance > 0 and max_iterations >= 1",
-            );
-        }
-        if o.interior_samples > MAX_INTERIOR_SAMPLES
-            || (o.interior_samples > 0 && k > SAMPLE_MAX_ORDER)
-        {
+        o.validate()?;
+        if o.interior_samples > 0 && k > SAMPLE_MAX_ORDER {
             return invalid(
                 "options",
                 "at most 63 interior samples per step, for orders k <= 4",
             );
         }
-        if !(o.initial_barrier.is_finite() && o.initial_barrier > 0.0) {
+        // (mu = mu_0 / h per unit time: finite for the barrier to be)
+        if !(o.initial_barrier / self.h()).is_finite() {
             return invalid(
                 "options",
-                "the initial barrier parameter must be finite and > 0",
-            );
-        }
-        if !(o.armijo > 0.0 && o.armijo < 0.5) {
-            return invalid("options", "need 0 < armijo < 1/2");
-        }
-        if !(o.chord_spacing > 0.0 && o.max_chord_pieces <= crate::step::MAX_CHORD_PIECES) {
-            return invalid(
-                "options",
-                "the chord spacing must be > 0 (infinity: the three points only) and \
-                 max_chord_pieces at most MAX_CHORD_PIECES",
+                "the initial barrier parameter per unit time, mu_0 / h, must be finite",
             );
         }
         Ok(())
