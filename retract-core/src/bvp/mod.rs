@@ -47,7 +47,10 @@
 //! 9. `solve` (the solve front: [`OptimalControlProblem::solve`] and its variants, the first
 //!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]).
 //! 10. `realtime` (real-time iterations in a preparation and a feedback phase,
-//!     [`RealTimeIteration`]).
+//!     [`RealTimeIteration`]), `control` (a control period's safeguarded input and its
+//!     status, [`OptimalControlProblem::control`]), `sensitivity` (a plan's derivatives with
+//!     respect to its start and the Lagrangian's parameters from the factorisation at the
+//!     solution).
 //! 11. `batch` (many plans at once: [`solve_batch`], [`solve_stream`],
 //!     [`OptimalControlProblem::solve_multistart`]; on rayon's thread pool with the
 //!     `parallel` feature).
@@ -108,6 +111,7 @@
 mod barrier;
 mod batch;
 mod constraints;
+mod control;
 mod curve;
 mod dynamics;
 mod extrapolate;
@@ -118,6 +122,7 @@ mod options;
 mod plan;
 mod problem;
 mod realtime;
+mod sensitivity;
 mod solve;
 mod sqp;
 mod stack;
@@ -125,6 +130,7 @@ mod workspace;
 
 pub use batch::{Job, MultiStart, Outcome, Stream, solve_batch, solve_stream};
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
+pub use control::{Control, ControlOptions, ControlStatus, Fallback, InputSource};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
 pub use options::{MAX_INTERIOR_SAMPLES, PlanGuess, PlanOptions};
@@ -132,7 +138,8 @@ pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use problem::OptimalControlProblem;
-pub use realtime::{Feedback, Preparation, RealTimeIteration, Sensitivity};
+pub use realtime::{Feedback, Preparation, RealTimeIteration};
+pub use sensitivity::{ParameterSensitivity, Sensitivity};
 pub use workspace::Workspace;
 
 mod root_finder;
