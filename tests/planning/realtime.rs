@@ -264,3 +264,31 @@ fn the_start_sensitivity_matches_central_differences() {
         );
     }
 }
+
+/// `clamp_input` puts each component into the intersection of all the problem's bounds on the
+/// top derivative (two calls bounding the same component: the tighter side of each), leaves
+/// an unbounded side alone, and turns a non-finite component into 0 clamped likewise.
+#[test]
+fn clamp_input_keeps_the_intersection_of_the_bounds() {
+    use retract::bvp::Variable;
+    use retract::nalgebra::SVector;
+    let (model, _) = upright_models();
+    let problem = OptimalControlProblem::new(&model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS)
+        .with_input_bounds([-3.0, f64::NEG_INFINITY], [2.0, 5.0])
+        .with_bounds(Variable::Top(0), -1.0, 4.0);
+    let cases = [
+        ([-2.0, 7.0], [-1.0, 5.0]),
+        ([10.0, -1e9], [2.0, -1e9]),
+        ([0.5, 4.0], [0.5, 4.0]),
+        ([f64::NAN, f64::INFINITY], [0.0, 0.0]),
+        ([f64::NEG_INFINITY, f64::NAN], [0.0, 0.0]),
+    ];
+    for (u, expected) in cases {
+        let clamped = problem.clamp_input(&SVector::from(u));
+        assert_eq!(clamped, SVector::from(expected), "{u:?}");
+    }
+    // without bounds only the non-finite components change
+    let free = OptimalControlProblem::new(&model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS);
+    let u = SVector::from([1e12, f64::NAN]);
+    assert_eq!(free.clamp_input(&u), SVector::from([1e12, 0.0]));
+}
