@@ -1,7 +1,8 @@
 //! Sensitivities of a plan with respect to a parameter of its Lagrangian
 //! (`parameter_sensitivity`, from the KKT factorisation at the solution) against central
 //! differences of solves with the parameter moved: the swing-up of the double pendulum
-//! (gravity) and the one-disc scene (the barrier weight tau).
+//! (gravity), the acrobot's (gravity, in its cost and in its active equality) and the one-disc
+//! scene (the barrier weight tau).
 
 use std::f64::consts::PI;
 
@@ -94,7 +95,7 @@ fn the_swing_up_s_gravity_sensitivity_matches_central_differences() {
     assert_eq!(prepared.regularization, 0.0);
     let dl = GravityDerivative::new(g);
     let sensitivity = problem
-        .parameter_sensitivity(&rti, &dl)
+        .parameter_sensitivity(&rti, &dl, &[])
         .expect("sensitivity");
     let plus = solve(g + eps, PlanGuess::Plan(&plan));
     let minus = solve(g - eps, PlanGuess::Plan(&plan));
@@ -129,13 +130,84 @@ fn the_one_disc_barrier_sensitivity_matches_central_differences() {
         .expect("rti");
     let dl = BarrierDerivative::new();
     let refused = problem
-        .parameter_sensitivity(&rti, &dl)
+        .parameter_sensitivity(&rti, &dl, &[])
         .expect_err("unprepared");
     assert!(matches!(refused, Failure::Invalid(_)), "{refused}");
     problem.prepare(&mut rti).expect("prepared");
     let sensitivity = problem
-        .parameter_sensitivity(&rti, &dl)
+        .parameter_sensitivity(&rti, &dl, &[])
         .expect("sensitivity");
     let (plus, minus) = (solve(tau + eps), solve(tau - eps));
     assert_matches("one disc", &sensitivity, (&plus, &minus), eps);
+}
+
+/// dL/dg of the acrobot's cost (`ElbowCost`, unit masses and rods: L = 1/2 tau_2^2):
+/// tau_2 sin(q_0 + q_1).
+#[jet_function(order = 2)]
+fn elbow_gravity_derivative(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
+    let tau2 =
+        (1.0 + q[1].cos()) * ddq[0] + ddq[1] + q[1].sin() * dq[0] * dq[0] + g * (q[0] + q[1]).sin();
+    tau2 * (q[0] + q[1]).sin()
+}
+
+/// d tau_1 / dg of the acrobot's passive shoulder (`ShoulderTorque`, unit masses and rods):
+/// 2 sin q_0 + sin(q_0 + q_1).
+#[jet_function(order = 2)]
+fn shoulder_gravity_derivative(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
+    2.0 * q[0].sin() + (q[0] + q[1]).sin()
+}
+
+/// The acrobot's swing-up (T = 2, N = 50; cost 1/2 tau_2^2, the shoulder's torque zero as an
+/// equality at every step, active by definition): the derivative of the plan and its cost with
+/// respect to gravity, which moves both the cost and the equality, against central
+/// differences of solves at g = 9.81 +- 1e-4, to 1e-6 relative. Leaving out the equality's
+/// derivative gives another (wrong) answer, and a list of the wrong length is refused.
+#[test]
+fn the_acrobot_s_gravity_sensitivity_with_its_equality_matches_central_differences() {
+    use crate::pendulum::{ElbowCost, ShoulderTorque};
+    let goal = [PI, 0.0, 0.0, 0.0];
+    let (t_end, steps) = (2.0, 50);
+    let solve = |g: f64, guess: PlanGuess<'_, 2, 4>| {
+        let (cost, passive) = (
+            ElbowCost::new(1.0, 1.0, 1.0, 1.0, g),
+            ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, g),
+        );
+        OptimalControlProblem::new(&cost, &[0.0; 4], &goal, t_end, steps)
+            .with_equality(&passive)
+            .solve(guess)
+            .expect("acrobot")
+    };
+    let (g, eps) = (9.81, 1e-4);
+    let plan = solve(g, PlanGuess::Spline);
+    let (cost, passive) = (
+        ElbowCost::new(1.0, 1.0, 1.0, 1.0, g),
+        ShoulderTorque::new(1.0, 1.0, 1.0, 1.0, g),
+    );
+    let problem =
+        OptimalControlProblem::new(&cost, &[0.0; 4], &goal, t_end, steps).with_equality(&passive);
+    let mut rti = problem
+        .real_time_iteration(PlanGuess::Plan(&plan))
+        .expect("rti");
+    problem.prepare(&mut rti).expect("prepared");
+    let (dl, dg) = (
+        ElbowGravityDerivative::new(g),
+        ShoulderGravityDerivative::new(),
+    );
+    let sensitivity = problem
+        .parameter_sensitivity(&rti, &dl, &[&dg])
+        .expect("sensitivity");
+    let plus = solve(g + eps, PlanGuess::Plan(&plan));
+    let minus = solve(g - eps, PlanGuess::Plan(&plan));
+    let scale = assert_matches("acrobot", &sensitivity, (&plus, &minus), eps);
+    let without = problem
+        .parameter_sensitivity(&rti, &dl, &[])
+        .expect("cost only");
+    let apart = (without.u.iter().zip(&sensitivity.u))
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0, f64::max);
+    assert!(apart > 1e-3 * scale, "{apart:e}");
+    let refused = problem
+        .parameter_sensitivity(&rti, &dl, &[&dg, &dg])
+        .expect_err("two for one");
+    assert!(matches!(refused, Failure::Invalid(_)), "{refused}");
 }

@@ -63,7 +63,8 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// ```
 pub struct RealTimeIteration<const N: usize, const X: usize> {
     pub(super) iterate: Iterate<N, X>,
-    y: Vec<SVector<f64, N>>,
+    /// The stage equalities' multipliers.
+    pub(super) y: Vec<SVector<f64, N>>,
     pub(super) linearization: Option<Linearization<N, X>>,
     /// The inertia correction of the last preparation.
     pub(super) rho: f64,

@@ -31,8 +31,8 @@ pub struct ParameterSensitivity<const N: usize, const X: usize> {
     pub x: Vec<SVector<f64, X>>,
     /// $\partial u_i / \partial p$, $i < N$.
     pub u: Vec<SVector<f64, N>>,
-    /// $dJ/dp = \sum_i h\thinspace \partial L / \partial p(x_{\theta,i}, u_i)$ (the envelope
-    /// theorem: the constraints do not depend on $p$).
+    /// $dJ/dp$ (the envelope theorem: the derivative of the Lagrangian $J + \sum_i y_i^T g_i$
+    /// in $p$ at the solution).
     pub cost: f64,
 }
 
@@ -85,23 +85,29 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     }
 
     /// The derivative of the iterate of `rti`, a solution ([`Self::prepare`] at a converged
-    /// plan), with respect to a parameter $p$ of the Lagrangian, given its derivative
-    /// `derivative` $= \partial L / \partial p\thinspace(x, u)$ (of every stage's Lagrangian,
-    /// written under `#[jet_function]`): the subproblem prepared at the solution solved with
-    /// the stage gradients $h \nabla_{(x_\theta, u)} \partial L / \partial p$ at
-    /// $(x_{\theta,i}, u_i)$ in place of $h \nabla L$ and no defects, constraint values or
-    /// boundary residuals (the dynamics, stage equalities and ends do not depend on $p$), from
-    /// $\delta x_0 = 0$: $(\partial x_i / \partial p, \partial u_i / \partial p)$; and
-    /// $dJ/dp$. The preparation is kept.
+    /// plan), with respect to a parameter $p$ of the Lagrangian and of the stage equalities,
+    /// given their derivatives: `derivative` $= \partial L / \partial p\thinspace(x, u)$ (of
+    /// every stage's Lagrangian) and `equalities` $= (\partial g_j / \partial p)_j$ in the
+    /// order the equalities were added (empty: they do not depend on $p$), written under
+    /// `#[jet_function]`. The subproblem prepared at the solution is solved with, at each
+    /// step's $(x_{\theta,i}, u_i)$, the stage gradient $h \nabla_{(x_\theta, u)} \partial L
+    /// / \partial p + \sum_j y_{ij} \nabla \partial g_j / \partial p$ ($y_i$: the equalities'
+    /// multipliers) in place of the Lagrangian's and the constraint values $\partial g_j /
+    /// \partial p$, no defects or boundary residuals (the dynamics and the ends do not depend
+    /// on $p$), from $\delta x_0 = 0$: $(\partial x_i / \partial p, \partial u_i / \partial
+    /// p)$; and $dJ/dp = \sum_i (h\thinspace \partial L / \partial p + y_i^T \partial g /
+    /// \partial p)$ (the envelope theorem). The preparation is kept.
     ///
     /// # Errors
     /// [`Failure::Invalid`] if `rti` is not prepared, or was prepared with an inertia
     /// correction (the reduced Hessian is not positive definite there: not a strict local
-    /// minimum, or not a solution); [`Failure::NonFinite`] if the result is not finite.
+    /// minimum, or not a solution), or `equalities` is neither empty nor one per equality;
+    /// [`Failure::NonFinite`] if the result is not finite.
     pub fn parameter_sensitivity<const S: usize, const M: usize>(
         &self,
         rti: &RealTimeIteration<N, X>,
         derivative: &(dyn JetFunction<N, K> + Sync),
+        equalities: &[&(dyn JetFunction<N, K> + Sync)],
     ) -> Result<ParameterSensitivity<N, X>, Failure>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
@@ -109,6 +115,12 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let Some(lin) = rti.linearization.as_ref() else {
             return Err(not_prepared());
         };
+        if !equalities.is_empty() && equalities.len() != self.equalities.len() {
+            return Err(Failure::Invalid(Error::InvalidArgument {
+                name: "equalities",
+                requirement: "one derivative per stage equality, or none",
+            }));
+        }
         if lin.rho != 0.0 {
             return Err(Failure::Invalid(Error::InvalidArgument {
                 name: "real-time iteration",
@@ -122,14 +134,31 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let (x, u) = (rti.x(), rti.u());
         let at = |i: usize| blocks::<N, K, X>(&(x[i] * (1.0 - theta) + x[i + 1] * theta));
         let linear = |i: usize| {
-            let g = derivative.gradient(&at(i), &u[i]);
-            let gx = SVector::<f64, X>::from_fn(|r, _| h * g.x[r / N][r % N]);
+            let (xb, ui) = (at(i), &u[i]);
+            let g = derivative.gradient(&xb, ui);
+            let mut gx = SVector::<f64, X>::from_fn(|r, _| h * g.x[r / N][r % N]);
+            let mut gu = g.u * h;
+            let mut constraint = SVector::<f64, N>::zeros();
+            for (j, c) in equalities.iter().enumerate().take(N) {
+                let (grad, y) = (c.gradient(&xb, ui), rti.y[i][j]);
+                gx += SVector::<f64, X>::from_fn(|r, _| y * grad.x[r / N][r % N]);
+                gu += grad.u * y;
+                constraint[j] = c.value(&xb, ui);
+            }
             StageLinear {
                 lx: dynamics.poly_e.left_t(&gx),
-                lu: dynamics.poly_b.left_t(&gx) * theta + g.u * h,
+                lu: dynamics.poly_b.left_t(&gx) * theta + gu,
                 defect: SVector::zeros(),
-                constraint: SVector::zeros(),
+                constraint,
             }
+        };
+        let stage_cost = |i: usize| {
+            let (xb, ui) = (at(i), &u[i]);
+            let own = h * derivative.value(&xb, ui);
+            let through = (equalities.iter().enumerate().take(N))
+                .map(|(j, c)| rti.y[i][j] * c.value(&xb, ui))
+                .sum::<f64>();
+            own + through
         };
         let zero = SVector::<f64, X>::zeros();
         let mut pool = rti.workspace.pool.borrow_mut();
@@ -138,9 +167,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let sensitivity = ParameterSensitivity {
             x: solved.dx.clone(),
             u: solved.du.clone(),
-            cost: (0..u.len())
-                .map(|i| h * derivative.value(&at(i), &u[i]))
-                .sum(),
+            cost: (0..u.len()).map(stage_cost).sum(),
         };
         solved.recycle(&mut *pool);
         let finite = |v: &[f64]| v.iter().all(|e| e.is_finite());
