@@ -1,9 +1,11 @@
 //! Receding-horizon control of the double pendulum with the plant in the loop
 //! (`examples/common/pendulum.rs` has the loop): from the hanging rest state, swing up and
 //! hold upright, re-planning every control period h = T / N (N = 50, T = 1 s) from the
-//! plant's state with at most two warm-started SQP iterations. Prints exactly one line:
+//! plant's state with two real-time iterations (feedback steps of the library's
+//! `RealTimeIteration`, started from a full solve). Prints exactly one line:
 //! `re-plans=<n> failures=<f> median_us=<m> p99_us=<p> max_us=<x>` (a failure is a re-plan
-//! that returns an error; the times are those of the re-plans alone).
+//! that fell back to the shifted plan or a preparation that failed; the times are those of
+//! the re-plans alone, with the shift and the next preparation).
 //!
 //! Run: `cargo run --release --example mpc_swing_up` (1000 re-plans, 20 s of simulated time; add a
 //! number for another count).

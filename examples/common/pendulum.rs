@@ -6,8 +6,8 @@
 //!
 //! Every control period h the planner re-plans from the plant's measured state (q, q') to the
 //! upright equilibrium over a fixed horizon T = N h: the minimum-torque problem
-//! L = 1/2 |tau|^2 on the lifted-midpoint transcription, warm-started from its last plan
-//! shifted by one step, with at most `ITERATIONS` SQP iterations (real-time iteration). The
+//! L = 1/2 |tau|^2 on the lifted-midpoint transcription, by `ITERATIONS` real-time iterations
+//! (feedback steps of the subproblem prepared at its last plan shifted by one step). The
 //! plant, the mechanical Lagrangian T - V, takes one forced-midpoint step (discrete
 //! Lagrange-d'Alembert) under the torque of the plan's first step at its midpoint. From the
 //! hanging rest state the loop swings the pendulum up, then holds it upright.
@@ -16,7 +16,9 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, Workspace};
+use retract::bvp::{
+    Control, ControlOptions, InputSource, OptimalControlProblem, PlanGuess, RealTimeIteration,
+};
 use retract::forced::forced_step;
 use retract::nalgebra::SVector;
 use retract::{
@@ -27,7 +29,7 @@ use retract::{
 pub const STEPS: usize = 50;
 /// Horizon length (s); the control period is `HORIZON / STEPS`.
 pub const HORIZON: f64 = 1.0;
-/// SQP iterations per re-plan at most.
+/// Real-time iterations (feedback steps) per re-plan.
 pub const ITERATIONS: usize = 2;
 /// Masses, lengths and gravity of both models.
 const M1: f64 = 1.0;
@@ -158,7 +160,7 @@ pub struct Summary {
     pub failures: usize,
     /// Wall time of every re-plan (microseconds), in order.
     pub times_us: Vec<f64>,
-    /// Re-plans whose plan was a certified minimum.
+    /// Re-plans whose last Newton step was at most 1e-6.
     pub converged: usize,
     /// The plant's jet (q, q') after the last step.
     pub last: [f64; 4],
@@ -176,78 +178,90 @@ impl Summary {
     }
 }
 
-/// The torque of a plan's first step, at its midpoint: tau(x_theta,0, u_0).
-fn first_torque(model: &TorqueCost, plan: &Plan<2, 4>) -> [f64; 2] {
-    let x = (plan.x[0] + plan.x[1]) * 0.5;
+/// The torque of a first step at its midpoint: tau((x_0 + x_1) / 2, u_0).
+fn first_torque(
+    model: &TorqueCost,
+    [x0, x1]: &[SVector<f64, 4>; 2],
+    u0: &SVector<f64, 2>,
+) -> [f64; 2] {
+    let x = (x0 + x1) * 0.5;
     let jet = [
         x.fixed_rows::<2>(0).into_owned(),
         x.fixed_rows::<2>(2).into_owned(),
     ];
-    model.tau(&jet, &plan.u[0])
+    model.tau(&jet, u0)
 }
 
-/// The receding-horizon controller: one problem, re-solved from each measured state by
-/// [`ITERATIONS`] SQP iterations from the last plan moved one period on, in one workspace
-/// (no allocation a period once the workspace has served a re-plan).
+/// The receding-horizon controller: one problem and its real-time iteration (as acados'
+/// RTI), started from a full solve; each period [`ITERATIONS`] feedback steps from the
+/// measured state (the library's [`OptimalControlProblem::control`], which applies the
+/// shifted plan's input if a re-plan fails), then the iterate shifted by a period and its
+/// subproblem prepared for the next one (no allocation a period).
 pub struct Controller<'m> {
     model: &'m TorqueCost,
     problem: OptimalControlProblem<'m, TorqueCost, 2, 2, 4>,
-    workspace: Workspace<2, 4>,
-    plan: Option<Plan<2, 4>>,
+    rti: RealTimeIteration<2, 4>,
+    options: ControlOptions,
+    /// The last period's applied first step.
+    applied: Control<2, 4>,
 }
 
 /// How a re-plan ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Replan {
-    /// A certified plan.
+    /// The re-plan applied, converged (its last Newton step at most 1e-6).
     Converged,
-    /// The iterate after [`ITERATIONS`] iterations.
+    /// The re-plan applied, not converged (the tangential predictor).
     Unfinished,
-    /// A failure: the controller goes on with its last iterate (or the shifted plan).
+    /// The re-plan failed (the shifted plan's input applied) or the next preparation did.
     Failed,
 }
 
 impl<'m> Controller<'m> {
-    /// A controller towards the upright rest state, from the jet `jet`.
-    pub fn new(model: &'m TorqueCost, jet: &[f64; 4]) -> Self {
+    /// A controller towards the upright rest state, from the jet `jet`: the plan solved from
+    /// there, its real-time iteration prepared.
+    ///
+    /// # Errors
+    /// The first solve or preparation failing.
+    pub fn new(model: &'m TorqueCost, jet: &[f64; 4]) -> Result<Self, Box<dyn std::error::Error>> {
         let goal = [PI, 0.0, 0.0, 0.0];
-        Self {
+        let problem = OptimalControlProblem::new(model, jet, &goal, HORIZON, STEPS);
+        let plan = problem.solve(PlanGuess::Spline)?;
+        let mut rti = problem.real_time_iteration(PlanGuess::Plan(&plan))?;
+        problem.prepare(&mut rti)?;
+        let applied = (problem).clamped_control(
+            ([plan.x[0], plan.x[1]], plan.u[0]),
+            InputSource::Converged,
+            (0, 0.0),
+        );
+        Ok(Self {
             model,
-            problem: OptimalControlProblem::new(model, jet, &goal, HORIZON, STEPS),
-            workspace: Workspace::new(),
-            plan: None,
-        }
+            problem,
+            rti,
+            options: ControlOptions::default().with_iterations(ITERATIONS),
+            applied,
+        })
     }
 
-    /// Re-plans from the measured jet `jet`.
+    /// Re-plans from the measured jet `jet` (the input to apply: [`Self::torque`]), then
+    /// prepares the next period.
     pub fn replan(&mut self, jet: &[f64; 4]) -> Replan {
-        self.problem.set_start(jet);
-        // the last plan moved one period on (one it cannot shift is kept as it is)
-        if let Some(plan) = self.plan.as_mut() {
-            let _ = plan.try_shift();
+        self.applied = self.problem.control(&mut self.rti, jet, &self.options);
+        self.rti.shift();
+        let prepared = self.problem.prepare(&mut self.rti).is_ok();
+        let status = self.applied.status;
+        if !status.replanned() || !prepared {
+            Replan::Failed
+        } else if status.converged() {
+            Replan::Converged
+        } else {
+            Replan::Unfinished
         }
-        let guess = self
-            .plan
-            .as_ref()
-            .map_or(PlanGuess::Spline, PlanGuess::Plan);
-        let result = (self.problem).solve_real_time_with(guess, ITERATIONS, &mut self.workspace);
-        let (next, outcome) = match result {
-            Ok(real_time) if real_time.converged => (Some(real_time.plan), Replan::Converged),
-            Ok(real_time) => (Some(real_time.plan), Replan::Unfinished),
-            // keep going on the last iterate (or the previous plan, shifted)
-            Err(error) => (error.last.map(|p| *p), Replan::Failed),
-        };
-        if let Some(next) = next
-            && let Some(old) = self.plan.replace(next)
-        {
-            self.workspace.recycle(old);
-        }
-        outcome
     }
 
-    /// The torque of the plan's first step (zero without any plan).
+    /// The torque of the last re-plan's first step.
     pub fn torque(&self) -> [f64; 2] {
-        (self.plan.as_ref()).map_or([0.0; 2], |plan| first_torque(self.model, plan))
+        first_torque(self.model, &self.applied.x, &self.applied.input)
     }
 }
 
@@ -290,8 +304,8 @@ pub fn upright_models() -> (UprightCost, Plant) {
 /// Runs `replans` control periods from the hanging rest state.
 ///
 /// # Errors
-/// A plant step that fails (the plant itself, not a re-plan: those are counted).
-pub fn run(replans: usize) -> Result<Summary, retract::Error> {
+/// The first solve, or a plant step, failing (the re-plans' failures are counted).
+pub fn run(replans: usize) -> Result<Summary, Box<dyn std::error::Error>> {
     let (model, pendulum) = models();
     let mut jet = [0.0; 4];
     let mut z = pendulum.legendre(&SVector::from(jet));
@@ -303,7 +317,7 @@ pub fn run(replans: usize) -> Result<Summary, retract::Error> {
         last: jet,
         max_torque: 0.0,
     };
-    let mut controller = Controller::new(&model, &jet);
+    let mut controller = Controller::new(&model, &jet)?;
     for _ in 0..replans {
         let started = Instant::now();
         let outcome = controller.replan(&jet);

@@ -17,7 +17,8 @@ use std::time::Instant;
 use crate::pendulum::{HORIZON, Plant, STEPS, UprightCost, plant_step, upright_models};
 use retract::LiftedSystem;
 use retract::bvp::{
-    OptimalControlProblem, Plan, PlanGuess, PlanOptions, RealTimeIteration, Workspace,
+    Control, ControlOptions, ControlStatus, Fallback, InputSource, OptimalControlProblem, Plan,
+    PlanGuess, PlanOptions, RealTimeIteration, Workspace,
 };
 use retract::nalgebra::SVector;
 
@@ -65,65 +66,57 @@ pub fn first_torque(
 }
 
 /// A receding-horizon controller of the benchmark: one problem, its real-time iteration and
-/// the last full plan, in one workspace. Every period says how its torque was chosen
-/// ([`Status`]): a re-plan that is not converged is never applied silently, a failed one
-/// falls back to the previous plan shifted by a period, and the applied torque is clamped to
-/// the torque limit ([`Self::with_torque_limit`]; none by default, as in the benchmark).
+/// the last full plan, in one workspace. Every period says how its input was chosen (the
+/// library's [`ControlStatus`]): a re-plan that is not converged is never applied silently,
+/// a failed one falls back to the previous plan shifted by a period, and the applied input
+/// q'' is clamped to the problem's input bounds ([`Self::with_input_limit`]; none by default,
+/// as in the benchmark). The torque applied is the one of that input ([`Period::tau`]).
 pub struct Controller<'m> {
     model: &'m UprightCost,
     problem: OptimalControlProblem<'m, UprightCost, 2, 2, 4>,
     mode: Mode,
+    options: ControlOptions,
     rti: RealTimeIteration<2, 4>,
     plan: Plan<2, 4>,
     workspace: Workspace<2, 4>,
     /// The measured jet of the last period.
     start: [f64; 4],
-    /// |tau_a| <= limit for the applied torque.
-    limit: f64,
-}
-
-/// The Newton step of a real-time iteration below which its iterate counts as converged
-/// (the iterate it started from solved the problem for the measured start to this size).
-pub const CONVERGED_STEP: f64 = 1e-6;
-
-/// Where a period's torque came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Source {
-    /// The re-plan of this period (converged or not: [`Status::converged`]).
-    Replan,
-    /// The re-plan failed (or gave no finite torque): the previous plan shifted by a period.
-    Shifted,
-}
-
-/// How a period's torque was chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Status {
-    /// Whether the re-plan converged: a full solve certified its plan, or a real-time
-    /// iteration's Newton step was below [`CONVERGED_STEP`] (its last step, with two).
-    pub converged: bool,
-    /// The plan the torque is read from.
-    pub source: Source,
-    /// Whether the torque was clamped to the limit.
-    pub clamped: bool,
 }
 
 /// What one period's re-plan gave.
 #[derive(Clone, Copy, Debug)]
 pub struct Period {
-    /// The torque to apply (within the limit, finite).
+    /// The torque to apply (finite): the plan's torque at its first step's midpoint,
+    /// tau((x_0 + x_1) / 2, u_0), for an applied re-plan's unclamped input; otherwise (a
+    /// clamped or fallback input, no longer consistent with the plan's jets) the torque that
+    /// gives the input's accelerations at the measured jet, tau(x_measured, u).
     pub tau: [f64; 2],
-    /// The torque of the plan before clamping.
-    pub planned: [f64; 2],
+    /// The input applied (q'' of the first step, within the problem's input bounds).
+    pub input: SVector<f64, 2>,
+    /// The chosen plan's input before clamping.
+    pub planned: SVector<f64, 2>,
     /// The time from the measured state to the torque (us).
     pub feedback_us: f64,
-    /// How the torque was chosen.
-    pub status: Status,
+    /// How the input was chosen.
+    pub status: ControlStatus,
 }
 
 impl Period {
-    /// Whether the re-plan failed (the torque is the shifted plan's).
+    /// Whether the re-plan failed (the input is the shifted plan's).
     pub fn failed(&self) -> bool {
-        self.status.source == Source::Shifted
+        !self.status.replanned()
+    }
+}
+
+/// The benchmark's problem: upright to upright, with |q''_a| <= `limit` when given.
+fn upright_problem(
+    model: &UprightCost,
+    limit: Option<f64>,
+) -> OptimalControlProblem<'_, UprightCost, 2, 2, 4> {
+    let problem = OptimalControlProblem::new(model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS);
+    match limit {
+        Some(a) => problem.with_input_bounds([-a; 2], [a; 2]),
+        None => problem,
     }
 }
 
@@ -133,20 +126,45 @@ impl<'m> Controller<'m> {
     /// # Errors
     /// The first solve or preparation failing.
     pub fn new(model: &'m UprightCost, mode: Mode) -> Result<Self, Box<dyn std::error::Error>> {
-        let problem = OptimalControlProblem::new(model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS);
+        Self::bounded(model, mode, None)
+    }
+
+    /// [`Self::new`] with the problem's input bounds |q''_a| <= `limit` (the re-plans' inputs
+    /// clamped to them).
+    ///
+    /// # Errors
+    /// The first solve or preparation failing.
+    pub fn with_input_limit(
+        model: &'m UprightCost,
+        mode: Mode,
+        limit: f64,
+    ) -> Result<Self, Box<dyn std::error::Error>> {
+        Self::bounded(model, mode, Some(limit))
+    }
+
+    fn bounded(
+        model: &'m UprightCost,
+        mode: Mode,
+        limit: Option<f64>,
+    ) -> Result<Self, Box<dyn std::error::Error>> {
+        let problem = upright_problem(model, limit);
         let mut workspace = Workspace::new();
         let plan = problem.solve_with(PlanGuess::Spline, &mut workspace)?;
         let mut rti = problem.real_time_iteration(PlanGuess::Plan(&plan))?;
         problem.prepare(&mut rti)?;
+        let iterations = match mode {
+            Mode::Rti(n) => n,
+            Mode::Full => 1,
+        };
         Ok(Self {
             model,
             problem,
             mode,
+            options: ControlOptions::default().with_iterations(iterations),
             rti,
             plan,
             workspace,
             start: UPRIGHT,
-            limit: f64::INFINITY,
         })
     }
 
@@ -155,14 +173,14 @@ impl<'m> Controller<'m> {
     /// falls back to the shifted plan).
     pub fn with_time_budget(mut self, budget: std::time::Duration) -> Self {
         let options = PlanOptions::default().with_max_time(budget);
-        self.problem = OptimalControlProblem::new(self.model, &UPRIGHT, &UPRIGHT, HORIZON, STEPS)
-            .with_options(options);
+        self.problem = self.problem.with_options(options);
         self
     }
 
-    /// The controller with the applied torque clamped to |tau_a| <= `limit`.
-    pub fn with_torque_limit(mut self, limit: f64) -> Self {
-        self.limit = limit;
+    /// The controller with the real-time re-plans applied only while their Newton steps are
+    /// at most `step` ([`ControlOptions::max_step`]).
+    pub fn with_max_step(mut self, step: f64) -> Self {
+        self.options = self.options.with_max_step(step);
         self
     }
 
@@ -170,59 +188,61 @@ impl<'m> Controller<'m> {
     pub fn control(&mut self, jet: &[f64; 4]) -> Period {
         let started = Instant::now();
         self.start = *jet;
-        // the fallback: the torque of the plan shifted at the last preparation
-        let shifted = self.torque();
-        let (replanned, converged) = match self.mode {
-            Mode::Rti(iterations) => {
-                let mut fed = self.problem.feedback(&mut self.rti, jet);
-                let replanned = fed.is_ok();
-                for _ in 1..iterations {
-                    if fed.is_ok() && self.problem.prepare(&mut self.rti).is_ok() {
-                        fed = self.problem.feedback(&mut self.rti, jet);
-                    }
-                }
-                let converged = fed.is_ok_and(|f| f.step <= CONVERGED_STEP);
-                (replanned, converged)
-            }
-            Mode::Full => {
-                self.problem.set_start(jet);
-                let _ = self.plan.try_shift();
-                let solved = self
-                    .problem
-                    .solve_with(PlanGuess::Plan(&self.plan), &mut self.workspace);
-                match solved {
-                    Ok(next) => {
-                        self.workspace
-                            .recycle(std::mem::replace(&mut self.plan, next));
-                        (true, true)
-                    }
-                    Err(_) => (false, false),
-                }
-            }
+        let control = match self.mode {
+            Mode::Rti(_) => self.problem.control(&mut self.rti, jet, &self.options),
+            Mode::Full => self.full(jet),
         };
-        let planned = if replanned { self.torque() } else { shifted };
-        let finite = planned.iter().all(|t| t.is_finite());
-        let source = if replanned && finite {
-            Source::Replan
+        let [x0, x1] = &control.x;
+        let status = control.status;
+        let tau = if status.replanned() && !status.clamped {
+            first_torque(self.model, (x0, x1), &control.input)
         } else {
-            Source::Shifted
+            // (the input is no longer the plan's: the torque that gives it where the plant is)
+            let jet = SVector::from(*jet);
+            let at = [
+                jet.fixed_rows::<2>(0).into_owned(),
+                jet.fixed_rows::<2>(2).into_owned(),
+            ];
+            self.model.tau(&at, &control.input)
         };
-        let chosen = match source {
-            Source::Replan => planned,
-            // (a shifted plan without a finite torque: none)
-            Source::Shifted if shifted.iter().all(|t| t.is_finite()) => shifted,
-            Source::Shifted => [0.0; 2],
-        };
-        let tau = chosen.map(|t| t.clamp(-self.limit, self.limit));
         Period {
             tau,
-            planned,
+            input: control.input,
+            planned: control.planned,
             feedback_us: started.elapsed().as_secs_f64() * 1e6,
-            status: Status {
-                converged: converged && source == Source::Replan,
-                source,
-                clamped: tau != chosen,
-            },
+            status: control.status,
+        }
+    }
+
+    /// A full solve from the plan shifted by [`Self::prepare`], as a control period: the new
+    /// plan's first input if it solved, else the shifted plan's; clamped to the input bounds
+    /// (the status's step is 0: no Newton step is measured).
+    fn full(&mut self, jet: &[f64; 4]) -> Control<2, 4> {
+        self.problem.set_start(jet);
+        let shifted = ([self.plan.x[0], self.plan.x[1]], self.plan.u[0]);
+        let solved = (self.problem).solve_with(PlanGuess::Plan(&self.plan), &mut self.workspace);
+        let (source, iterations) = match solved {
+            Ok(next) => {
+                let iterations = next.iterations;
+                self.workspace
+                    .recycle(std::mem::replace(&mut self.plan, next));
+                (InputSource::Converged, iterations)
+            }
+            Err(_) => (InputSource::Shifted(Fallback::Failed), 0),
+        };
+        let first = match source {
+            InputSource::Converged => ([self.plan.x[0], self.plan.x[1]], self.plan.u[0]),
+            _ => shifted,
+        };
+        (self.problem).clamped_control(first, source, (iterations, 0.0))
+    }
+
+    /// The input q'' of the current plan's first step (between [`Self::prepare`] and
+    /// [`Self::control`]: the shifted plan's, the period's fallback).
+    pub fn input(&self) -> SVector<f64, 2> {
+        match self.mode {
+            Mode::Rti(_) => self.rti.u()[0],
+            Mode::Full => self.plan.u[0],
         }
     }
 
@@ -240,11 +260,13 @@ impl<'m> Controller<'m> {
         }
     }
 
-    /// The preparation for the next period (real-time iterations: the iterate shifted and its
-    /// subproblem prepared); whether it failed. A failed preparation starts the real-time
-    /// iteration again from the spline between the last measured jet and the goal.
+    /// The preparation for the next period: the plan shifted by a period (a plan that cannot
+    /// shift is kept) and, for real-time iterations, the subproblem prepared at it; whether
+    /// it failed. A failed preparation starts the real-time iteration again from the spline
+    /// between the last measured jet and the goal.
     pub fn prepare(&mut self) -> bool {
         let Mode::Rti(_) = self.mode else {
+            let _ = self.plan.try_shift();
             return false;
         };
         self.rti.shift();

@@ -22,6 +22,7 @@ mod mpc;
 mod optimize;
 mod placement;
 mod realtime;
+mod sensitivity;
 mod stage_systems;
 mod typed_data;
 mod vector_bounds;

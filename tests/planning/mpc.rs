@@ -38,7 +38,8 @@ fn the_applied_torque_is_the_planned_one() {
 }
 
 /// 300 re-plans (6 s): no re-plan fails, the pendulum ends upright at rest (to 1e-6; it
-/// starts hanging, pi away), and once there the real-time iterations certify their plans.
+/// starts hanging, pi away), and once there the real-time iterations converge (Newton steps
+/// at most 1e-6).
 #[test]
 fn the_loop_swings_up_and_holds() {
     let summary = pendulum::run(300).expect("the plant steps");
@@ -49,7 +50,7 @@ fn the_loop_swings_up_and_holds() {
     assert!(error < 1e-6, "final state {:?}", summary.last);
     assert!(
         summary.converged >= 200,
-        "{} certified plans",
+        "{} converged plans",
         summary.converged
     );
 }

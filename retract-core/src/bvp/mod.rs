@@ -48,7 +48,10 @@
 //!    iterate), `extrapolate` (Richardson extrapolation, [`Extrapolated`]), `free_time` (the
 //!    horizon as a decision variable, [`FreeTime`], [`FreeTimePlan`]).
 //! 10. `realtime` (real-time iterations in a preparation and a feedback phase,
-//!     [`RealTimeIteration`]).
+//!     [`RealTimeIteration`]), `control` (a control period's safeguarded input and its
+//!     status, [`OptimalControlProblem::control`]), `sensitivity` (a plan's derivatives with
+//!     respect to its start and the Lagrangian's parameters from the factorisation at the
+//!     solution).
 //! 11. `batch` (many plans at once: [`solve_batch`], [`solve_stream`],
 //!     [`OptimalControlProblem::solve_multistart`]; on rayon's thread pool with the
 //!     `parallel` feature).
@@ -109,6 +112,7 @@
 mod barrier;
 mod batch;
 mod constraints;
+mod control;
 mod curve;
 mod dynamics;
 mod extrapolate;
@@ -120,6 +124,7 @@ mod options;
 mod plan;
 mod problem;
 mod realtime;
+mod sensitivity;
 mod solve;
 mod sqp;
 mod stack;
@@ -131,6 +136,7 @@ mod hostile_json;
 
 pub use batch::{Job, MultiStart, Outcome, Stream, solve_batch, solve_stream};
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
+pub use control::{Control, ControlOptions, ControlStatus, Fallback, InputSource};
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
 pub use free_time::{FreeTime, FreeTimePlan};
@@ -139,7 +145,8 @@ pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};
 pub use problem::OptimalControlProblem;
-pub use realtime::{Feedback, Preparation, RealTimeIteration, Sensitivity};
+pub use realtime::{Feedback, Preparation, RealTimeIteration};
+pub use sensitivity::{ParameterSensitivity, Sensitivity};
 pub use workspace::Workspace;
 
 mod root_finder;

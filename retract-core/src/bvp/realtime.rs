@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
+use super::constraints::{Inequality, Source, Variable};
 use super::dynamics::Dynamics;
 use super::iterate::Iterate;
 use super::options::PlanGuess;
@@ -31,6 +32,11 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// 2. [`Self::shift`] (the iterate one period on) and [`OptimalControlProblem::prepare`]
 ///    (models, factorisation and the backward pass of the solve at the shifted iterate,
 ///    none of which needs the next start), while the system moves.
+///
+/// [`OptimalControlProblem::control`] makes step 1 a safeguarded control period: it chooses
+/// the input to apply (the re-plan's, or the shifted plan's when the re-plan failed), clamps
+/// it to the problem's bounds on the top derivative and says how it was chosen
+/// ([`ControlStatus`](super::ControlStatus)).
 ///
 /// The full step of the tangential predictor is a Newton step of the KKT conditions with the
 /// start as a parameter: from an iterate that solves the problem for the predicted start $a$
@@ -56,14 +62,15 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub struct RealTimeIteration<const N: usize, const X: usize> {
-    iterate: Iterate<N, X>,
-    y: Vec<SVector<f64, N>>,
-    linearization: Option<Linearization<N, X>>,
+    pub(super) iterate: Iterate<N, X>,
+    /// The stage equalities' multipliers.
+    pub(super) y: Vec<SVector<f64, N>>,
+    pub(super) linearization: Option<Linearization<N, X>>,
     /// The inertia correction of the last preparation.
-    rho: f64,
+    pub(super) rho: f64,
     h: f64,
     theta: f64,
-    workspace: Workspace<N, X>,
+    pub(super) workspace: Workspace<N, X>,
 }
 
 /// What a preparation found at the iterate: the largest constraint violation there (the
@@ -90,11 +97,6 @@ pub struct Feedback {
     /// The start's change.
     pub start_change: f64,
 }
-
-/// A plan's derivative along a direction of its start:
-/// $(\partial x_i / \partial a\thinspace d)_{i \le N}$ and $(\partial u_i / \partial
-/// a\thinspace d)_{i < N}$ ([`OptimalControlProblem::start_sensitivity`]).
-pub type Sensitivity<const N: usize, const X: usize> = (Vec<SVector<f64, X>>, Vec<SVector<f64, N>>);
 
 impl<const N: usize, const X: usize> RealTimeIteration<N, X> {
     /// The iterate's jets $x_0, \dots, x_N$.
@@ -152,12 +154,16 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 {
     /// A real-time iteration of this problem from `guess` (typically the plan of a full solve,
     /// [`PlanGuess::Plan`], with its multipliers), not yet prepared. Problems with stage
-    /// equalities but no inequalities: the full step of the feedback phase has no
-    /// fraction-to-the-boundary rule for slacks.
+    /// equalities, and inequalities only as bounds on the top derivative
+    /// ([`Self::with_input_bounds`], [`Self::with_bounds`] on [`Variable::Top`]): the full step
+    /// of the feedback phase has no fraction-to-the-boundary rule for slacks, so the subproblem
+    /// does not see the bounds; they bound the input a control period applies, which is
+    /// clamped to them ([`Self::control`], [`Self::clamp_input`]), while the iterate's later
+    /// inputs may lie outside.
     ///
     /// # Errors
     /// As [`Self::solve`] before its first iteration; [`Failure::Invalid`] for a problem with
-    /// inequalities.
+    /// other inequalities (on functions or on the jet).
     pub fn real_time_iteration<const S: usize, const M: usize>(
         &self,
         guess: PlanGuess<'_, N, X>,
@@ -166,12 +172,14 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
         self.check_problem::<S, M>()?;
-        if !self.inequalities.is_empty() {
+        let input_bound =
+            |c: &Inequality<'a, N, K>| matches!(c.source, Source::Variable(Variable::Top(_)));
+        if !self.inequalities.iter().all(input_bound) {
             return Err(PlanError::without_iterate(Failure::Invalid(
                 Error::InvalidArgument {
                     name: "problem",
-                    requirement: "a real-time iteration takes full steps: stage equalities, \
-                                  no inequalities",
+                    requirement: "a real-time iteration takes full steps: stage equalities and \
+                                  bounds on the top derivative, no other inequalities",
                 },
             )));
         }
@@ -264,69 +272,21 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         })
     }
 
-    /// The derivative of the iterate of `rti` with respect to the start, along `direction`:
-    /// $(\partial x_i / \partial a, \partial u_i / \partial a)\thinspace d$ for $d = $
-    /// `direction` (its free start components ignored), from the subproblem prepared at the
-    /// iterate, which must be a solution ([`Self::prepare`] at a converged plan): the
-    /// subproblem's solution is affine in $\delta x_0$, and its linear part is the KKT
-    /// system's derivative, so the sensitivity is the forward pass from $\delta x_0 = d$
-    /// less the one from $\delta x_0 = 0$. The preparation is kept (for more directions or a
-    /// feedback).
-    ///
-    /// # Errors
-    /// [`Failure::Invalid`] if `rti` is not prepared.
-    pub fn start_sensitivity<const S: usize, const M: usize>(
-        &self,
-        rti: &RealTimeIteration<N, X>,
-        direction: &[f64; X],
-    ) -> Result<Sensitivity<N, X>, Failure>
-    where
-        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
-    {
-        let Some(lin) = rti.linearization.as_ref() else {
-            return Err(Failure::Invalid(Error::InvalidArgument {
-                name: "real-time iteration",
-                requirement: "prepared (OptimalControlProblem::prepare) before a sensitivity",
-            }));
-        };
-        let sqp = self.sqp::<S, M>(&rti.workspace);
-        let d = SVector::<f64, X>::from_column_slice(direction).component_mul(&self.fixed_start);
-        let mut pool = rti.workspace.pool.borrow_mut();
-        let (riccati, dynamics) = (&lin.riccati, &sqp.dynamics);
-        let moved = riccati.forward(dynamics, &lin.prepared, &d, &lin.r_end, &mut *pool);
-        let base = (riccati).forward(
-            dynamics,
-            &lin.prepared,
-            &SVector::zeros(),
-            &lin.r_end,
-            &mut *pool,
-        );
-        let dx = (moved.dx.iter().zip(&base.dx))
-            .map(|(a, b)| a - b)
-            .collect();
-        let du = (moved.du.iter().zip(&base.du))
-            .map(|(a, b)| a - b)
-            .collect();
-        moved.recycle(&mut *pool);
-        base.recycle(&mut *pool);
-        Ok((dx, du))
-    }
-
-    /// The SQP iteration's phases over `workspace`, with the problem's options.
-    fn sqp<'s, const S: usize, const M: usize>(
+    /// The SQP iteration's phases over `workspace`, with the problem's options and without
+    /// its inequalities (bounds on the top derivative, which clamp the applied input only).
+    pub(super) fn sqp<'s, const S: usize, const M: usize>(
         &'s self,
         workspace: &'s Workspace<N, X>,
     ) -> Sqp<'s, 'a, Sys, N, K, X, S, M>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
-        let placed = self.placed();
         Sqp {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started: Instant::now(),
-            at_steps: &placed.at_steps,
-            at_nodes: &placed.at_nodes,
+            at_steps: &[],
+            at_nodes: &[],
             pool: &workspace.pool,
             options: self.options,
             real_time: true,
