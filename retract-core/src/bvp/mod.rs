@@ -130,10 +130,6 @@ mod sqp;
 mod stack;
 mod workspace;
 
-#[cfg(test)]
-#[cfg(feature = "serde")]
-mod hostile_json;
-
 pub use batch::{Job, MultiStart, Outcome, Stream, solve_batch, solve_stream};
 pub use constraints::{ConstraintKind, ConstraintRef, Placement, Variable};
 pub use control::{Control, ControlOptions, ControlStatus, Fallback, InputSource};

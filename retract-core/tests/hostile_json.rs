@@ -3,14 +3,16 @@
 //! error that names it, never turned into a NaN result. (`Plan` and `Extrapolated` have
 //! their own in `plan` and `extrapolate`.)
 
+#![cfg(feature = "serde")]
+
 use serde_json::{Value, json};
 
-use super::{
+use retract_core::Error;
+use retract_core::bvp::{
     BoundaryValueProblem, BvpOptions, BvpSolution, Failure, Guess, OptimalControlProblem,
     PlanGuess, PlanOptions, Variable,
 };
-use crate::Error;
-use crate::models::PlanarBarrier;
+use retract_core::models::PlanarBarrier;
 
 type Edit = fn(&mut Value);
 
@@ -191,7 +193,7 @@ fn hostile_duals_are_dropped_by_the_warm_start() {
     let plan = problem.solve(PlanGuess::Spline).expect("a regular problem");
     assert!(!plan.duals.step_slacks.is_empty() && !plan.duals.node_slacks.is_empty());
     let mut bare = plan.clone();
-    bare.duals = super::Duals::default();
+    bare.duals = retract_core::bvp::Duals::default();
     let without = problem.solve(PlanGuess::Plan(&bare)).expect("a warm start");
     let valid = serde_json::to_value(&plan).expect("writes");
     let hostile: [(&str, Edit); 6] = [
@@ -215,7 +217,7 @@ fn hostile_duals_are_dropped_by_the_warm_start() {
         }),
     ];
     for (what, edit) in hostile {
-        let mut read: super::Plan<2, 4> =
+        let mut read: retract_core::bvp::Plan<2, 4> =
             serde_json::from_value(edited(&valid, edit)).unwrap_or_else(|e| panic!("{what}: {e}"));
         // (the equalities' multipliers are dropped alike: compare with none)
         if what.contains("equality") {
