@@ -6,32 +6,80 @@
 //! (`retract_validation::report`).
 //!
 //! Run: `cargo run --release -p retract-validation --example report` (about a minute), or
-//! with `-- --quick` for the same lines at reduced size in a few seconds.
+//! with `-- --quick` for the same lines at reduced size in a few seconds; `-- --batch` prints
+//! only the plans across cores (`batch <name> threads=<t> plans_per_s=<p> scaling=<s>`);
+//! `-- --write docs/benchmarks.md` also writes the report into that file, between its lines
+//! `<!-- report:begin ... -->` and `<!-- report:end -->`.
 
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use retract_validation::Error;
 use retract_validation::report::{self, Size};
 
+/// Standard output, with a copy of everything written (for `--write`).
+struct Tee<W> {
+    stdout: W,
+    text: Vec<u8>,
+}
+
+impl<W: Write> Write for Tee<W> {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let written = self.stdout.write(bytes)?;
+        self.text.extend_from_slice(&bytes[..written]);
+        Ok(written)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.stdout.flush()
+    }
+}
+
 fn run() -> Result<(), Error> {
     let mut size = Size::full();
-    for argument in std::env::args().skip(1) {
+    let mut only_batches = false;
+    let mut target = None;
+    let mut arguments = std::env::args().skip(1);
+    while let Some(argument) = arguments.next() {
         match argument.as_str() {
             "--quick" => size = Size::quick(),
+            "--batch" => only_batches = true,
+            "--write" => match arguments.next() {
+                Some(path) => target = Some(PathBuf::from(path)),
+                None => return Err(invalid("`--write` needs the path of the file to write")),
+            },
             other => {
-                return Err(Error::Io(std::io::Error::new(
-                    std::io::ErrorKind::InvalidInput,
-                    format!("unknown argument `{other}`; supported: --quick"),
+                return Err(invalid(&format!(
+                    "unknown argument `{other}`; supported: --quick, --batch, --write PATH"
                 )));
             }
         }
     }
     let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    report::run(&size, &mut out)?;
+    let mut out = Tee {
+        stdout: stdout.lock(),
+        text: Vec::new(),
+    };
+    if only_batches {
+        writeln!(out, "{}", report::header(&size))?;
+        report::batches(&size, &mut out)?;
+    } else {
+        report::run(&size, &mut out)?;
+    }
     out.flush()?;
+    if let Some(path) = target {
+        report::write_block(&path, &String::from_utf8_lossy(&out.text))?;
+    }
     Ok(())
+}
+
+/// An error about the command line.
+fn invalid(message: &str) -> Error {
+    Error::Io(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        message,
+    ))
 }
 
 fn main() -> ExitCode {

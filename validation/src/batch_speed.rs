@@ -2,9 +2,10 @@
 //! the machine's cores, for two batches:
 //!
 //! - `one-disc`: the one-disc scene of `../shared/BENCHMARKS.md` (N = 400, from the guess
-//!   bumped above the disc) from starts moved up by 0.01 each;
+//!   bumped above the disc) from starts moved up by 0.01 each (16 distinct starts, repeated);
 //! - `swing-up`: the double pendulum of the swing-up suite (T = 2, N = 200, from the
-//!   smoothstep) to goals $(\pi + \delta, 0)$, $\delta$ in steps of 0.01.
+//!   smoothstep) to goals $(\pi + \delta, 0)$, $\delta$ in steps of 0.01 (16 distinct goals,
+//!   repeated).
 //!
 //! Every plan must be certified. Each thread count is timed in interleaved rounds
 //! ([`crate::timing::interleaved`], one batch a sample); the figure is plans per second at the
@@ -23,6 +24,10 @@ const THREADS: [&str; 16] = [
     "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12", "13", "14", "15", "16",
 ];
 
+/// The distinct problems of a batch: plan `i` is the `i mod DISTINCT`-th (a batch for many
+/// threads repeats them rather than moving its starts or goals ever further).
+const DISTINCT: usize = 16;
+
 /// One batch's figures: plans per second for 1, 2, ... threads.
 #[derive(Clone, Debug)]
 pub struct BatchSpeed {
@@ -40,7 +45,7 @@ impl BatchSpeed {
 }
 
 /// The thread counts measured: 1 up to the machine's cores (at most 16).
-fn thread_counts() -> usize {
+pub fn thread_counts() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get().min(THREADS.len()))
 }
 
@@ -83,7 +88,7 @@ pub fn one_disc(plans: usize, rounds: usize) -> Result<BatchSpeed, Error> {
     let starts: Vec<[f64; 4]> = (0..plans)
         .map(|i| {
             let mut start = DISC_START;
-            start[1] += 0.01 * i as f64;
+            start[1] += 0.01 * (i % DISTINCT) as f64;
             start
         })
         .collect();
@@ -106,7 +111,14 @@ pub fn one_disc(plans: usize, rounds: usize) -> Result<BatchSpeed, Error> {
 pub fn swing_up(plans: usize, rounds: usize) -> Result<BatchSpeed, Error> {
     let system = DoublePendulum { g: 9.81 };
     let goals: Vec<[f64; 4]> = (0..plans)
-        .map(|i| [std::f64::consts::PI + 0.01 * i as f64, 0.0, 0.0, 0.0])
+        .map(|i| {
+            [
+                std::f64::consts::PI + 0.01 * (i % DISTINCT) as f64,
+                0.0,
+                0.0,
+                0.0,
+            ]
+        })
         .collect();
     let jobs: Vec<_> = (goals.iter())
         .map(|goal| {

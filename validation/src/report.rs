@@ -45,7 +45,9 @@ pub struct Size {
     pub race_rounds: usize,
     /// Expansions of each case of the compile-time cost.
     pub expansion_rounds: usize,
-    /// Plans in each batch of the thread scaling, and its interleaved rounds.
+    /// Plans per thread of the most threads measured in each batch of the thread scaling
+    /// (the batch holds that many times the machine's thread count, so that each thread of
+    /// the largest pool has as many plans), and its interleaved rounds.
     pub batch: (usize, usize),
 }
 
@@ -62,7 +64,7 @@ impl Size {
             planner_rounds: 60,
             race_rounds: 200,
             expansion_rounds: 5,
-            batch: (64, 5),
+            batch: (16, 5),
         }
     }
 
@@ -79,7 +81,7 @@ impl Size {
             planner_rounds: 2,
             race_rounds: 2,
             expansion_rounds: 1,
-            batch: (4, 1),
+            batch: (1, 1),
         }
     }
 }
@@ -121,12 +123,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     long_run::write_long_runs(out, &long, size.long_run_end)?;
     let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
-    let (plans, rounds) = size.batch;
-    let batches = [
-        batch_speed::one_disc(plans, rounds)?,
-        batch_speed::swing_up(plans / 4, rounds)?,
-    ];
-    batch_speed::write_batches(out, &batches)?;
+    batches(size, out)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
     let chains = expansion_cost::chain_expansions(size.expansion_rounds)?;
@@ -138,6 +135,21 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
         planner,
         seconds,
     })
+}
+
+/// The plans-across-cores part of [`run`] alone ([`batch_speed`]): the one-disc and the
+/// swing-up batches, each of `size.batch.0` plans per thread of the largest pool.
+///
+/// # Errors
+/// A plan that is not certified ([`Error::Plan`]) or [`Error::Io`].
+pub fn batches(size: &Size, out: &mut dyn Write) -> Result<(), Error> {
+    let (per_thread, rounds) = size.batch;
+    let plans = per_thread * batch_speed::thread_counts();
+    let batches = [
+        batch_speed::one_disc(plans, rounds)?,
+        batch_speed::swing_up(plans, rounds)?,
+    ];
+    batch_speed::write_batches(out, &batches)
 }
 
 /// The work-precision part of [`run`]: the reference, the sweeps, the times at 1e-8.
@@ -215,4 +227,43 @@ pub fn machine() -> String {
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = std::thread::available_parallelism().map_or(0, |n| n.get());
     format!("{model}, {threads} threads")
+}
+
+/// The line that opens the block of a markdown file that [`write_block`] replaces.
+pub const BLOCK_BEGIN: &str =
+    "<!-- report:begin (written by the speed report; edits here are overwritten) -->";
+/// The line that closes that block.
+pub const BLOCK_END: &str = "<!-- report:end -->";
+
+/// `document` with the lines between [`BLOCK_BEGIN`] and [`BLOCK_END`] replaced by `report`
+/// (the markers kept), or `None` if the document lacks either marker or has them out of order.
+pub fn replace_block(document: &str, report: &str) -> Option<String> {
+    let begin = document.find(BLOCK_BEGIN)? + BLOCK_BEGIN.len();
+    let end = begin + document[begin..].find(BLOCK_END)?;
+    Some(format!(
+        "{}\n\n{}\n\n{}",
+        &document[..begin],
+        report.trim(),
+        &document[end..]
+    ))
+}
+
+/// Writes `report` into the file at `path` between its markers ([`replace_block`]).
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read or written, or lacks the markers.
+pub fn write_block(path: &std::path::Path, report: &str) -> Result<(), Error> {
+    let document = std::fs::read_to_string(path)?;
+    let Some(updated) = replace_block(&document, report) else {
+        return Err(Error::Io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "{} lacks the lines `{BLOCK_BEGIN}` and `{BLOCK_END}` (in this order) that \
+                 mark the report's block",
+                path.display()
+            ),
+        )));
+    };
+    std::fs::write(path, updated)?;
+    Ok(())
 }

@@ -161,3 +161,44 @@ fn interpolation_between_sweep_points() {
     assert!((t - 10.0).abs() < 1e-9);
     assert_eq!(time_at_error(&[(1.0, 1e-6), (2.0, 1e-7)], 1e-8), None);
 }
+
+#[test]
+fn the_report_replaces_only_its_marked_block() {
+    let document = format!(
+        "# Title\n\nprose above\n\n{}\nold report\nold line\n{}\n\nprose below\n",
+        report::BLOCK_BEGIN,
+        report::BLOCK_END
+    );
+    let updated = report::replace_block(&document, "new report\n").expect("markers found");
+    assert_eq!(
+        updated,
+        format!(
+            "# Title\n\nprose above\n\n{}\n\nnew report\n\n{}\n\nprose below\n",
+            report::BLOCK_BEGIN,
+            report::BLOCK_END
+        )
+    );
+    // Written twice, the block is the same (the markers stay, nothing accumulates).
+    let again = report::replace_block(&updated, "new report\n").expect("markers found");
+    assert_eq!(again, updated);
+    // Without both markers in order, nothing is written.
+    assert!(report::replace_block("no markers", "x").is_none());
+    let reversed = format!("{}\n{}\n", report::BLOCK_END, report::BLOCK_BEGIN);
+    assert!(report::replace_block(&reversed, "x").is_none());
+    let path = std::env::temp_dir().join(format!("retract-report-{}.md", std::process::id()));
+    std::fs::write(&path, "no markers").expect("temp file");
+    let error = report::write_block(&path, "x").expect_err("refused without markers");
+    assert!(error.to_string().contains("report:begin"), "{error}");
+    assert_eq!(std::fs::read_to_string(&path).expect("read"), "no markers");
+    let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn the_benchmarks_page_holds_the_report_block() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/benchmarks.md");
+    let page = std::fs::read_to_string(&path).expect("docs/benchmarks.md");
+    assert!(
+        report::replace_block(&page, "x").is_some(),
+        "docs/benchmarks.md must hold the report's markers"
+    );
+}
