@@ -110,6 +110,7 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
         #allow
         impl #generics #core::DiscretizationMap<#n_lit, #k_lit> for #ty_full {
             /// The lifted points (R1(x, xi), R2(x, xi)), straight-line code.
+            #[inline]
             fn points(&self, x: &#blocks, xi: &#blocks) -> (#blocks, #blocks) {
                 #float
                 #points_stmts
@@ -121,6 +122,7 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
 
             /// The Jacobians of the lifted points, differentiated at compile time; structural
             /// zeros are not computed.
+            #[inline]
             fn jacobians(&self, x: &#blocks, xi: &#blocks) -> #core::MapJacobians<#n_lit, #k_lit> {
                 #float
                 #jacobian_stmts
@@ -136,6 +138,7 @@ fn map_impl(sig: &Signature, g: &Graph, lift: &Lift, params: &ParamTokens) -> To
             }
 
             /// The Hessian of w2 . R2 - w1 . R1 in (x, xi), differentiated at compile time.
+            #[inline]
             fn covector_hessian(
                 &self,
                 x: &#blocks,
