@@ -21,6 +21,7 @@ mod mechanical;
 mod mpc;
 mod optimize;
 mod placement;
+mod plan_sensitivity;
 mod realtime;
 mod sensitivity;
 mod stage_systems;

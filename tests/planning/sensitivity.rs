@@ -17,7 +17,7 @@ use retract::nalgebra::SVector;
 /// tau = M(q) q'' + C(q, q') q' + g G_1(q)): tau . G_1(q), G_1 = (2 sin q_0 + sin(q_0 + q_1),
 /// sin(q_0 + q_1)).
 #[jet_function(order = 2)]
-fn gravity_derivative(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
+pub(crate) fn gravity_derivative(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
     let c2 = q[1].cos();
     let s2 = q[1].sin();
     let m11 = 3.0 + 2.0 * c2;
@@ -31,7 +31,7 @@ fn gravity_derivative(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2], g: f64) -> f64 {
 
 /// dL/dtau of the one-disc scene (L = 1/2 |q''|^2 + tau / (x^2 + y^2 - 1)).
 #[jet_function(order = 2)]
-fn barrier_derivative(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
+pub(crate) fn barrier_derivative(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
     1.0 / (q[0].powi(2) + q[1].powi(2) - 1.0)
 }
 
@@ -39,7 +39,7 @@ fn barrier_derivative(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
 /// p +- eps) to 1e-6 relative: the largest error over the jets and top derivatives against the
 /// sensitivity's largest entry, and the cost's error against its derivative (both above 1e-2:
 /// the parameter moves the plan); returns the largest entry.
-fn assert_matches(
+pub(crate) fn assert_matches(
     case: &str,
     sensitivity: &ParameterSensitivity<2, 4>,
     (plus, minus): (&Plan<2, 4>, &Plan<2, 4>),

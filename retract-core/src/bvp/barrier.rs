@@ -59,6 +59,7 @@ pub(super) struct Barrier {
 }
 
 /// Where entry `k` of a [`Barrier`] lives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Slot {
     /// At the evaluation point of step `i`.
     Step(usize),
@@ -126,6 +127,28 @@ impl Barrier {
             s,
             y,
             z,
+            count,
+            nodes,
+            steps,
+        }
+    }
+
+    /// The barrier of a plan as it ended, for its sensitivities: the plan's `duals` (which
+    /// fit the layout `(count, nodes, steps)`), slacks and multipliers exactly as they are
+    /// (unlike [`Self::warm`]), $y = z$ and the final barrier parameter.
+    pub fn at_solution<const N: usize>(
+        duals: &super::plan::duals::Duals<N>,
+        (count, nodes, steps): (usize, usize, usize),
+        [mut s, mut z, mut y]: [Vec<f64>; 3],
+    ) -> Self {
+        s.extend(duals.step_slacks.iter().chain(&duals.node_slacks));
+        z.extend(duals.step_multipliers.iter().chain(&duals.node_multipliers));
+        y.extend_from_slice(&z);
+        Self {
+            mu: duals.barrier,
+            s,
+            z,
+            y,
             count,
             nodes,
             steps,

@@ -11,6 +11,7 @@
 
 use nalgebra::SVector;
 
+use super::dynamics::Dynamics;
 use super::iterate::blocks;
 use super::kkt::model::StageLinear;
 use super::plan::Failure;
@@ -115,12 +116,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let Some(lin) = rti.linearization.as_ref() else {
             return Err(not_prepared());
         };
-        if !equalities.is_empty() && equalities.len() != self.equalities.len() {
-            return Err(Failure::Invalid(Error::InvalidArgument {
-                name: "equalities",
-                requirement: "one derivative per stage equality, or none",
-            }));
-        }
+        self.check_parameter(equalities)?;
         if lin.rho != 0.0 {
             return Err(Failure::Invalid(Error::InvalidArgument {
                 name: "real-time iteration",
@@ -132,34 +128,16 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let dynamics = &sqp.dynamics;
         let (h, theta) = (dynamics.h, dynamics.theta);
         let (x, u) = (rti.x(), rti.u());
-        let at = |i: usize| blocks::<N, K, X>(&(x[i] * (1.0 - theta) + x[i + 1] * theta));
-        let linear = |i: usize| {
-            let (xb, ui) = (at(i), &u[i]);
-            let g = derivative.gradient(&xb, ui);
-            let mut gx = SVector::<f64, X>::from_fn(|r, _| h * g.x[r / N][r % N]);
-            let mut gu = g.u * h;
-            let mut constraint = SVector::<f64, N>::zeros();
-            for (j, c) in equalities.iter().enumerate().take(N) {
-                let (grad, y) = (c.gradient(&xb, ui), rti.y[i][j]);
-                gx += SVector::<f64, X>::from_fn(|r, _| y * grad.x[r / N][r % N]);
-                gu += grad.u * y;
-                constraint[j] = c.value(&xb, ui);
-            }
-            StageLinear {
-                lx: dynamics.poly_e.left_t(&gx),
-                lu: dynamics.poly_b.left_t(&gx) * theta + gu,
-                defect: SVector::zeros(),
-                constraint,
-            }
+        let parameter = Parameter {
+            lagrangian: derivative,
+            equalities,
         };
-        let stage_cost = |i: usize| {
-            let (xb, ui) = (at(i), &u[i]);
-            let own = h * derivative.value(&xb, ui);
-            let through = (equalities.iter().enumerate().take(N))
-                .map(|(j, c)| rti.y[i][j] * c.value(&xb, ui))
-                .sum::<f64>();
-            own + through
+        let terms = |i: usize| {
+            let xt = x[i] * (1.0 - theta) + x[i + 1] * theta;
+            ParameterTerms::new::<K>(&xt, &u[i], &rti.y[i], h, &parameter)
         };
+        let linear = |i: usize| terms(i).linear(dynamics);
+        let stage_cost = |i: usize| terms(i).cost;
         let zero = SVector::<f64, X>::zeros();
         let mut pool = rti.workspace.pool.borrow_mut();
         let solved =
@@ -170,14 +148,22 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             cost: (0..u.len()).map(stage_cost).sum(),
         };
         solved.recycle(&mut *pool);
-        let finite = |v: &[f64]| v.iter().all(|e| e.is_finite());
-        let all_finite = sensitivity.cost.is_finite()
-            && sensitivity.x.iter().all(|v| finite(v.as_slice()))
-            && sensitivity.u.iter().all(|v| finite(v.as_slice()));
-        if !all_finite {
-            return Err(Failure::NonFinite);
+        sensitivity.checked()
+    }
+
+    /// [`Failure::Invalid`] unless `equalities` (the derivatives of the stage equalities in
+    /// a parameter) is empty or holds one per stage equality.
+    pub(super) fn check_parameter(
+        &self,
+        equalities: &[&(dyn JetFunction<N, K> + Sync)],
+    ) -> Result<(), Failure> {
+        if !equalities.is_empty() && equalities.len() != self.equalities.len() {
+            return Err(Failure::Invalid(Error::InvalidArgument {
+                name: "equalities",
+                requirement: "one derivative per stage equality, or none",
+            }));
         }
-        Ok(sensitivity)
+        Ok(())
     }
 }
 
@@ -187,4 +173,95 @@ fn not_prepared() -> Failure {
         name: "real-time iteration",
         requirement: "prepared (OptimalControlProblem::prepare) before a sensitivity",
     })
+}
+
+/// A parameter $p$ of a problem, given by its derivatives, written under `#[jet_function]`:
+/// `lagrangian` $= \partial L / \partial p\thinspace(x, u)$ (of every stage's Lagrangian)
+/// and `equalities` $= (\partial g_j / \partial p)_j$ in the order the stage equalities were
+/// added (empty: they do not depend on $p$). The dynamics, the ends and the inequalities do
+/// not depend on $p$.
+#[derive(Clone, Copy)]
+pub struct Parameter<'f, const N: usize, const K: usize> {
+    /// $\partial L / \partial p$.
+    pub lagrangian: &'f (dyn JetFunction<N, K> + Sync),
+    /// $(\partial g_j / \partial p)_j$, one per stage equality, or none.
+    pub equalities: &'f [&'f (dyn JetFunction<N, K> + Sync)],
+}
+
+impl<const N: usize, const K: usize> core::fmt::Debug for Parameter<'_, N, K> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Parameter")
+            .field("lagrangian", &self.lagrangian.name())
+            .field("equalities", &self.equalities.len())
+            .finish()
+    }
+}
+
+/// The terms of a parameter $p$ at one step's $(x_\theta, u)$ with the stage equalities'
+/// multipliers $y$: the derivative in $p$ of the gradient of the Lagrangian, $h \nabla
+/// \partial L / \partial p + \sum_j y_j \nabla \partial g_j / \partial p$ (in $x_\theta$ and
+/// $u$), of the equalities, $\partial g_j / \partial p$, and of the step's Lagrangian, $h
+/// \partial L / \partial p + y^T \partial g / \partial p$.
+pub(super) struct ParameterTerms<const N: usize, const X: usize> {
+    pub gx: SVector<f64, X>,
+    pub gu: SVector<f64, N>,
+    pub constraint: SVector<f64, N>,
+    pub cost: f64,
+}
+
+impl<const N: usize, const X: usize> ParameterTerms<N, X> {
+    /// The terms of `parameter` at `(x_theta, u)` with the multipliers `y`, step `h`.
+    pub fn new<const K: usize>(
+        x_theta: &SVector<f64, X>,
+        u: &SVector<f64, N>,
+        y: &SVector<f64, N>,
+        h: f64,
+        parameter: &Parameter<'_, N, K>,
+    ) -> Self {
+        let xb = blocks::<N, K, X>(x_theta);
+        let (own, g) = (
+            parameter.lagrangian.value(&xb, u),
+            parameter.lagrangian.gradient(&xb, u),
+        );
+        let mut terms = Self {
+            gx: SVector::from_fn(|r, _| h * g.x[r / N][r % N]),
+            gu: g.u * h,
+            constraint: SVector::zeros(),
+            cost: h * own,
+        };
+        for (j, c) in parameter.equalities.iter().enumerate().take(N) {
+            let (grad, value) = (c.gradient(&xb, u), c.value(&xb, u));
+            terms.gx += SVector::<f64, X>::from_fn(|r, _| y[j] * grad.x[r / N][r % N]);
+            terms.gu += grad.u * y[j];
+            terms.constraint[j] = value;
+            terms.cost += y[j] * value;
+        }
+        terms
+    }
+
+    /// The terms in the subproblem's variables $(\delta x_i, \delta u_i)$: $l_x = E^T g_x$,
+    /// $l_u = \theta \bar B^T g_x + g_u$, no defect.
+    pub fn linear(&self, dynamics: &Dynamics<N, X>) -> StageLinear<N, X> {
+        StageLinear {
+            lx: dynamics.poly_e.left_t(&self.gx),
+            lu: dynamics.poly_b.left_t(&self.gx) * dynamics.theta + self.gu,
+            defect: SVector::zeros(),
+            constraint: self.constraint,
+        }
+    }
+}
+
+impl<const N: usize, const X: usize> ParameterSensitivity<N, X> {
+    /// Itself if every entry is finite, else [`Failure::NonFinite`].
+    pub(super) fn checked(self) -> Result<Self, Failure> {
+        let finite = |v: &[f64]| v.iter().all(|e| e.is_finite());
+        let all_finite = self.cost.is_finite()
+            && self.x.iter().all(|v| finite(v.as_slice()))
+            && self.u.iter().all(|v| finite(v.as_slice()));
+        if all_finite {
+            Ok(self)
+        } else {
+            Err(Failure::NonFinite)
+        }
+    }
 }

@@ -46,6 +46,21 @@ fn stage_gradient<const N: usize, const X: usize>(
     (lx, lu, constraint)
 }
 
+/// The multiplier $\mu$ of the start condition $\delta x_0 = r_0$ at the solution `d` of the
+/// subproblem whose first stage is `stage` (no inertia correction): the gradient in
+/// $\delta x_0$ of the Lagrangian of stage 0 at `d` plus $\bar A^T \lambda_0$ (the costate of
+/// step 0), the residual of the stationarity at $x_0$ that the start condition takes up (zero
+/// on the free start components).
+pub(crate) fn start_multiplier<const N: usize, const X: usize>(
+    dynamics: &Dynamics<N, X>,
+    stage: &StageModel<N, X>,
+    d: &Direction<N, X>,
+) -> SVector<f64, X> {
+    let point = (&d.dx[0], &d.du[0], &d.multipliers[0]);
+    let (lx, _, _) = stage_gradient(dynamics, stage, 0.0, point);
+    lx + dynamics.poly_a.left_t(&d.costate[0])
+}
+
 /// One step of iterative refinement of `d`, the solution by `riccati` of the subproblem of
 /// `stages` (with `rho`, the start `r0`, the end `r_end` and the terminal gradient `s_end`):
 /// the residuals of stationarity in $\delta u_i$ and $\delta x_i$, of the dynamics, of the

@@ -59,6 +59,21 @@ pub enum Failure {
         /// Negative eigenvalues of the reduced Hessian.
         negative_directions: usize,
     },
+    /// A plan's sensitivity was asked where an inequality is weakly active: its value and
+    /// its multiplier both vanish (its slack $s$ and multiplier $z$, whose product is the
+    /// barrier parameter $\mu$, within a factor 100 of each other: both near $\sqrt\mu$,
+    /// where strict complementarity would keep one of order 1), so the active set changes
+    /// with any perturbation and the plan is not differentiable there.
+    WeaklyActive {
+        /// The inequality.
+        constraint: super::super::ConstraintRef,
+        /// Where.
+        location: super::violations::Location,
+        /// Its slack $s$.
+        slack: f64,
+        /// Its multiplier $z$ (per unit time).
+        multiplier: f64,
+    },
 }
 
 impl core::fmt::Display for Failure {
@@ -114,6 +129,24 @@ impl core::fmt::Display for Failure {
                  constraints are dependent there; remove the redundant ones or start from \
                  another guess"
             ),
+            Failure::WeaklyActive {
+                constraint,
+                location,
+                slack,
+                multiplier,
+            } => {
+                match location {
+                    super::violations::Location::Node(i) => write!(f, "at node {i}, ")?,
+                    super::violations::Location::Step(i) => write!(f, "at step {i}, ")?,
+                    other => write!(f, "at {other:?}, ")?,
+                }
+                write!(
+                    f,
+                    "{constraint} is weakly active (slack {slack:e}, multiplier \
+                     {multiplier:e}: both near zero), so the plan is not differentiable there; \
+                     move the constraint off the unconstrained plan or make it strictly active"
+                )
+            }
             Failure::NotAMinimum {
                 negative_directions,
             } => write!(

@@ -46,6 +46,7 @@ use crate::bvp::plan::duals::Duals;
 use crate::bvp::plan::{Failure, Plan, PlanError};
 use crate::{Lagrangian, LiftedSystem};
 
+mod at_solution;
 mod correction;
 mod direction;
 mod feedback;
@@ -57,6 +58,7 @@ mod second_order;
 mod state;
 mod termination;
 
+pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
 use state::{State, Subproblem};

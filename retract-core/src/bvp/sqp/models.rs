@@ -131,6 +131,18 @@ where
         y: &[SVector<f64, N>],
         barrier: &Barrier,
     ) -> Result<Models<N, X>, Failure> {
+        self.models_with(iterate, y, barrier, true)
+    }
+
+    /// [`Self::models`], with the cost $J$ evaluated only if `with_cost` (else it is 0: a
+    /// real-time iteration's second and later steps of a period, which report no cost).
+    pub(super) fn models_with(
+        &self,
+        iterate: &Iterate<N, X>,
+        y: &[SVector<f64, N>],
+        barrier: &Barrier,
+        with_cost: bool,
+    ) -> Result<Models<N, X>, Failure> {
         let h = self.dynamics.h;
         let steps = iterate.u.len();
         let inequalities = self.inequalities(iterate);
@@ -143,8 +155,10 @@ where
             if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
                 return Err(Failure::TimeLimit);
             }
-            let system = self.problem.system_at(i);
-            cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
+            if with_cost {
+                let system = self.problem.system_at(i);
+                cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
+            }
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
             // (built in place: a stage model is a few hundred bytes)
