@@ -19,6 +19,7 @@ use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
+use crate::sphere_cubic;
 use crate::systems::{closest_approach, paper_system};
 use crate::{
     batch_speed, expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision,
@@ -127,6 +128,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
         batch_speed::swing_up(plans / 4, rounds)?,
     ];
     batch_speed::write_batches(out, &batches)?;
+    sphere_cubic::run(out, size.planner_rounds)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
     let chains = expansion_cost::chain_expansions(size.expansion_rounds)?;
