@@ -579,7 +579,7 @@ pub fn verdict(result: &SphereCubic) -> String {
 }
 
 /// Measures at [`RESOLUTIONS`] over `rounds` rounds and writes the lines and the table
-/// ([`measure`], [`write`]).
+/// ([`measure`], [`write()`]).
 ///
 /// # Errors
 /// [`measure`]'s, or [`Error::Io`].
