@@ -28,6 +28,9 @@ pub enum Error {
         /// The relative difference of the costs.
         difference: f64,
     },
+    /// A reference solution (the exact curve a measurement is compared with) could not be
+    /// computed; why.
+    Reference(String),
     /// A hand-written step left the domain of the potential (x^2 + y^2 = 1 crossed).
     Domain(&'static str),
     /// The report could not be written.
@@ -52,6 +55,7 @@ impl fmt::Display for Error {
                 "{case}: the optimizer's and the root finder's costs differ by {difference:e} \
                  (relative; more than 1e-8)"
             ),
+            Error::Reference(message) => write!(f, "reference solution: {message}"),
             Error::Domain(variant) => write!(f, "{variant} left the domain of the potential"),
             Error::Io(e) => write!(f, "writing the report: {e}"),
         }

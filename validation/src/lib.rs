@@ -8,7 +8,7 @@
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
 //! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
 //! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
-//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`]), which [`report`]
+//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`], [`sphere_cubic`]), which [`report`]
 //! runs and prints in one go.
 
 pub mod batch_speed;
@@ -22,6 +22,7 @@ pub mod models;
 pub mod peers;
 pub mod planner_speed;
 pub mod report;
+pub mod sphere_cubic;
 pub mod step_speed;
 pub mod systems;
 pub mod timing;

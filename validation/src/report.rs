@@ -13,12 +13,16 @@
 //! `ratios: one-disc cold <r>x, one-disc warm <r>x, se2 cold <r>x, se2 warm <r>x (target <= 1.2)`,
 //! and Richardson extrapolation; and the compile-time cost of the expansion
 //! ([`crate::expansion_cost`]), with the lines `chain n=<n> expand_ms=<t> lines=<l>` of the
-//! n-link chain written as T - V.
+//! n-link chain written as T - V; the plans across cores ([`crate::batch_speed`], lines
+//! `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`) and the Riemannian cubic on
+//! $S^2$ against de Casteljau ([`crate::sphere_cubic`], lines
+//! `sphere cubic error=<e> time_us=<t> method=<retract|decasteljau>`).
 
 use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
+use crate::sphere_cubic;
 use crate::systems::{closest_approach, paper_system};
 use crate::{
     batch_speed, expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision,
@@ -124,6 +128,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
     batches(size, out)?;
+    sphere_cubic::run(out, size.planner_rounds)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;
     let chains = expansion_cost::chain_expansions(size.expansion_rounds)?;

@@ -2,7 +2,7 @@
 //! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <r>` line parses with
 //! r = best / DOP853 within the rounding of the printed figures; the planner's tables and its
 //! `ratios: ...` line are there, with one ratio per race; the compile-time table is there. No
-//! timing is asserted.
+//! timing is asserted; the `sphere cubic ...` lines are there, one pair per resolution.
 
 use retract_validation::planner_speed::PlannerSpeed;
 use retract_validation::report::{self, Size, utc_date};
@@ -71,6 +71,51 @@ fn quick_report_prints_the_work_precision_line() {
     );
     planner_lines(&text, &summary.planner);
     batch_lines(&text);
+    sphere_lines(&text);
+}
+
+/// The lines `sphere cubic error=<e> time_us=<t> method=<retract|decasteljau>`: one pair per
+/// resolution (retract, then de Casteljau), positive figures, retract's error falling with
+/// the resolution and de Casteljau's staying (it is another curve than the cubic).
+fn sphere_lines(text: &str) {
+    let rows: Vec<(f64, f64, &str)> = (text.lines())
+        .filter_map(|l| l.strip_prefix("sphere cubic error="))
+        .map(|rest| {
+            let (e, rest) = rest.split_once(" time_us=").expect("time_us");
+            let (t, method) = rest.split_once(" method=").expect("method");
+            let parse = |v: &str| v.parse::<f64>().expect("a number");
+            (parse(e), parse(t), method)
+        })
+        .collect();
+    let resolutions = retract_validation::sphere_cubic::RESOLUTIONS.len();
+    assert_eq!(
+        rows.len(),
+        2 * resolutions,
+        "sphere cubic lines in:\n{text}"
+    );
+    for (i, &(e, t, method)) in rows.iter().enumerate() {
+        assert_eq!(method, ["retract", "decasteljau"][i % 2], "{rows:?}");
+        assert!(e > 0.0 && e.is_finite() && t > 0.0, "{rows:?}");
+    }
+    let errors = |m: usize| {
+        rows.iter()
+            .skip(m)
+            .step_by(2)
+            .map(|r| r.0)
+            .collect::<Vec<_>>()
+    };
+    let (retract, casteljau) = (errors(0), errors(1));
+    assert!(retract.windows(2).all(|w| w[1] < w[0]), "{rows:?}");
+    assert!(
+        casteljau
+            .iter()
+            .all(|e| (e - casteljau[0]).abs() <= 1e-3 * casteljau[0]),
+        "{rows:?}"
+    );
+    assert!(
+        text.contains("| N | retract error | retract time | extrapolated error, curve (nodes) |"),
+        "{text}"
+    );
 }
 
 /// The batch lines: for each batch, `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`
