@@ -218,8 +218,8 @@ pub fn utc_date(time: SystemTime) -> String {
     format!("{year:04}-{month:02}-{day:02}")
 }
 
-/// The CPU model (from /proc/cpuinfo, else "unknown CPU") and the number of threads the
-/// process may use.
+/// The CPU model (from /proc/cpuinfo, else "unknown CPU"), the number of threads the
+/// process may use and, where /proc/loadavg is readable, the one-minute load average.
 pub fn machine() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -231,7 +231,12 @@ pub fn machine() -> String {
         })
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = std::thread::available_parallelism().map_or(0, |n| n.get());
-    format!("{model}, {threads} threads")
+    // the one-minute load average at the start: other work beside the report slows it
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .map_or_else(String::new, |l| format!(", load {l}"));
+    format!("{model}, {threads} threads{load}")
 }
 
 /// The line that opens the block of a markdown file that [`write_block`] replaces.
