@@ -78,7 +78,20 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
     let (tau_stmts, tau_exprs) = (&tau.stmts, &tau.exprs);
     let mass = sets(e, &el.mass, n, &names);
     let forces = sets(e, &el.forces, 0, &names);
-    let input = sets(e, &el.input, 0, &names);
+    // (with actuated coordinates, u is tau there: read from `tau`, not emitted again)
+    let input = match actuated {
+        Some(actuated) => {
+            let each = actuated.iter().enumerate().map(|(j, &a)| {
+                let (j, a) = (index(j), index(a));
+                quote!(__out[#j] = __tau[#a];)
+            });
+            quote! {
+                let __tau = self.tau(q, dq, ddq);
+                #(#each)*
+            }
+        }
+        None => sets(e, &el.input, 0, &names),
+    };
     let m_lit = index(el.input.len());
     let passive: Vec<usize> = el.unactuated.iter().map(|u| u.index).collect();
     let p_len = index(passive.len());
