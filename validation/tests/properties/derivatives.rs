@@ -148,7 +148,6 @@ fn chain24(q: [f64; 24], dq: [f64; 24], kappa: f64) -> f64 {
 /// chain of `examples/common/mechanical.rs` (its order-2 effort and its plant, whose mass
 /// matrix varies, are both built structurally: the Hessian, the momenta and the Legendre
 /// inverse evaluate the Hessian-vector product at run time).
-#[allow(dead_code)]
 #[path = "../../../examples/common/mechanical.rs"]
 mod mechanical;
 
