@@ -164,6 +164,20 @@ impl<'a> Emission<'a> {
         }
     }
 
+    /// The head of an inherent impl of the generated type: `#[automatically_derived]`, the
+    /// allowed lints and `impl<'a> Type<'a>`.
+    pub fn inherent_header(&self) -> TokenStream {
+        let allow = &self.allow;
+        let ParamTokens {
+            generics, ty_full, ..
+        } = &self.params;
+        quote! {
+            #[automatically_derived]
+            #allow
+            impl #generics #ty_full
+        }
+    }
+
     /// The leaves inside the methods of the scheme, which read z0, w, h, theta and the
     /// parameters (never the jet, named NaN).
     pub fn scheme(&self) -> Names<'a> {

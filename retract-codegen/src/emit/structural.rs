@@ -25,7 +25,7 @@ use crate::mechanics::HessianVector;
 /// each direction d_c of `directions` (module docs).
 pub(crate) fn hessian_vectors_method(e: &Emission<'_>, hv: &HessianVector) -> TokenStream {
     let (sig, k) = (e.sig, e.k);
-    let (jet_blocks, vec_n, float, allow) = (&e.jet_blocks, &e.vec_n, &e.float, &e.allow);
+    let (jet_blocks, vec_n, float) = (&e.jet_blocks, &e.vec_n, &e.float);
     let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
     let xu = Names { sig, jet: &in_xu };
     let hoisted = emit(e.g, &hv.hoisted, &xu);
@@ -33,13 +33,9 @@ pub(crate) fn hessian_vectors_method(e: &Emission<'_>, hv: &HessianVector) -> To
     let code = emit(e.g, &hv.column, &xu);
     let (stmts, exprs) = (&code.stmts, &code.exprs);
     let dim = index(e.n * (k + 1));
-    let super::helpers::ParamTokens {
-        generics, ty_full, ..
-    } = &e.params;
+    let header = e.inherent_header();
     quote! {
-        #[automatically_derived]
-        #allow
-        impl #generics #ty_full {
+        #header {
             /// H d for each direction d of `directions`, into `out` in order (H the Hessian
             /// of L in (x, u), index j n + i for q^(j)_i): the derivative of the gradient
             /// along d, forward over reverse, exact; the nodes that d does not change are
