@@ -2,8 +2,8 @@
 //! (`examples/common/mechanical.rs`): the double pendulum's swing-up of the swing-up suite, the
 //! planar quadrotor of the constrained suite (C2) driven by its two rotors through B(q) with
 //! the lateral force as the generated passive equality, past the disc, and the n-link chain
-//! (C4) with its joint limits for n = 3, 7 (the chain also compiles for n = 5; the growth of
-//! its expansion in n is in `validation/examples/chain_expansion.rs`). One line per plan, `<name> T=<T> N=<N> J=<J> iterations=<n> time_ms=<t>
+//! (C4) with its joint limits for n = 3, 7, 12 (the chain also compiles for n = 5; the growth
+//! of its expansion in n is in `validation/examples/chain_expansion.rs`). One line per plan, `<name> T=<T> N=<N> J=<J> iterations=<n> time_ms=<t>
 //! min_reduced_hessian_eig=<e> max_equality=<v>` (the largest passive equality along the plan's
 //! midpoints; 0 where there is none).
 //!
@@ -26,6 +26,7 @@ use mechanical::{DoublePendulumEnergy, QuadrotorEnergy};
 energy_chain!(chain3, 3);
 energy_chain!(chain5, 5);
 energy_chain!(chain7, 7);
+energy_chain!(chain12, 12);
 
 /// Clearance of the disc of radius 0.3 about (1, 0.5): (x - 1)^2 + (z - 0.5)^2 - 0.3^2.
 #[jet_function(order = 2)]
@@ -125,6 +126,7 @@ fn run() -> Outcome {
 
     plan_chain!("chain3-energy", Chain3::new(), 3, 1.5, steps, options);
     plan_chain!("chain7-energy", Chain7::new(), 7, 0.5, steps, options);
+    plan_chain!("chain12-energy", Chain12::new(), 12, 0.5, steps, options);
     // (compiled, not planned)
     let _ = Chain5::new();
     Ok(())

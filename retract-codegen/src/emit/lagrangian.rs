@@ -9,7 +9,8 @@ use quote::quote;
 
 use super::Emission;
 use super::helpers::{Names, index, xu_leaf};
-use super::scalar::{ScalarBodies, hessian_by_columns, scalar_bodies};
+use super::scalar::{ScalarBodies, scalar_bodies};
+use super::structural;
 use crate::emit::codegen::{constant, emit};
 use crate::ir::graph::Id;
 use crate::mechanics::LegendreInverse;
@@ -40,18 +41,39 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
         gradient: g_body,
         hessian: h_body,
     } = scalar_bodies(g, sig, mech.lagrangian, &mech.gradient, entries);
-    let (h_body, h_doc) = match &mech.hessian_vector {
+    let (h_body, h_doc, hessian_vectors) = match &mech.hessian_vector {
         Some(hv) => (
-            hessian_by_columns(g, sig, hv),
+            {
+                let body = structural::hessian_body(e);
+                quote!(#float #body)
+            },
             "The Hessian of L in (x, u), column by column: the Hessian-vector product (the \
              derivative of the gradient along a direction) at each unit vector.",
+            Some(structural::hessian_vectors_method(e, hv)),
         ),
         None => (
             h_body,
             "The Hessian of L in (x, u); structural zeros are not computed.",
+            None,
         ),
     };
-    let (p_stmts, p_sets) = momenta(e);
+    let momenta_body = match mech
+        .hessian_vector
+        .as_ref()
+        .and(structural::momenta_body(e))
+    {
+        Some(body) => quote!(#float #body),
+        None => {
+            let (p_stmts, p_sets) = momenta(e);
+            quote! {
+                #float
+                #p_stmts
+                let mut __out = [#na::SVector::<f64, #n_lit>::zeros(); #k_lit];
+                #(#p_sets)*
+                __out
+            }
+        }
+    };
     let top_derivative = mech
         .legendre_inverse
         .as_ref()
@@ -76,15 +98,13 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
 
             /// Ostrogradsky momenta p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j.
             fn momenta(&self, lower: &#jet_blocks, upper: &#jet_blocks) -> #jet_blocks {
-                #float
-                #p_stmts
-                let mut __out = [#na::SVector::<f64, #n_lit>::zeros(); #k_lit];
-                #(#p_sets)*
-                __out
+                #momenta_body
             }
 
             #top_derivative
         }
+
+        #hessian_vectors
     }
 }
 
@@ -136,21 +156,27 @@ fn top_derivative(e: &Emission<'_>, inv: &LegendreInverse) -> TokenStream {
         vec_n,
         ..
     } = e;
-    let in_xu = |order: u8, i: u32| xu_leaf(*k, order, i);
-    let xu = Names { sig, jet: &in_xu };
-    let mut roots = inv.b.clone();
-    roots.extend(inv.a.iter().copied());
-    let code = emit(g, &roots, &xu);
-    let stmts = code.stmts;
-    let b = &code.exprs[..*n];
-    let rhs: Vec<TokenStream> = (0..*n)
-        .map(|i| {
-            let bi = &b[i];
+    // (structural: b from the gradient at u = 0 and A from the Hessian-vector product)
+    let (stmts, a, b) = if e.mech.hessian_vector.is_some() {
+        structural::legendre_inputs(e, inv.a_inv.is_some())
+    } else {
+        let in_xu = |order: u8, i: u32| xu_leaf(*k, order, i);
+        let xu = Names { sig, jet: &in_xu };
+        let mut roots = inv.b.clone();
+        roots.extend(inv.a.iter().copied());
+        let mut code = emit(g, &roots, &xu);
+        let a = code.exprs.split_off(*n);
+        (code.stmts, a, code.exprs)
+    };
+    let rhs: Vec<TokenStream> = b
+        .iter()
+        .enumerate()
+        .map(|(i, bi)| {
             let ii = index(i);
             quote!(p_top[#ii] - #bi)
         })
         .collect();
-    let solve = legendre_solve(e, inv, &code.exprs[*n..], &rhs);
+    let solve = legendre_solve(e, inv, &a, &rhs);
     let doc = if inv.a_inv.is_some() {
         "Closed-form Legendre inverse: L is quadratic in u with a constant Hessian A, so \
          u = A^{-1} (p_{k-1} - dL/du(x, 0)), with A^{-1} computed at compile time."

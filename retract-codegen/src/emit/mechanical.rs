@@ -10,7 +10,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Emission;
-use super::helpers::{Names, ParamTokens, index};
+use super::helpers::{Names, index};
 use super::scalar::{ScalarBodies, scalar_bodies};
 use crate::emit::codegen::emit;
 use crate::mechanics::euler_lagrange::{Component, EulerLagrange};
@@ -61,7 +61,7 @@ fn sets(
 fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) -> TokenStream {
     let (g, n) = (e.g, e.n);
     let (na, core, vec_n, vec_n_path, n_lit) = (&e.na, &e.core, &e.vec_n, &e.vec_n_path, &e.n_lit);
-    let (float, allow) = (&e.float, &e.allow);
+    let float = &e.float;
     let in_qdq = |order: u8, i: u32| {
         let i = index(i as usize);
         match order {
@@ -78,7 +78,20 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
     let (tau_stmts, tau_exprs) = (&tau.stmts, &tau.exprs);
     let mass = sets(e, &el.mass, n, &names);
     let forces = sets(e, &el.forces, 0, &names);
-    let input = sets(e, &el.input, 0, &names);
+    // (with actuated coordinates, u is tau there: read from `tau`, not emitted again)
+    let input = match actuated {
+        Some(actuated) => {
+            let each = actuated.iter().enumerate().map(|(j, &a)| {
+                let (j, a) = (index(j), index(a));
+                quote!(__out[#j] = __tau[#a];)
+            });
+            quote! {
+                let __tau = self.tau(q, dq, ddq);
+                #(#each)*
+            }
+        }
+        None => sets(e, &el.input, 0, &names),
+    };
     let m_lit = index(el.input.len());
     let passive: Vec<usize> = el.unactuated.iter().map(|u| u.index).collect();
     let p_len = index(passive.len());
@@ -113,13 +126,9 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
             pub const UNACTUATED: [usize; #p_len] = [#(#u_list),*];
         }
     });
-    let ParamTokens {
-        generics, ty_full, ..
-    } = &e.params;
+    let header = e.inherent_header();
     quote! {
-        #[automatically_derived]
-        #allow
-        impl #generics #ty_full {
+        #header {
             #coordinates
             /// The number m of inputs u.
             pub const INPUTS: usize = #m_lit;
@@ -184,10 +193,7 @@ fn inherent(e: &Emission<'_>, el: &EulerLagrange, actuated: Option<&[usize]>) ->
 /// `impl Type { plant, input_force }`: the plant with the same parameters, and the
 /// generalized force B(q) u of an input u.
 fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, el: &EulerLagrange) -> TokenStream {
-    let (na, vec_n, allow, float) = (&e.na, &e.vec_n, &e.allow, &e.float);
-    let ParamTokens {
-        generics, ty_full, ..
-    } = &e.params;
+    let (na, vec_n, float) = (&e.na, &e.vec_n, &e.float);
     let (plant_ty, plant_name) = (&plant.params.ty_full, &plant.sig.type_name);
     let fields = e.sig.params.iter().map(|p| {
         let name = &p.name;
@@ -205,10 +211,9 @@ fn plant_methods(e: &Emission<'_>, plant: &Emission<'_>, el: &EulerLagrange) -> 
     let matrix = sets(e, &el.input_matrix, m, &names);
     let m_lit = index(m);
     let n_lit = &e.n_lit;
+    let header = e.inherent_header();
     quote! {
-        #[automatically_derived]
-        #allow
-        impl #generics #ty_full {
+        #header {
             /// The plant: the Lagrangian l(q, q') of order 1 with these parameters, for plant
             /// simulation under an input u by the forced midpoint rule (discrete
             /// Lagrange-d'Alembert), `retract::forced::forced_step(&system.plant(), &z0,

@@ -3,7 +3,9 @@
 //!
 //! - `ty`: the re-emitted function, the parameter struct and its constructor and constants;
 //! - `lagrangian`: the `Lagrangian` impl (L, its gradient and Hessian, the Ostrogradsky
-//!   momenta and, for L quadratic in the top derivative, the Legendre inverse);
+//!   momenta and, for L quadratic in the top derivative, the Legendre inverse), with
+//!   `structural` where the mechanics were built structurally: the Hessian-vector product as
+//!   one private method that the Hessian, the momenta and the Legendre inverse evaluate;
 //! - `lifted`: the `LiftedSystem` impl (residual and Jacobians of the lifted theta-scheme);
 //! - `domain`: its `check_domain` method (the singularity guard);
 //! - `reduced`: the `ReducedScheme` impl, where the Hessian of L depends on a few jet
@@ -45,6 +47,7 @@ pub(crate) mod reduced;
 pub(crate) mod scalar;
 pub(crate) mod scopes;
 pub(crate) mod separable;
+pub(crate) mod structural;
 pub(crate) mod ty;
 
 /// What the items generated for one Lagrangian share: the input, its mechanics, and the
@@ -158,6 +161,20 @@ impl<'a> Emission<'a> {
             #[automatically_derived]
             #allow
             impl #generics #core::#trait_ for #ty_full
+        }
+    }
+
+    /// The head of an inherent impl of the generated type: `#[automatically_derived]`, the
+    /// allowed lints and `impl<'a> Type<'a>`.
+    pub fn inherent_header(&self) -> TokenStream {
+        let allow = &self.allow;
+        let ParamTokens {
+            generics, ty_full, ..
+        } = &self.params;
+        quote! {
+            #[automatically_derived]
+            #allow
+            impl #generics #ty_full
         }
     }
 

@@ -9,7 +9,6 @@ use super::helpers::{Names, float_import, index, xu_leaf};
 use crate::emit::codegen::emit;
 use crate::front::signature::Signature;
 use crate::ir::graph::{Graph, Id};
-use crate::mechanics::HessianVector;
 use crate::util::core_path;
 
 /// The bodies of the value, gradient and Hessian methods of a scalar function of the jet,
@@ -24,8 +23,8 @@ pub(crate) struct ScalarBodies {
 }
 
 /// Straight-line bodies for `value`, its `gradient` (entry `j * n + i` is d/dq^(j)_i) and its
-/// symmetric `hessian` over the same index, as built by `mechanics::derivatives` (see
-/// [`hessian_by_columns`] for the Hessian from a Hessian-vector product).
+/// symmetric `hessian` over the same index, as built by `mechanics::derivatives` (the
+/// Hessian from a Hessian-vector product is `structural`'s).
 pub(crate) fn scalar_bodies(
     g: &Graph,
     sig: &Signature,
@@ -103,49 +102,5 @@ pub(crate) fn scalar_bodies(
             #(#h_sets)*
             __out
         },
-    }
-}
-
-/// The body of a `hessian` method from the Hessian-vector product `hv` (entry `j * n + i` of
-/// H d for the direction d, `Var::Direction`, named `__d`): its hoisted nodes evaluated once
-/// (`__h`), then straight-line code for H d evaluated for each unit vector d = e_b (column b
-/// of H); the entries on and above the diagonal are kept and mirrored, so that the Hessian is
-/// exactly symmetric.
-pub(crate) fn hessian_by_columns(g: &Graph, sig: &Signature, hv: &HessianVector) -> TokenStream {
-    let (n, k) = (sig.dim, sig.order);
-    let core = core_path();
-    let float = float_import();
-    let in_xu = |order: u8, i: u32| xu_leaf(k, order, i);
-    let xu = Names { sig, jet: &in_xu };
-    let hoisted = emit(g, &hv.hoisted, &xu);
-    let (h_stmts, h_exprs, h_len) = (&hoisted.stmts, &hoisted.exprs, index(hv.hoisted.len()));
-    let code = emit(g, &hv.column, &xu);
-    let (stmts, exprs) = (&code.stmts, &code.exprs);
-    let (n_lit, k_lit, dim) = (index(n), index(k), index(n * (k + 1)));
-    quote! {
-        #float
-        #h_stmts
-        let __h: [f64; #h_len] = [#(#h_exprs),*];
-        let mut __out = #core::Hessian::zeros();
-        for __b in 0..#dim {
-            let mut __d = [0.0f64; #dim];
-            __d[__b] = 1.0;
-            #stmts
-            let __column: [f64; #dim] = [#(#exprs),*];
-            let (__jb, __ib) = (__b / #n_lit, __b % #n_lit);
-            for (__a, &__v) in __column.iter().enumerate().take(__b + 1) {
-                let (__ja, __ia) = (__a / #n_lit, __a % #n_lit);
-                if __jb < #k_lit {
-                    __out.xx[__ja][__jb][(__ia, __ib)] = __v;
-                    __out.xx[__jb][__ja][(__ib, __ia)] = __v;
-                } else if __ja < #k_lit {
-                    __out.xu[__ja][(__ia, __ib)] = __v;
-                } else {
-                    __out.uu[(__ia, __ib)] = __v;
-                    __out.uu[(__ib, __ia)] = __v;
-                }
-            }
-        }
-        __out
     }
 }

@@ -8,7 +8,8 @@
 //! M_ij  = d2l/dq'_i dq'_j
 //! ```
 //!
-//! with D the total derivative (`ir::diff::total_derivative`, q' and q'' the next jets). The
+//! with D the total derivative (`ir::diff::total_derivatives`, q' and q'' the next jets, one
+//! directional sweep over the momenta) and dl/dq, dl/dq' from one reverse sweep over l. The
 //! motion is driven by inputs u in R^m through tau = B(q) u; the input the motion needs,
 //! u(q, q', q''), and the passive equalities (what no input can supply) are:
 //!
@@ -27,7 +28,7 @@
 //! The optimal-control Lagrangian of order 2 built from it is
 //! L = R/2 |u|^2 + C(q, q', u), C the user's cost (zero without one).
 
-use crate::ir::diff::{Differentiator, total_derivative};
+use crate::ir::diff::{Differentiator, reverse_gradient, total_derivatives};
 use crate::ir::graph::{Graph, Id, Var};
 use crate::mechanics::{derivatives, invert, symbolic_solve};
 
@@ -36,7 +37,8 @@ use crate::mechanics::{derivatives, invert, symbolic_solve};
 pub struct EulerLagrange {
     /// tau_i, i = 0..n.
     pub tau: Vec<Id>,
-    /// M_ij at `i * n + j`.
+    /// M_ij at `i * n + j`, the entries on and above the diagonal mirrored (exactly
+    /// symmetric).
     pub mass: Vec<Id>,
     /// Q_nc,i (zeros without forces).
     pub forces: Vec<Id>,
@@ -111,9 +113,23 @@ pub fn build(
         order,
         index: i as u32,
     };
-    let momenta: Vec<Id> = (0..n).map(|i| d.diff(g, l, jet(1, i))).collect();
+    // dl/dq and the momenta dl/dq' in one reverse sweep (O(nodes of l): for a chain whose
+    // velocities accumulate link by link, O(n), where one forward derivative per coordinate
+    // is O(n^2)); forward where l sums over a slice
+    let vars: Vec<Var> = (0..2)
+        .flat_map(|o| (0..n).map(move |i| jet(o, i)))
+        .collect();
+    let mut dl = match reverse_gradient(g, l, &vars) {
+        Some(gradient) => gradient,
+        None => vars.iter().map(|&v| d.diff(g, l, v)).collect(),
+    };
+    let momenta = dl.split_off(n);
+    // (the entries on and above the diagonal, mirrored: M is exactly symmetric)
     let mass: Vec<Id> = (0..n * n)
-        .map(|r| d.diff(g, momenta[r / n], jet(1, r % n)))
+        .map(|r| {
+            let (i, j) = (r / n, r % n);
+            d.diff(g, momenta[i.min(j)], jet(1, i.max(j)))
+        })
         .collect();
     if mass.iter().all(|&m| g.is_const(m, 0.0)) {
         return Err(Ok(if momenta.iter().all(|&p| g.is_const(p, 0.0)) {
@@ -128,11 +144,11 @@ pub fn build(
     }
     let zero = g.constant(0.0);
     let forces = forces.map_or_else(|| vec![zero; n], <[Id]>::to_vec);
+    // D p in one directional sweep: q moves at the rate q', q' at the rate q''
+    let dp = total_derivatives(g, &momenta, n, 2);
     let tau: Vec<Id> = (0..n)
         .map(|i| {
-            let dp = total_derivative(g, &mut d, momenta[i], n, 2);
-            let dl = d.diff(g, l, jet(0, i));
-            let conservative = g.sub(dp, dl);
+            let conservative = g.sub(dp[i], dl[i]);
             g.sub(conservative, forces[i])
         })
         .collect();

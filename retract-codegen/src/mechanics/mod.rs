@@ -5,15 +5,16 @@
 //! Built in one of two ways ([`Derivation`]): by forward differentiation throughout, the
 //! scheme's Jacobians differentiated symbolically (`#[higher_order_lagrangian]`); or
 //! structurally, for a Lagrangian whose expression is large (the effort of a mechanical
-//! system, a function of tau(q, q', q'')): the gradient by reverse accumulation (O(nodes)),
-//! the Hessian-vector product H d as the derivative of that gradient along a symbolic
-//! direction d (O(nodes); the emitted Hessian evaluates it for each unit vector d, column
-//! by column, forward over reverse, exact; the nodes it reads that d does not change are
-//! hoisted out of that loop), the rows of u of the Hessian alone as nodes (for the Legendre
-//! inverse), the total time derivatives of the momenta in one directional sweep, and no
-//! symbolic scheme: the emitted residual and Jacobians call `retract_core::lifted`'s generic
-//! functions, which evaluate the same formulas from the gradient and Hessian at the
-//! evaluation point.
+//! system, a function of tau(q, q', q''), and the plant whose mass matrix varies): the
+//! gradient by reverse accumulation (O(nodes)), the Hessian-vector product H d as the
+//! derivative of that gradient along a symbolic direction d (O(nodes); the emitted Hessian,
+//! momenta of order 2 and Legendre inverse evaluate it at run time, `emit::structural`:
+//! forward over reverse, exact; the nodes it reads that d does not change are hoisted out of
+//! the loop over the directions), the rows of u of the Hessian alone as nodes (for the
+//! degeneracy checks and the Legendre inverse's conditions), the total time derivatives of
+//! the momenta in one directional sweep, and no symbolic scheme: the emitted residual and
+//! Jacobians call `retract_core::lifted`'s generic functions, which evaluate the same
+//! formulas from the gradient and Hessian at the evaluation point.
 
 pub(crate) mod euler_lagrange;
 pub(crate) mod lift;
@@ -796,7 +797,7 @@ pub fn product_pattern(a: &[Vec<bool>], b: &[Vec<bool>]) -> Vec<Vec<bool>> {
 }
 
 /// Whether a variable matching `target` is reachable from `id` (through sums too).
-fn depends_on(g: &Graph, id: Id, target: &dyn Fn(&Var) -> bool) -> bool {
+pub(crate) fn depends_on(g: &Graph, id: Id, target: &dyn Fn(&Var) -> bool) -> bool {
     let mut stack = vec![id];
     let mut seen = std::collections::HashSet::new();
     while let Some(node) = stack.pop() {

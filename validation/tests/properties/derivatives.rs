@@ -2,7 +2,9 @@
 //! fourth-order central finite differences (error O(eps^4), relative tolerance 1e-8):
 //! gradient (of `lagrangian`), Hessian (of `gradient`), momenta (by differentiating the
 //! momenta in time along the polynomial curve with the given jet), H(Leg(jet)) = E_L(jet),
-//! the vector field = J grad H, and the scheme's Jacobians (of `residual`).
+//! the vector field = J grad H, and the scheme's Jacobians (of `residual`); for the
+//! systems of `#[higher_order_lagrangian]` and those of `#[mechanical_system]` with their
+//! plants.
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
@@ -140,6 +142,26 @@ fn chain24(q: [f64; 24], dq: [f64; 24], kappa: f64) -> f64 {
         l += 0.05 * dq[i] * dq[i + 1] - 0.5 * kappa * (q[i + 1] * q[i]).cos();
     }
     l
+}
+
+/// The mechanical systems from their energy (`#[mechanical_system]`): the planar n-link
+/// chain of `examples/common/mechanical.rs` (its order-2 effort and its plant, whose mass
+/// matrix varies, are both built structurally: the Hessian, the momenta and the Legendre
+/// inverse evaluate the Hessian-vector product at run time).
+#[path = "../../../examples/common/mechanical.rs"]
+mod mechanical;
+
+crate::energy_chain!(chain_three, 3);
+
+/// A particle in a well with damping, every coordinate driven, as its energy: the mass
+/// matrix is constant, so the effort's A = d2L/du2 is (the closed-form Legendre inverse) and
+/// the plant keeps the symbolic scheme.
+#[retract::mechanical_system(forces = damping)]
+fn well(q: [f64; 2], dq: [f64; 2], c: f64) -> f64 {
+    fn damping(dq: [f64; 2], c: f64) -> [f64; 2] {
+        [-c * dq[0], -c * dq[1] * dq[1]]
+    }
+    0.5 * (dq[0] * dq[0] + 2.0 * dq[1] * dq[1]) - q[0].cos() * q[1].powi(2) - 0.1 * q[1].powi(4)
 }
 
 // ---- finite differences -----------------------------------------------------------------
@@ -359,6 +381,20 @@ proptest! {
     #[test]
     fn special_functions_k2(v in point(8, -1.0, 1.0), eps in 0.25..0.5, h in 0.01..0.1, theta in 0.0..1.0) {
         check_all(&Special { eps }, &v, h, theta);
+    }
+
+    #[test]
+    fn mechanical_chain_and_its_plant(v in point(12, -1.0, 1.0), h in 0.01..0.1, theta in 0.0..1.0) {
+        let chain = ChainThree::new();
+        check_all(&chain, &v, h, theta);
+        check_all(&chain.plant(), &v, h, theta);
+    }
+
+    #[test]
+    fn mechanical_well_and_its_plant(v in point(8, -1.0, 1.0), c in 0.0..1.0, h in 0.01..0.1, theta in 0.0..1.0) {
+        let well = Well::new(c);
+        check_all(&well, &v, h, theta);
+        check_all(&well.plant(), &v, h, theta);
     }
 
     #[test]
