@@ -258,13 +258,30 @@ pub fn replace_block(document: &str, report: &str) -> Option<String> {
     ))
 }
 
-/// Writes `report` into the file at `path` between its markers ([`replace_block`]).
+/// `report` with its markdown headings two levels lower (`#` -> `###`), to sit under a
+/// section of a page.
+pub fn demoted(report: &str) -> String {
+    report
+        .lines()
+        .map(|line| {
+            if line.starts_with('#') {
+                format!("##{line}")
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Writes `report`, its headings [`demoted`], into the file at `path` between its markers
+/// ([`replace_block`]).
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be read or written, or lacks the markers.
 pub fn write_block(path: &std::path::Path, report: &str) -> Result<(), Error> {
     let document = std::fs::read_to_string(path)?;
-    let Some(updated) = replace_block(&document, report) else {
+    let Some(updated) = replace_block(&document, &demoted(report)) else {
         return Err(Error::Io(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             format!(

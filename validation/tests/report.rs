@@ -230,6 +230,10 @@ fn the_report_replaces_only_its_marked_block() {
     assert!(report::replace_block("no markers", "x").is_none());
     let reversed = format!("{}\n{}\n", report::BLOCK_END, report::BLOCK_BEGIN);
     assert!(report::replace_block(&reversed, "x").is_none());
+    assert_eq!(
+        report::demoted("# report\ntext # not a heading\n## part"),
+        "### report\ntext # not a heading\n#### part"
+    );
     let path = std::env::temp_dir().join(format!("retract-report-{}.md", std::process::id()));
     std::fs::write(&path, "no markers").expect("temp file");
     let error = report::write_block(&path, "x").expect_err("refused without markers");
