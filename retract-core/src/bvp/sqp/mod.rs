@@ -258,8 +258,8 @@ where
             let mut models = match self.models(&st.iterate, &st.y, &st.barrier) {
                 Ok(models) => models,
                 Err(Failure::TimeLimit) => {
-                    let unknown = super::plan::certificate::unknown_certificate();
-                    return Err(fail(Failure::TimeLimit, f64::NAN, unknown, vec![]));
+                    let (cost, certificate) = self.interrupted_certificate(point.0, point.2);
+                    return Err(fail(Failure::TimeLimit, cost, certificate, vec![]));
                 }
                 Err(failure) => return Err(PlanError::without_iterate(failure)),
             };

@@ -8,7 +8,7 @@ use nalgebra::SVector;
 
 use super::state::{Models, Sqp, Subproblem};
 use crate::bvp::barrier::Barrier;
-use crate::bvp::iterate::Iterate;
+use crate::bvp::iterate::{Iterate, blocks};
 use crate::bvp::kkt::residuals::kkt_residuals;
 use crate::bvp::kkt::riccati::Direction;
 use crate::bvp::plan::duals::Duals;
@@ -119,6 +119,49 @@ where
         pool.jets.give(momenta);
         direction.recycle(&mut *pool);
         certificate
+    }
+
+    /// The cost and the certificate at an `iterate` whose models were not built (the
+    /// wall-time budget ran out during the build), from one pass over the steps without
+    /// derivatives: $J$; the feasibility, the max-norm of the dynamics defects, the stage
+    /// equalities, the boundary data and the inequalities' $|g - s|$ (as
+    /// [`Models::violation_max`]); the complementarity $\max z s$ of `barrier`. The
+    /// stationarity needs the models and a factorisation: $\infty$ (not computed), never NaN.
+    pub(super) fn interrupted_certificate(
+        &self,
+        iterate: &Iterate<N, X>,
+        barrier: &Barrier,
+    ) -> (f64, Certificate) {
+        let h = self.dynamics.h;
+        let (mut cost, mut violation) = (0.0, 0.0_f64);
+        for (i, u) in iterate.u.iter().enumerate() {
+            let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
+            cost += h * self.problem.system_at(i).lagrangian(&xb, u);
+            let defect = self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1];
+            violation = violation.max(defect.amax());
+            for g in &self.problem.equalities {
+                violation = violation.max(g.value(&xb, u).abs());
+            }
+        }
+        let mut values = self.pool.borrow_mut().reals.take(barrier.s.len());
+        self.inequality_values(iterate, &mut values);
+        for (g, s) in values.iter().zip(&barrier.s) {
+            violation = violation.max((g - s).abs());
+        }
+        self.pool.borrow_mut().reals.give(values);
+        let last = &iterate.x[iterate.x.len() - 1];
+        let ends = [
+            (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start),
+            (self.problem.goal - last).component_mul(&self.problem.fixed_end),
+        ];
+        let certificate = Certificate {
+            stationarity: f64::INFINITY,
+            feasibility: ends.iter().fold(violation, |m, r| m.max(r.amax())),
+            complementarity: barrier.complementarity().0,
+            negative_directions: 0,
+            min_reduced_hessian_eig: f64::NAN,
+        };
+        (cost + self.terminal_value(last), certificate)
     }
 
     /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
