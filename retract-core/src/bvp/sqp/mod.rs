@@ -180,8 +180,9 @@ where
     /// stationary are far larger: on parking-x0.4 of the constrained suite they gave 698 per
     /// unit time against the threshold 100, and $\mu$ stayed at $\mu_0$ for 35 iterations.)
     /// The stage equalities' first multipliers stay 0: IPOPT starts them at the
-    /// least-squares estimate, which on the constrained suite led parking-x0.8 to a costlier
-    /// minimum (3.131 against 3.029).
+    /// least-squares estimate, which on the constrained suite moves the parkings to other
+    /// minima, one lower and one higher (parking-x0.8 2.880 against 2.979, parking-x0.4 6.863
+    /// against 6.842; the other problems unchanged): no clear gain.
     fn first_barrier_test(&self, st: &mut State<N, X>) {
         if st.barrier.s.is_empty() {
             return;
