@@ -27,6 +27,11 @@ pub(super) struct Pool<const N: usize, const X: usize> {
     pub pairs: Stack<(f64, f64)>,
     /// The Lanczos vectors of the certificate's eigenvalue (their own sizes).
     pub lanczos: Stack<f64>,
+    /// The inequalities' values at the last trial point of a line search and its step
+    /// length (written by the merit function's evaluation): the point a search accepts is
+    /// the last one it evaluated, so the slack reset after the step reads them instead of
+    /// evaluating the inequalities again.
+    pub trial_values: (Vec<f64>, f64),
 }
 
 impl<const N: usize, const X: usize> Pool<N, X> {

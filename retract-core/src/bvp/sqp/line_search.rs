@@ -58,6 +58,8 @@ where
 {
     /// The barrier cost $J - h \mu \sum \ln s$ and $\Vert c\Vert_1$ (with $\sum |g - s|$) at a
     /// trial point whose slacks are $s + \alpha\thinspace\delta s$; `None` if not finite.
+    /// The inequalities' values there are kept with $\alpha$ in the pool's `trial_values`
+    /// (for [`Self::advance`]).
     fn merit_parts(
         &self,
         iterate: &Iterate<N, X>,
@@ -67,7 +69,8 @@ where
     ) -> Option<(f64, f64)> {
         let h = self.dynamics.h;
         let (mut cost, mut violation) = (0.0, 0.0);
-        let mut values = self.pool.borrow_mut().reals.take(ds.len());
+        let (mut values, _) = core::mem::take(&mut self.pool.borrow_mut().trial_values);
+        values.clear();
         for (i, u) in iterate.u.iter().enumerate() {
             let system = self.problem.system_at(i);
             let xt = self.x_theta(iterate, i);
@@ -81,7 +84,7 @@ where
         }
         self.node_values(iterate, &mut values);
         let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
-        self.pool.borrow_mut().reals.give(values);
+        self.pool.borrow_mut().trial_values = (values, alpha);
         let last = &iterate.x[iterate.x.len() - 1];
         violation += slack
             + (self.problem.start - iterate.x[0])
@@ -171,7 +174,8 @@ where
 
     /// Moves to the `accepted` point along `direction` with slack steps `ds` (or along its
     /// corrected step): the iterate; the slacks and the multipliers $z$ by its step length
-    /// (then the slacks far below their inequality's value reset, [`Barrier::reset_slacks`]);
+    /// (then the slacks far below their inequality's value reset, [`Barrier::reset_slacks`],
+    /// from the values the trial's merit evaluation kept);
     /// the stage equalities' multipliers `y` toward the direction's by the same primal step
     /// length. Returns the step length, whether the decrease was at rounding level and
     /// whether the step was the direction itself (not a correction).
@@ -191,10 +195,13 @@ where
         self.give_iterate(left);
         barrier.update(ds, alpha);
         if !barrier.s.is_empty() {
-            let mut values = self.pool.borrow_mut().reals.take(barrier.s.len());
-            self.inequality_values(iterate, &mut values);
+            // the accepted point is the last trial evaluated: its values are kept
+            let (mut values, at) = core::mem::take(&mut self.pool.borrow_mut().trial_values);
+            if at != alpha || values.len() != barrier.s.len() {
+                self.inequality_values(iterate, &mut values);
+            }
             barrier.reset_slacks(&values);
-            self.pool.borrow_mut().reals.give(values);
+            self.pool.borrow_mut().trial_values = (values, at);
         }
         for (yi, target) in y.iter_mut().zip(&direction.multipliers) {
             *yi += (target - *yi) * alpha;
