@@ -143,13 +143,73 @@ where
         barrier: &Barrier,
         with_cost: bool,
     ) -> Result<Models<N, X>, Failure> {
-        let h = self.dynamics.h;
         let steps = iterate.u.len();
         let inequalities = self.inequalities(iterate);
         let (mut stages, mut cost_gradient) = {
             let mut pool = self.pool.borrow_mut();
             (pool.stages.take(steps), pool.gradients.take(steps))
         };
+        let filled = self.fill_stages(
+            (iterate, y, barrier, with_cost),
+            &inequalities,
+            &mut stages,
+            &mut cost_gradient,
+        );
+        let give_back = |stages, inequalities, cost_gradient, failure| {
+            let mut pool = self.pool.borrow_mut();
+            pool.stages.give(stages);
+            pool.linearized.give(inequalities);
+            pool.gradients.give(cost_gradient);
+            Err(failure)
+        };
+        let cost = match filled {
+            Ok(cost) => cost,
+            Err(failure) => return give_back(stages, inequalities, cost_gradient, failure),
+        };
+        let r0 = (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start);
+        let last = &iterate.x[iterate.x.len() - 1];
+        let fixed = self.problem.fixed_end;
+        let r_end = (self.problem.goal - last).component_mul(&fixed);
+        let (log, slack_l1) = barrier.current_terms(&inequalities, self.dynamics.h);
+        let slack_violation = (slack_l1, barrier.residual(&inequalities));
+        let (phi, terminal_gradient, hessian) = self.terminal_model(last);
+        let cost = cost + phi;
+        let barrier_cost = cost + log;
+        let finite =
+            barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian);
+        if !finite {
+            return give_back(stages, inequalities, cost_gradient, Failure::NonFinite);
+        }
+        Ok(Models {
+            stages,
+            cost,
+            barrier_cost,
+            r0,
+            r_end,
+            inequalities,
+            cost_gradient,
+            slack_violation,
+            terminal: Terminal {
+                hessian,
+                fixed,
+                start_fixed: self.problem.fixed_start,
+            },
+            terminal_gradient,
+        })
+    }
+
+    /// Builds the stage models of [`Self::models_with`] into `stages` (with the cost
+    /// gradients into `cost_gradient`, before the barrier terms are added) and returns
+    /// $J = \sum_i h L(x_{i+\theta}, u_i)$ (0 unless `with_cost`); [`Failure::NonFinite`]
+    /// if a model is not finite, [`Failure::TimeLimit`] if the budget runs out.
+    fn fill_stages(
+        &self,
+        (iterate, y, barrier, with_cost): (&Iterate<N, X>, &[SVector<f64, N>], &Barrier, bool),
+        inequalities: &[Linearized<N, X>],
+        stages: &mut Vec<StageModel<N, X>>,
+        cost_gradient: &mut Vec<(SVector<f64, X>, SVector<f64, N>)>,
+    ) -> Result<f64, Failure> {
+        let h = self.dynamics.h;
         let mut cost = 0.0;
         for (i, u) in iterate.u.iter().enumerate() {
             if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
@@ -189,36 +249,7 @@ where
                 return Err(Failure::NonFinite);
             }
         }
-        let r0 = (self.problem.start - iterate.x[0]).component_mul(&self.problem.fixed_start);
-        let last = &iterate.x[iterate.x.len() - 1];
-        let fixed = self.problem.fixed_end;
-        let r_end = (self.problem.goal - last).component_mul(&fixed);
-        let (log, slack_l1) = barrier.current_terms(&inequalities, h);
-        let slack_violation = (slack_l1, barrier.residual(&inequalities));
-        let (phi, terminal_gradient, hessian) = self.terminal_model(last);
-        let cost = cost + phi;
-        let barrier_cost = cost + log;
-        let finite =
-            barrier_cost.is_finite() && all_finite(&terminal_gradient) && all_finite(&hessian);
-        if !finite {
-            return Err(Failure::NonFinite);
-        }
-        Ok(Models {
-            stages,
-            cost,
-            barrier_cost,
-            r0,
-            r_end,
-            inequalities,
-            cost_gradient,
-            slack_violation,
-            terminal: Terminal {
-                hessian,
-                fixed,
-                start_fixed: self.problem.fixed_start,
-            },
-            terminal_gradient,
-        })
+        Ok(cost)
     }
 
     /// $\Phi(x_N)$ (0 without a terminal cost).
