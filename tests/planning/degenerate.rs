@@ -115,3 +115,33 @@ fn parking_from_twelve_guesses_never_fails_the_inertia_correction() {
         }
     }
 }
+
+/// A cost singular in a whole direction: the cart-pole's 1/2 F^2 with the pole left free (no
+/// equality), so the pole's motion is paid for only through the cart force. The discrete
+/// problem reaches F = 0 at every step (J ~ 1e-26), the global minimum since J >= 0; the
+/// Hessian of 1/2 F^2 there is grad F grad F^T (rank one a stage) plus F times the curvature of
+/// F, which leaves pivots of the rounding's size and either sign on its null space. That is a
+/// minimum, flat along those directions: certified with smallest eigenvalue 0, not refused
+/// as a saddle (a shift of the rounding's size makes the reduced Hessian definite).
+#[test]
+fn a_global_minimum_with_rounding_sized_curvature_is_not_a_saddle() {
+    use crate::cart_pole::{CartForce, CartPole};
+    let system = CartPole::new(1.0, 0.3, 0.5);
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    for steps in [40, 100] {
+        for bound in [None, Some(12.0)] {
+            let problem =
+                OptimalControlProblem::new(&system, &[0.0; 4], &[1.0, 0.5, 0.0, 0.0], 2.0, steps);
+            let problem = match bound {
+                Some(b) => problem.with_function_bounds(&force, -b, b),
+                None => problem,
+            };
+            let case = format!("N = {steps}, bound {bound:?}");
+            let plan = problem
+                .solve(PlanGuess::Spline)
+                .unwrap_or_else(|e| panic!("{case}: {e}"));
+            assert!(plan.cost < 1e-20, "{case}: J = {}", plan.cost);
+            assert_eq!(plan.certificate.min_reduced_hessian_eig, 0.0, "{case}");
+        }
+    }
+}

@@ -20,8 +20,9 @@ use crate::{Lagrangian, LiftedSystem};
 const FINSLER_WEIGHTS: [f64; 3] = [1e2, 1e4, 1e6];
 
 /// The shift of the stage Hessians, relative to their largest entry, under which a singular
-/// reduced Hessian without negative directions counts as positive semidefinite
-/// ([`Sqp::shifted_factor`]): a few hundred roundings of the largest entry.
+/// reduced Hessian, or one whose negative eigenvalues are of the rounding's size, counts as
+/// positive semidefinite ([`Sqp::shifted_factor`]): a few hundred roundings of the largest
+/// entry.
 const SEMIDEFINITE_SHIFT: f64 = 1e-13;
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
@@ -79,20 +80,18 @@ where
     ) -> Result<Certificate, (Failure, Certificate)> {
         certificate.negative_directions = exact.negative;
         if !exact.positive_definite() {
-            // singular without a negative pivot: semidefinite if a shift of the rounding's
-            // size makes it definite (a minimum, flat along some direction: not strict)
-            let shifted = (exact.negative == 0).then(|| self.shifted_factor(state, models));
-            let definite = shifted.as_ref().is_some_and(|f| f.positive_definite());
-            let negative = shifted.map_or(exact.negative, |f| {
-                let negative = f.negative;
-                f.recycle(&mut *self.pool.borrow_mut());
-                negative
-            });
+            // singular, or with pivots of either sign at the rounding's size: semidefinite
+            // if a shift of the rounding's size makes it definite (a minimum, flat along some
+            // direction: not strict); the negative directions that remain under the shift
+            // are the ones counted
+            let shifted = self.shifted_factor(state, models);
+            let (definite, negative) = (shifted.positive_definite(), shifted.negative);
+            shifted.recycle(&mut *self.pool.borrow_mut());
+            certificate.negative_directions = negative;
             if definite {
                 certificate.min_reduced_hessian_eig = 0.0;
                 return Ok(certificate);
             }
-            certificate.negative_directions = negative;
             let failure = Failure::NotAMinimum {
                 negative_directions: negative,
             };
