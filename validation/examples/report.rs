@@ -7,7 +7,8 @@
 //!
 //! Run: `cargo run --release -p retract-validation --example report` (about a minute), or
 //! with `-- --quick` for the same lines at reduced size in a few seconds; `-- --batch` prints
-//! only the plans across cores (`batch <name> threads=<t> plans_per_s=<p> scaling=<s>`);
+//! only the plans across cores (`batch <name> threads=<t> plans_per_s=<p> scaling=<s>`),
+//! `-- --steps` only the one-step table (`step ratio generated/hand-written: ...`);
 //! `-- --write docs/benchmarks.md` also writes the report into that file, between its lines
 //! `<!-- report:begin ... -->` and `<!-- report:end -->`.
 
@@ -38,20 +39,21 @@ impl<W: Write> Write for Tee<W> {
 
 fn run() -> Result<(), Error> {
     let mut size = Size::full();
-    let mut only_batches = false;
+    let (mut only_batches, mut only_steps) = (false, false);
     let mut target = None;
     let mut arguments = std::env::args().skip(1);
     while let Some(argument) = arguments.next() {
         match argument.as_str() {
             "--quick" => size = Size::quick(),
             "--batch" => only_batches = true,
+            "--steps" => only_steps = true,
             "--write" => match arguments.next() {
                 Some(path) => target = Some(PathBuf::from(path)),
                 None => return Err(invalid("`--write` needs the path of the file to write")),
             },
             other => {
                 return Err(invalid(&format!(
-                    "unknown argument `{other}`; supported: --quick, --batch, --write PATH"
+                    "unknown argument `{other}`; supported: --quick, --batch, --steps, --write PATH"
                 )));
             }
         }
@@ -61,9 +63,14 @@ fn run() -> Result<(), Error> {
         stdout: stdout.lock(),
         text: Vec::new(),
     };
-    if only_batches {
+    if only_batches || only_steps {
         writeln!(out, "{}", report::header(&size))?;
-        report::batches(&size, &mut out)?;
+        if only_steps {
+            report::steps(&size, &mut out)?;
+        }
+        if only_batches {
+            report::batches(&size, &mut out)?;
+        }
     } else {
         report::run(&size, &mut out)?;
     }

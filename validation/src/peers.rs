@@ -1,8 +1,9 @@
 //! The peers `retract` is measured against, one implementation each:
 //! - hand-written midpoint steps of the SE(2) obstacle system (tau = [`TAU`], h = [`H`]): a
 //!   dense 12x12 Newton with the Jacobian by hand, by dual numbers (num-dual) or by central
-//!   finite differences, and a hand-reduced 3x3 Newton on $q_\theta$ (the limit), with and
-//!   without the generated step's domain check;
+//!   finite differences, a hand-reduced 3x3 Newton on $q_\theta$, with and without the
+//!   generated step's domain check, and the tight reduced step (Newton on the two nonlinear
+//!   unknowns, a closed-form 2x2 solve, the guard in one expression);
 //! - RK4 and DOP853 (ode_solvers) on the plain first-order system ([`Plain`]), their best
 //!   form, and DOP853 on a generated system's Hamilton equations ([`Hamilton`]).
 
@@ -197,6 +198,73 @@ pub fn hand_guarded_step(z0: &Z) -> Result<Z, Error> {
     } else {
         Err(Error::Domain("the hand-written guarded step"))
     }
+}
+
+/// The tight hand-written reduced step, a peer at the limit of the algorithm. The theta
+/// row of [`Core`] is linear ($\partial V/\partial\theta = 0$, so $y_\theta = c_{0,\theta}$);
+/// Newton runs on the two nonlinear unknowns $w = (y_x, y_y)$ of
+/// $r(w) = a(s)\thinspace w - c$, $a = 1 - 2\tau k/s^2$, $s = |w|^2 - 1$, $k = h^4/16$, from
+/// the explicit predictor $a(s(c))\thinspace c$, until $\Vert r\Vert_\infty \le 10^{-14}$ or
+/// a step $\Vert\Delta\Vert_\infty \le 10^{-15} + 10^{-10}\Vert w\Vert_\infty$ (the
+/// library's default tests). The Jacobian $a I + b\thinspace w w^T$
+/// ($b = 8\tau k/s^3$) is solved in closed form (Sherman-Morrison,
+/// $J^{-1} r = (r - t\thinspace w)/a$ with $t = b\thinspace (w \cdot r)/m$,
+/// $m = a + b|w|^2$), with three divisions an iteration ($1/s$, then $1/a$ and $1/m$ together). The guard is one
+/// expression: $s$ finite and of one sign at $q_0$, $q_\theta$ and $q_1$. No rounding
+/// compensation.
+///
+/// # Errors
+/// [`Error::Domain`] if Newton does not converge in 50 iterations or the guard fails.
+pub fn tight_guarded_step(z0: &Z) -> Result<Z, Error> {
+    let k2 = 2.0 * TAU * H * H * H * H / 16.0;
+    let (q, v, p0, p1) = (
+        z0.fixed_rows::<3>(0),
+        z0.fixed_rows::<3>(3),
+        z0.fixed_rows::<3>(6),
+        z0.fixed_rows::<3>(9),
+    );
+    let c = q + v * (H / 2.0) + p1 * (H * H / 4.0) - p0 * (H * H * H / 8.0);
+    // the explicit predictor a(s(c)) c
+    let s_c = c[0] * c[0] + c[1] * c[1] - 1.0;
+    let a_c = 1.0 - k2 / (s_c * s_c);
+    let (mut x, mut y) = (c[0] * a_c, c[1] * a_c);
+    let mut found = None;
+    for _ in 0..50 {
+        let s = x * x + y * y - 1.0;
+        let inv_s = 1.0 / s;
+        let inv_s2 = inv_s * inv_s;
+        let a = 1.0 - k2 * inv_s2;
+        let (rx, ry) = (a * x - c[0], a * y - c[1]);
+        if rx.abs().max(ry.abs()) <= 1e-14 {
+            found = Some((s, inv_s2));
+            break;
+        }
+        let b = 4.0 * k2 * inv_s2 * inv_s;
+        let m = a + b * (x * x + y * y);
+        // (two independent divisions: they overlap in the divider)
+        let (inv_a, inv_m) = (1.0 / a, 1.0 / m);
+        let t = b * (x * rx + y * ry) * inv_m;
+        x -= (rx - t * x) * inv_a;
+        y -= (ry - t * y) * inv_a;
+    }
+    let Some((s_th, inv_s2)) = found else {
+        return Err(Error::Domain("the tight hand-written step: no convergence"));
+    };
+    let q1 = Vector3::new(2.0 * x - q[0], 2.0 * y - q[1], 2.0 * c[2] - q[2]);
+    let s0 = q[0] * q[0] + q[1] * q[1] - 1.0;
+    let s1 = q1[0] * q1[0] + q1[1] * q1[1] - 1.0;
+    if !(s0 * s_th > 0.0 && s0 * s1 > 0.0 && (s0 * s_th * s1).is_finite()) {
+        return Err(Error::Domain("the tight hand-written step: the guard"));
+    }
+    let g = Vector3::new(x, y, 0.0) * (-2.0 * TAU * inv_s2);
+    let p0_th = p0 + g * (H / 2.0);
+    let mut z1 = Z::zeros();
+    z1.fixed_rows_mut::<3>(0).copy_from(&q1);
+    z1.fixed_rows_mut::<3>(3)
+        .copy_from(&(v + (p1 - p0_th * (H / 2.0)) * H));
+    z1.fixed_rows_mut::<3>(6).copy_from(&(p0 + g * H));
+    z1.fixed_rows_mut::<3>(9).copy_from(&(p1 - p0_th * H));
+    Ok(z1)
 }
 
 /// The obstacle model's Euler-Lagrange equation as a plain first-order system, the peers'

@@ -101,6 +101,19 @@ pub struct Summary {
     pub seconds: f64,
 }
 
+/// Writes the one-step table of the SE(2) obstacle system and its ratios to the hand-written
+/// steps ([`step_speed`]), every variant first checked against the general step.
+///
+/// # Errors
+/// A step that fails or disagrees ([`Error`]), or [`Error::Io`].
+pub fn steps(size: &Size, out: &mut dyn Write) -> Result<(), Error> {
+    let system = paper_system();
+    let z = closest_approach(&system)?;
+    step_speed::check_variants(&system, &z)?;
+    let rows = step_speed::steps(&system, &z, size.step_rounds, size.step_calls);
+    step_speed::write_steps(out, &rows, size.step_rounds)
+}
+
 /// Writes the whole report to `out` (module docs).
 ///
 /// # Errors
@@ -114,10 +127,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
          order reversed every other round); ratios come from the same rounds.\n"
     )?;
     let system = paper_system();
-    let z = closest_approach(&system)?;
-    step_speed::check_variants(&system, &z)?;
-    let steps = step_speed::steps(&system, &z, size.step_rounds, size.step_calls);
-    step_speed::write_steps(out, &steps, size.step_rounds)?;
+    steps(size, out)?;
     let runs = step_speed::paper_runs(&system, size.run_rounds, size.run_calls)?;
     step_speed::write_runs(out, &runs, size.run_rounds)?;
     let guard = guard_cost::guard_costs(&system, size.run_rounds, size.step_calls)?;

@@ -4,12 +4,15 @@
 //!
 //! The variants of one step, timed in interleaved rounds ([`crate::timing`]):
 //! - generated, reduced (Newton on the 2 core unknowns, `ReducedStepper`), with and without
-//!   the domain check, and without the domain check and the rounding corrections
-//!   (`StepOptions::compensated` off);
+//!   the domain check, without the rounding corrections (`StepOptions::compensated` off),
+//!   and without both;
 //! - generated, general (Newton on all 15 unknowns, `retract::step`);
 //! - the hand-written peers of [`crate::peers`]: dense 12x12 Newton (Jacobian by hand, by
-//!   dual numbers, by finite differences) and the reduced 3x3 Newton on $q_\theta$ (the
-//!   limit), without and with the generated step's domain check.
+//!   dual numbers, by finite differences) and the reduced 3x3 Newton on $q_\theta$, without
+//!   and with the generated step's domain check;
+//! - the tight hand-written reduced step with the guard ([`tight_guarded_step`]); the faster
+//!   of it and the guarded 3x3 Newton is the limit the generated step is measured against
+//!   (`step ratio generated/hand-written`).
 
 use std::hint::black_box;
 use std::io::Write;
@@ -21,7 +24,7 @@ use retract::{LiftedSystem, ReducedFactors, ReducedScheme, ReducedStepper, StepO
 use crate::Error;
 use crate::peers::{
     Core, Dense, DenseJacobian, dense_jacobian, dense_residual, dense_step, hand_guarded_step,
-    hand_reduced_step,
+    hand_reduced_step, tight_guarded_step,
 };
 use crate::systems::{H, PAPER_STEPS, RigidBody, Z, paper_start};
 use crate::timing::{Row, Timed, best_ns, best_of, format_ns, interleaved, write_rows};
@@ -32,12 +35,16 @@ pub const REDUCED: &str = "generated, reduced (2 unknowns)";
 pub const REDUCED_UNCHECKED: &str = "generated, reduced, domain check off";
 /// Generated, reduced step, domain check and rounding corrections off.
 pub const REDUCED_PLAIN: &str = "generated, reduced, check and corrections off";
+/// Generated, reduced step, domain check on, rounding corrections off.
+pub const REDUCED_UNCOMPENSATED: &str = "generated, reduced, check on, corrections off";
+/// The tight hand-written reduced step with the guard ([`tight_guarded_step`]).
+pub const TIGHT: &str = "hand-written tight reduced step (2x2 closed form), guard";
 /// Generated, general step.
 pub const GENERAL: &str = "generated, general (15 unknowns)";
 /// Hand-written dense Newton.
 pub const HAND_DENSE: &str = "hand-written dense 12x12 Newton";
 /// Hand-written reduced Newton.
-pub const HAND_REDUCED: &str = "hand-written reduced 3x3 Newton (the limit)";
+pub const HAND_REDUCED: &str = "hand-written reduced 3x3 Newton";
 /// Hand-written reduced Newton with the domain check.
 pub const HAND_GUARDED: &str = "hand-written reduced 3x3 Newton, domain check";
 /// Dense Newton, dual-number Jacobian.
@@ -54,9 +61,12 @@ pub fn check_variants(system: &RigidBody, z: &Z) -> Result<(), Error> {
     let reference = step(system, z, H, &options)?.0;
     let mut reduced = ReducedStepper::new(system);
     let plain = options.with_domain_check(false).with_compensation(false);
-    let variants: [(&'static str, Z); 7] = [
+    let uncompensated = options.with_compensation(false);
+    let variants: [(&'static str, Z); 9] = [
         (REDUCED, reduced.step(z, H, &options)?.0),
         (REDUCED_PLAIN, reduced.step(z, H, &plain)?.0),
+        (REDUCED_UNCOMPENSATED, reduced.step(z, H, &uncompensated)?.0),
+        (TIGHT, tight_guarded_step(z)?),
         (HAND_DENSE, dense_step(z, DenseJacobian::Hand)?),
         (HAND_REDUCED, hand_reduced_step(z)?),
         (HAND_GUARDED, hand_guarded_step(z)?),
@@ -151,7 +161,9 @@ pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row>
     let options = StepOptions::default();
     let unchecked = options.with_domain_check(false);
     let plain = unchecked.with_compensation(false);
-    let (mut reduced, mut reduced_unchecked, mut reduced_plain) = (
+    let uncompensated = options.with_compensation(false);
+    let (mut reduced, mut reduced_unchecked, mut reduced_plain, mut reduced_uncompensated) = (
+        ReducedStepper::new(system),
         ReducedStepper::new(system),
         ReducedStepper::new(system),
         ReducedStepper::new(system),
@@ -170,6 +182,13 @@ pub fn steps(system: &RigidBody, z: &Z, rounds: usize, calls: usize) -> Vec<Row>
             Timed::new(REDUCED_PLAIN, calls, &mut || {
                 let s = reduced_plain.step(black_box(z), H, &plain);
                 black_box(s.map(|s| s.0[0]).ok());
+            }),
+            Timed::new(REDUCED_UNCOMPENSATED, calls, &mut || {
+                let s = reduced_uncompensated.step(black_box(z), H, &uncompensated);
+                black_box(s.map(|s| s.0[0]).ok());
+            }),
+            Timed::new(TIGHT, calls, &mut || {
+                black_box(tight_guarded_step(black_box(z)).ok());
             }),
             Timed::new(GENERAL, slow, &mut || {
                 black_box(step(system, black_box(z), H, &options).map(|s| s.0[0]).ok());
@@ -259,8 +278,10 @@ pub fn paper_runs(system: &RigidBody, rounds: usize, calls: usize) -> Result<Vec
     ))
 }
 
-/// Writes the step table (time, ratio to the generated reduced step) and the like-for-like
-/// ratios of the generated and the hand-written reduced steps, as markdown.
+/// Writes the step table (time, ratio to the generated reduced step), the ratios of the
+/// generated reduced step with the guard (without and with the rounding corrections) to the
+/// faster hand-written guarded step (the tight one or the 3x3 Newton), and the like-for-like ratios of the generated and the hand-written
+/// reduced steps, as markdown.
 ///
 /// # Errors
 /// [`Error::Io`].
@@ -273,7 +294,7 @@ pub fn write_steps(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(
     writeln!(out, "| one step | time | vs generated reduced |")?;
     writeln!(out, "|---|---|---|")?;
     let reduced = best_of(rows, REDUCED);
-    for row in rows.iter().filter(|r| r.name != HAND_GUARDED) {
+    for row in rows {
         let t = row.samples.best();
         writeln!(
             out,
@@ -288,6 +309,15 @@ pub fn write_steps(out: &mut dyn Write, rows: &[Row], rounds: usize) -> Result<(
         best_of(rows, HAND_REDUCED),
         best_of(rows, HAND_GUARDED),
     );
+    // the limit: the faster of the two hand-written guarded steps in these rounds
+    let tight = best_of(rows, TIGHT).min(best_of(rows, HAND_GUARDED));
+    writeln!(
+        out,
+        "\nstep ratio generated/hand-written: {:.2} (guard, no compensation), {:.2} \
+         (compensated)",
+        best_of(rows, REDUCED_UNCOMPENSATED) / tight,
+        reduced / tight,
+    )?;
     writeln!(
         out,
         "\nstep ratios: generated/hand-written reduced {:.2}x (check off), {:.2}x (check on; \

@@ -70,6 +70,7 @@ fn quick_report_prints_the_work_precision_line() {
         "{text}"
     );
     planner_lines(&text, &summary.planner);
+    step_ratio_line(&text);
     batch_lines(&text);
     sphere_lines(&text);
 }
@@ -120,6 +121,25 @@ fn sphere_lines(text: &str) {
 
 /// The batch lines: for each batch, `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`
 /// for t = 1, 2, ... in turn, with positive figures and scaling 1 at one thread.
+/// The line `step ratio generated/hand-written: <r> (guard, no compensation), <r2>
+/// (compensated)`: once, with positive ratios.
+fn step_ratio_line(text: &str) {
+    let lines: Vec<&str> = (text.lines())
+        .filter_map(|l| l.strip_prefix("step ratio generated/hand-written: "))
+        .collect();
+    assert_eq!(lines.len(), 1, "one step-ratio line in:\n{text}");
+    let (r, rest) = lines[0]
+        .split_once(" (guard, no compensation), ")
+        .unwrap_or_else(|| panic!("unparsed: {}", lines[0]));
+    let r2 = rest
+        .strip_suffix(" (compensated)")
+        .unwrap_or_else(|| panic!("unparsed: {}", lines[0]));
+    let (r, r2): (f64, f64) = (r.parse().expect("r"), r2.parse().expect("r2"));
+    assert!(r > 0.0 && r2 > 0.0, "{}", lines[0]);
+}
+
+/// The lines `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`: one per thread count
+/// from 1, positive figures, the first scaling 1.
 fn batch_lines(text: &str) {
     for name in ["one-disc", "swing-up"] {
         let prefix = format!("batch {name} threads=");
