@@ -11,7 +11,7 @@ use std::cell::Cell;
 
 use retract::diagnostics::{rk4_step, symplecticity_error};
 use retract::nalgebra::SVector;
-use retract::{LiftedSystem, StepOptions, step};
+use retract::{LiftedSystem, ReducedStepper, StepOptions, step};
 
 thread_local! {
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
@@ -56,6 +56,7 @@ fn stepping_allocates_nothing() {
     ]);
     let z0 = system.legendre(&jet);
     let options = StepOptions::default();
+    let mut stepper = ReducedStepper::new(&system);
     let before = allocations();
     let mut z = z0;
     let mut iterations = 0;
@@ -66,10 +67,19 @@ fn stepping_allocates_nothing() {
     }
     let sympl = symplecticity_error(&system, &z, 0.01, &options).expect("regular");
     let explicit = rk4_step(&system, &z, 0.01).expect("regular");
+    // the reduced stepper with a new step size each step: new factors each step, in the
+    // slots of its cache (more sizes than slots, so slots are overwritten)
+    let sizes = 2 * retract::scheme::reduced::CACHE_SIZE;
+    let mut reduced = z0;
+    for i in 0..sizes {
+        let h = 0.01 * (1.0 + 0.001 * i as f64);
+        reduced = stepper.step(&reduced, h, &options).expect("regular step").0;
+    }
     let after = allocations();
     assert_eq!(after - before, 0, "allocations on the stepping path");
     // the work was real
     assert!(iterations > 400 && sympl < 1e-12 && explicit[0] > z0[0]);
+    assert!(stepper.factorisations() == sizes && reduced[0] > z0[0]);
     // and the counter works: a Vec allocates
     let v: Vec<f64> = Vec::with_capacity(4);
     assert!(allocations() > after && v.capacity() >= 4);

@@ -45,8 +45,13 @@ use crate::{Error, Lagrangian, LiftedSystem};
 ///
 /// Every value below is $R_2$ of the three plans' values and every error estimate is
 /// $|R_2 - R_1(2N, 4N)|$, componentwise.
+///
+/// A value read by serde is checked as it is read ([`Extrapolated::validate`]): a file whose
+/// plans do not fit an extrapolation, or whose values are not those of its plans, does not
+/// read.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "ExtrapolatedFields<N, X>"))]
 pub struct Extrapolated<const N: usize, const X: usize> {
     /// The coarse step $h = T/N$.
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
@@ -82,44 +87,16 @@ impl<const N: usize, const X: usize> Extrapolated<N, X> {
     /// [`Failure::Invalid`] if a plan fails [`Plan::validate`] (e.g. read back from a damaged
     /// file), if the plans' lengths are not those of $N$, $2N$ and $4N$ steps with their
     /// momenta, if their steps are not $h$, $h/2$ and $h/4$ (to a relative $10^{-12}$) or
-    /// their $\theta$ not $1/2$ (the expansion above), or if a cost is not finite.
+    /// their $\theta$ not $1/2$ (the expansion above), if a cost is not finite, or if a value
+    /// or an estimate of the extrapolation is not finite (plans' values near the largest
+    /// double overflow $4 Q_{2N}$ or $64 Q_{4N}$).
     pub fn from_plans(plans: [Plan<N, X>; 3]) -> Result<Self, PlanError<N, X>> {
         let invalid = |error| PlanError {
             failure: Failure::Invalid(error),
             last: None,
         };
-        let wrong = |requirement| {
-            invalid(Error::InvalidArgument {
-                name: "plans",
-                requirement,
-            })
-        };
+        check_plans(&plans).map_err(invalid)?;
         let [coarse, fine, finest] = &plans;
-        for plan in &plans {
-            plan.validate().map_err(invalid)?;
-        }
-        let steps = coarse.u.len();
-        let lengths = |plan: &Plan<N, X>, factor: usize| {
-            plan.u.len() == factor * steps
-                && plan.x.len() == factor * steps + 1
-                && plan.momenta.len() == factor * steps + 1
-        };
-        if !(lengths(coarse, 1) && lengths(fine, 2) && lengths(finest, 4)) {
-            return Err(wrong(
-                "extrapolation needs plans with N, 2N and 4N steps and their momenta",
-            ));
-        }
-        let step = |plan: &Plan<N, X>, factor: f64| {
-            (plan.h * factor - coarse.h).abs() <= 1e-12 * coarse.h && plan.theta == 0.5
-        };
-        if !(step(coarse, 1.0) && step(fine, 2.0) && step(finest, 4.0)) {
-            return Err(wrong(
-                "extrapolation needs plans with steps h, h/2 and h/4 and theta = 1/2",
-            ));
-        }
-        if !plans.iter().all(|plan| plan.cost.is_finite()) {
-            return Err(wrong("extrapolation needs plans with finite costs"));
-        }
         let nodes = |field: fn(&Plan<N, X>) -> &Vec<SVector<f64, X>>| {
             let (values, errors): (Vec<_>, Vec<_>) = field(coarse)
                 .iter()
@@ -132,7 +109,7 @@ impl<const N: usize, const X: usize> Extrapolated<N, X> {
         let (x, x_error) = nodes(|plan| &plan.x);
         let (momenta, momenta_error) = nodes(|plan| &plan.momenta);
         let (cost, cost_error) = richardson(coarse.cost, fine.cost, finest.cost);
-        Ok(Self {
+        let extrapolated = Self {
             h: coarse.h,
             cost,
             cost_error,
@@ -141,7 +118,81 @@ impl<const N: usize, const X: usize> Extrapolated<N, X> {
             momenta,
             momenta_error,
             plans,
-        })
+        };
+        let finite = |v: &[SVector<f64, X>]| v.iter().all(|v| v.iter().all(|e| e.is_finite()));
+        let Self {
+            x,
+            x_error,
+            momenta,
+            momenta_error,
+            ..
+        } = &extrapolated;
+        if !(cost.is_finite()
+            && cost_error.is_finite()
+            && [x, x_error, momenta, momenta_error]
+                .iter()
+                .all(|v| finite(v)))
+        {
+            return Err(invalid(Error::InvalidArgument {
+                name: "plans",
+                requirement: "extrapolation needs plans whose extrapolation is finite (4 Q_2N \
+                              and 64 Q_4N must not overflow)",
+            }));
+        }
+        Ok(extrapolated)
+    }
+
+    /// Checks that this is the extrapolation of its plans: the plans pass the checks of
+    /// [`Self::from_plans`], `h` is the coarse plan's step, there is one value and one
+    /// estimate per coarse node, and every value and estimate is that of the plans' values
+    /// $Q_N, Q_{2N}, Q_{4N}$ to $10^{-12} \max(|Q_N|, |Q_{2N}|, |Q_{4N}|)$ (a file may hold
+    /// them rounded). Run on every value read by serde.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] named `plan` or `plans` as [`Self::from_plans`], or named
+    /// `extrapolation` for a value, an estimate, `h` or a length that is not that of the
+    /// plans (a non-finite value among them).
+    pub fn validate(&self) -> Result<(), Error> {
+        check_plans(&self.plans)?;
+        let [coarse, fine, finest] = &self.plans;
+        // (NaN compares false: a non-finite value fails)
+        let fits = |value: f64, error: f64, [a, b, c]: [f64; 3]| {
+            let (v, e) = richardson(a, b, c);
+            let tolerance = VALUE_TOLERANCE * a.abs().max(b.abs()).max(c.abs());
+            (value - v).abs() <= tolerance && (error - e).abs() <= tolerance
+        };
+        let nodes_fit = |values: &[SVector<f64, X>],
+                         errors: &[SVector<f64, X>],
+                         field: fn(&Plan<N, X>) -> &Vec<SVector<f64, X>>| {
+            values.len() == field(coarse).len()
+                && errors.len() == values.len()
+                && values
+                    .iter()
+                    .zip(errors)
+                    .zip(field(coarse))
+                    .zip(field(fine).iter().step_by(2))
+                    .zip(field(finest).iter().step_by(4))
+                    .all(|((((v, e), a), b), c)| {
+                        (0..X).all(|r| fits(v[r], e[r], [a[r], b[r], c[r]]))
+                    })
+        };
+        let fitting = (self.h - coarse.h).abs() <= VALUE_TOLERANCE * coarse.h
+            && fits(
+                self.cost,
+                self.cost_error,
+                [coarse.cost, fine.cost, finest.cost],
+            )
+            && nodes_fit(&self.x, &self.x_error, |plan| &plan.x)
+            && nodes_fit(&self.momenta, &self.momenta_error, |plan| &plan.momenta);
+        if fitting {
+            Ok(())
+        } else {
+            Err(Error::InvalidArgument {
+                name: "extrapolation",
+                requirement: "its h, values and estimates must be those of its plans (to 1e-12 \
+                              of the plans' values), one per coarse node",
+            })
+        }
     }
 
     /// The extrapolated boundary momenta $[p(0), p(T)]$; `None` without momenta.
@@ -157,6 +208,104 @@ impl<const N: usize, const X: usize> Extrapolated<N, X> {
     /// The SQP iterations of the plans with $N$, $2N$ and $4N$ steps.
     pub fn iterations(&self) -> [usize; 3] {
         self.plans.each_ref().map(|plan| plan.iterations)
+    }
+}
+
+/// How far a value or an estimate read back may be from the one of its plans, relative to
+/// the largest of the plans' values ([`Extrapolated::validate`]).
+const VALUE_TOLERANCE: f64 = 1e-12;
+
+/// The checks of [`Extrapolated::from_plans`] on its plans.
+fn check_plans<const N: usize, const X: usize>(plans: &[Plan<N, X>; 3]) -> Result<(), Error> {
+    let wrong = |requirement| {
+        Err(Error::InvalidArgument {
+            name: "plans",
+            requirement,
+        })
+    };
+    for plan in plans {
+        plan.validate()?;
+    }
+    let [coarse, fine, finest] = plans;
+    let steps = coarse.u.len();
+    let lengths = |plan: &Plan<N, X>, factor: usize| {
+        plan.u.len() == factor * steps
+            && plan.x.len() == factor * steps + 1
+            && plan.momenta.len() == factor * steps + 1
+    };
+    if !(lengths(coarse, 1) && lengths(fine, 2) && lengths(finest, 4)) {
+        return wrong("extrapolation needs plans with N, 2N and 4N steps and their momenta");
+    }
+    let step = |plan: &Plan<N, X>, factor: f64| {
+        (plan.h * factor - coarse.h).abs() <= 1e-12 * coarse.h && plan.theta == 0.5
+    };
+    if !(step(coarse, 1.0) && step(fine, 2.0) && step(finest, 4.0)) {
+        return wrong("extrapolation needs plans with steps h, h/2 and h/4 and theta = 1/2");
+    }
+    if !plans.iter().all(|plan| plan.cost.is_finite()) {
+        return wrong("extrapolation needs plans with finite costs");
+    }
+    Ok(())
+}
+
+/// The fields of an [`Extrapolated`] as read, before [`Extrapolated::validate`] (serde reads
+/// an `Extrapolated` through it).
+#[cfg(feature = "serde")]
+#[derive(serde::Deserialize)]
+struct ExtrapolatedFields<const N: usize, const X: usize> {
+    #[serde(with = "crate::serde_float")]
+    h: f64,
+    #[serde(with = "crate::serde_float")]
+    cost: f64,
+    #[serde(with = "crate::serde_float")]
+    cost_error: f64,
+    #[serde(with = "crate::serde_float::vectors")]
+    x: Vec<SVector<f64, X>>,
+    #[serde(with = "crate::serde_float::vectors")]
+    x_error: Vec<SVector<f64, X>>,
+    #[serde(with = "crate::serde_float::vectors")]
+    momenta: Vec<SVector<f64, X>>,
+    #[serde(with = "crate::serde_float::vectors")]
+    momenta_error: Vec<SVector<f64, X>>,
+    plans: [Plan<N, X>; 3],
+}
+
+#[cfg(feature = "serde")]
+impl<const N: usize, const X: usize> ExtrapolatedFields<N, X> {
+    /// The fields as an [`Extrapolated`], unchecked.
+    fn unchecked(self) -> Extrapolated<N, X> {
+        let Self {
+            h,
+            cost,
+            cost_error,
+            x,
+            x_error,
+            momenta,
+            momenta_error,
+            plans,
+        } = self;
+        Extrapolated {
+            h,
+            cost,
+            cost_error,
+            x,
+            x_error,
+            momenta,
+            momenta_error,
+            plans,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<const N: usize, const X: usize> TryFrom<ExtrapolatedFields<N, X>> for Extrapolated<N, X> {
+    type Error = Error;
+
+    /// The fields as an [`Extrapolated`], if it passes [`Extrapolated::validate`].
+    fn try_from(fields: ExtrapolatedFields<N, X>) -> Result<Self, Error> {
+        let read = fields.unchecked();
+        read.validate()?;
+        Ok(read)
     }
 }
 
@@ -437,7 +586,7 @@ mod tests {
     }
 
     /// Plans read back from hostile JSON are refused by the extrapolation; the extrapolation
-    /// itself round-trips, NaN estimates included.
+    /// itself round-trips.
     #[cfg(feature = "serde")]
     #[test]
     fn plans_from_hostile_json_are_refused_by_the_extrapolation() {
@@ -462,13 +611,109 @@ mod tests {
                 "{what}: {result:?}"
             );
         }
-        let mut valid = Extrapolated::from_plans(edited(|_| ())).expect("three fitting plans");
-        valid.cost_error = f64::NAN;
-        valid.momenta_error[1][0] = f64::INFINITY;
+        // the extrapolation itself round-trips exactly (the plans' unknown certificates are NaN:
+        // compared by their Debug form)
+        let valid = Extrapolated::from_plans(edited(|_| ())).expect("three fitting plans");
         let text = serde_json::to_string(&valid).unwrap();
         let back: Extrapolated<1, 2> = serde_json::from_str(&text).unwrap();
-        assert!(back.cost_error.is_nan() && back.momenta_error[1][0] == f64::INFINITY);
+        assert_eq!(format!("{back:?}"), format!("{valid:?}"));
         assert_eq!(serde_json::to_string(&back).unwrap(), text);
+    }
+
+    /// An extrapolation read from hostile JSON does not read: its plans are checked as by
+    /// [`Extrapolated::from_plans`] and its values against those of its plans, and the
+    /// error names the cause; [`Extrapolated::validate`] refuses the same values in memory.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn an_extrapolation_from_hostile_json_does_not_read() {
+        let valid = Extrapolated::from_plans(edited(|_| ())).expect("three fitting plans");
+        let json = serde_json::to_value(&valid).unwrap();
+        type Edit = fn(&mut serde_json::Value);
+        let hostile: [(&str, &str, Edit); 12] = [
+            ("plans with mismatched steps", "plans", |v| {
+                v["plans"][1]["h"] = 0.2.into()
+            }),
+            ("a NaN plan cost", "plans", |v| {
+                v["plans"][0]["cost"] = "NaN".into()
+            }),
+            ("theta = 0.3 in every plan", "plans", |v| {
+                for k in 0..3 {
+                    v["plans"][k]["theta"] = 0.3.into();
+                }
+            }),
+            ("a plan without jets", "plan", |v| {
+                v["plans"][2]["x"] = serde_json::json!([])
+            }),
+            ("a plan's jet changed", "extrapolation", |v| {
+                v["plans"][1]["x"][2][0] = 0.5.into()
+            }),
+            ("no values", "extrapolation", |v| {
+                v["x"] = serde_json::json!([]);
+                v["x_error"] = serde_json::json!([]);
+            }),
+            ("no momenta", "extrapolation", |v| {
+                v["momenta"] = serde_json::json!([])
+            }),
+            ("a cost not the plans'", "extrapolation", |v| {
+                v["cost"] = 2.0.into()
+            }),
+            ("a NaN cost estimate", "extrapolation", |v| {
+                v["cost_error"] = "NaN".into()
+            }),
+            ("h = 1e308", "extrapolation", |v| v["h"] = 1e308.into()),
+            ("an infinite jet estimate", "extrapolation", |v| {
+                v["x_error"][1][0] = "inf".into()
+            }),
+            ("a momentum changed", "extrapolation", |v| {
+                v["momenta"][0][1] = 0.5.into()
+            }),
+        ];
+        for (what, name, edit) in hostile {
+            let mut value = json.clone();
+            edit(&mut value);
+            let read = serde_json::from_value::<Extrapolated<1, 2>>(value.clone());
+            let error = read.expect_err(what).to_string();
+            assert!(error.contains(name), "{what}: {error}");
+            // the fields as read, checked in memory
+            let fields: ExtrapolatedFields<1, 2> = serde_json::from_value(value).unwrap();
+            let unchecked = fields.unchecked();
+            assert!(
+                matches!(unchecked.validate(), Err(Error::InvalidArgument { name: n, .. }) if n == name),
+                "{what}"
+            );
+        }
+        // a value written with 14 significant digits still reads (pi + h^2 extrapolates to pi)
+        let pi = Extrapolated::from_plans(edited(|p| {
+            for plan in p {
+                plan.cost = core::f64::consts::PI + plan.h * plan.h;
+            }
+        }))
+        .expect("three fitting plans");
+        let mut rounded = serde_json::to_value(&pi).unwrap();
+        let short: f64 = format!("{:.13e}", pi.cost).parse().unwrap();
+        assert!(short != pi.cost && (short - core::f64::consts::PI).abs() < 1e-12);
+        rounded["cost"] = short.into();
+        let read: Extrapolated<1, 2> = serde_json::from_value(rounded).expect("reads");
+        assert_eq!(read.cost, short);
+    }
+
+    /// Plans whose values are finite but whose extrapolation overflows are refused, not
+    /// extrapolated to NaN.
+    #[test]
+    fn an_overflowing_extrapolation_is_refused() {
+        let plans = edited(|p| {
+            for plan in p {
+                plan.cost = 1e308;
+            }
+        });
+        let error = Extrapolated::from_plans(plans).expect_err("overflows");
+        assert!(
+            matches!(
+                error.failure,
+                Failure::Invalid(Error::InvalidArgument { name: "plans", .. })
+            ),
+            "{error}"
+        );
     }
 
     #[test]

@@ -91,9 +91,52 @@ pub(crate) fn solve_columns_overwriting<const M: usize>(
     b: &mut [f64],
     d: &mut [f64],
 ) -> bool {
+    let mut pivots = Pivots::new();
+    if !factor_overwriting(a, n, &mut pivots, b, d) {
+        return false;
+    }
+    back_substitute(a, n, &pivots, b) && back_substitute(a, n, &pivots, d)
+}
+
+/// The row interchanges and the reciprocal pivots of an LU factorisation by
+/// [`factor_overwriting`], for later right-hand sides ([`solve_factored`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pivots<const M: usize> {
+    /// The row swapped with row `col` at elimination step `col`.
+    rows: [usize; M],
+    /// $1 / u_{col, col}$.
+    inverse: [f64; M],
+}
+
+impl<const M: usize> Pivots<M> {
+    /// No interchanges and unit pivots (to be written by [`factor_overwriting`]).
+    pub(crate) fn new() -> Self {
+        Self {
+            rows: core::array::from_fn(|i| i),
+            inverse: [1.0; M],
+        }
+    }
+}
+
+/// $P A = L U$ of the leading `n x n` block of `a` in place (`n <= M`; $L$ unit lower
+/// triangular below the diagonal, $U$ on and above it, the interchanges and $1/u_{ii}$ in
+/// `pivots`), with the same interchanges and elimination applied to the right-hand sides
+/// `b` and `d` (column-major, columns of length `M`, the first `n` rows used): after it they
+/// hold $L^{-1} P$ times themselves. Column-oriented (the storage is column-major): each update
+/// runs down a contiguous column, and columns with a zero multiplier are skipped. Returns
+/// `false` for a zero or non-finite pivot.
+pub(crate) fn factor_overwriting<const M: usize>(
+    a: &mut SMatrix<f64, M, M>,
+    n: usize,
+    pivots: &mut Pivots<M>,
+    b: &mut [f64],
+    d: &mut [f64],
+) -> bool {
+    if n > M {
+        return false;
+    }
     // column-major storage: entry (r, c) at c * M + r
     let a = a.as_mut_slice();
-    let mut inverse_pivots = [0.0; M];
     for col in 0..n {
         let pivot_column = &a[col * M..col * M + n];
         let mut pivot_row = col;
@@ -107,6 +150,7 @@ pub(crate) fn solve_columns_overwriting<const M: usize>(
         if pivot_abs == 0.0 || !pivot_abs.is_finite() {
             return false;
         }
+        pivots.rows[col] = pivot_row;
         if pivot_row != col {
             for part in [&mut a[..n * M], &mut *b, &mut *d] {
                 for column in part.chunks_exact_mut(M) {
@@ -119,7 +163,7 @@ pub(crate) fn solve_columns_overwriting<const M: usize>(
         let (left, right) = a.split_at_mut((col + 1) * M);
         let pivot_column = &mut left[col * M..col * M + n];
         let inverse = 1.0 / pivot_column[col];
-        inverse_pivots[col] = inverse;
+        pivots.inverse[col] = inverse;
         for v in &mut pivot_column[col + 1..] {
             *v *= inverse;
         }
@@ -130,30 +174,64 @@ pub(crate) fn solve_columns_overwriting<const M: usize>(
             }
         }
     }
-    // back substitution, one column of X at a time
-    for part in [&mut *b, &mut *d] {
-        for x in part.chunks_exact_mut(M) {
-            let x = &mut x[..n];
-            if x.iter().all(|&v| v == 0.0) {
-                continue;
-            }
-            for col in (0..n).rev() {
-                let u = &a[col * M..col * M + col];
-                let v = x[col] * inverse_pivots[col];
-                x[col] = v;
-                if v != 0.0 {
-                    for (xi, ui) in x[..col].iter_mut().zip(u) {
-                        *xi -= ui * v;
-                    }
+    true
+}
+
+/// Solves $U X = Y$ in place for the columns $Y$ of `x` (column-major, columns of length `M`,
+/// the first `n` rows used), $U$ from [`factor_overwriting`]; all-zero columns are skipped.
+/// Returns whether every solved entry is finite.
+fn back_substitute<const M: usize>(
+    a: &SMatrix<f64, M, M>,
+    n: usize,
+    pivots: &Pivots<M>,
+    x: &mut [f64],
+) -> bool {
+    let a = a.as_slice();
+    for x in x.chunks_exact_mut(M) {
+        let x = &mut x[..n];
+        if x.iter().all(|&v| v == 0.0) {
+            continue;
+        }
+        for col in (0..n).rev() {
+            let u = &a[col * M..col * M + col];
+            let v = x[col] * pivots.inverse[col];
+            x[col] = v;
+            if v != 0.0 {
+                for (xi, ui) in x[..col].iter_mut().zip(u) {
+                    *xi -= ui * v;
                 }
             }
         }
     }
-    let finite = |part: &[f64]| {
-        part.chunks_exact(M)
-            .all(|x| x[..n].iter().all(|v| v.is_finite()))
-    };
-    finite(b) && finite(d)
+    x.chunks_exact(M)
+        .all(|x| x[..n].iter().all(|v| v.is_finite()))
+}
+
+/// Solves $A X = Y$ in place for the columns $Y$ of `x` (as in [`back_substitute`]) with the
+/// factors of $A$ from [`factor_overwriting`]: the same interchanges and elimination, then the
+/// back substitution, so a column gives the same result, to the bit, as a right-hand side of
+/// the factorisation. Returns whether every solved entry is finite.
+pub(crate) fn solve_factored<const M: usize>(
+    a: &SMatrix<f64, M, M>,
+    n: usize,
+    pivots: &Pivots<M>,
+    x: &mut [f64],
+) -> bool {
+    let factors = a.as_slice();
+    for column in x.chunks_exact_mut(M) {
+        // the stored multipliers carry the later interchanges: all of them first (as LAPACK's
+        // getrs), then the same updates as during the factorisation, in the same order
+        for (col, &row) in pivots.rows[..n].iter().enumerate() {
+            column.swap(row, col);
+        }
+        for col in 0..n {
+            eliminate(
+                &mut column[col..n],
+                &factors[col * M + col + 1..col * M + n],
+            );
+        }
+    }
+    back_substitute(a, n, pivots, x)
 }
 
 /// `column[1..] -= column[0] * l` (one elimination update below a pivot), skipped when the
@@ -230,6 +308,44 @@ mod tests {
         assert_eq!((x[0], y[1]), (0.5, -2.0));
         let singular = nalgebra::Matrix2::new(1.0, 2.0, 2.0, 4.0);
         assert!(!solve_small_pair_in_place(singular, &mut b1, &mut d1));
+    }
+
+    /// Right-hand sides solved later with the factors give the same bits as right-hand sides
+    /// of the factorisation (the same interchanges and updates in the same order).
+    #[test]
+    fn factored_solves_equal_the_elimination() {
+        // pivoting on every column; a zero column and a zero leading entry
+        let a = Matrix3::new(1e-3, 2.0, -1.0, 4.0, 0.5, 3.0, -2.0, 7.0, 0.25);
+        let b = Matrix3::new(1.0, 0.0, 0.3, -2.0, 0.0, 0.7, 0.5, 0.0, 0.0);
+        let (mut together, mut later) = (b, b);
+        let mut factors = a;
+        assert!(solve_columns_overwriting(
+            &mut factors,
+            3,
+            together.as_mut_slice(),
+            &mut []
+        ));
+        let (mut factors, mut pivots) = (a, Pivots::new());
+        assert!(factor_overwriting(
+            &mut factors,
+            3,
+            &mut pivots,
+            &mut [],
+            &mut []
+        ));
+        assert!(solve_factored(&factors, 3, &pivots, later.as_mut_slice()));
+        assert_eq!(together, later);
+        assert!((a * later - b).amax() < 1e-14, "{later}");
+        assert_eq!(later.column(1).amax(), 0.0);
+        let singular = Matrix3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 1.0, 1.0);
+        let (mut factors, mut pivots) = (singular, Pivots::new());
+        assert!(!factor_overwriting(
+            &mut factors,
+            3,
+            &mut pivots,
+            &mut [],
+            &mut []
+        ));
     }
 
     #[test]

@@ -55,6 +55,8 @@
 //! $\sum_j |z_{0,j}| + \sum_q |n_q|$ is below [`ReducedFactors::finite_below`], and is checked
 //! entry by entry otherwise.
 
+mod blocks;
+
 use core::cell::Cell;
 
 use nalgebra::{SMatrix, SVector};
@@ -62,6 +64,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::numeric::newton::{self, Problem, all_finite, max_abs, sum_abs};
 use crate::scheme::step::StepReport;
 use crate::{Error, LiftedSystem, StepOptions};
+use blocks::{Block, BlockWork};
 
 /// A system whose step reduces to its nonlinear core of `R` variables (emitted by the macro;
 /// see the module docs for the formulas).
@@ -245,10 +248,10 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     }
 
     /// Computes the factors of `system` for $(h, \theta)$ in place (a cached slot is
-    /// overwritten, no copy of the factors): $T$ and $A^{-1}$ from the closed form where
-    /// `closed_form` allows and it is accepted, else by LU of the blocks of $A$, then their
-    /// corrections, $K$, $G$ and the finiteness bound. On an error the factors are
-    /// unspecified.
+    /// overwritten, no copy of the factors): block by block of $A$ ([`blocks`]), $T$ and
+    /// $A^{-1}$ from the closed form where `closed_form` allows and it is accepted for the
+    /// block, else by LU of the block, then their corrections with the same LU factors; then
+    /// $K$, $G$ and the finiteness bound. On an error the factors are unspecified.
     ///
     /// # Errors
     /// As [`Self::new`].
@@ -262,49 +265,47 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
-        let (a, b) = linear_parts(system, h, theta)?;
+        let a = system.linear_part(h, theta);
+        let b = system.initial_part(h, theta);
+        if !(all_finite(&a) && all_finite(&b)) {
+            return Err(Error::NonFinite {
+                iteration: 0,
+                location: "linear part of the reduced step",
+            });
+        }
         (self.h, self.theta) = (h, theta);
-        // (a slice's fill is one memset; the matrix's own runs entry by entry)
+        // (a slice's fill is one memset; the matrix's own runs entry by entry; the columns of
+        // a_inv and a_inv_lo outside the forced ones are zero from `zeroed` on: never written)
         for m in [&mut self.t, &mut self.t_lo] {
             m.as_mut_slice().fill(0.0);
         }
-        for m in [&mut self.a_inv, &mut self.a_inv_lo] {
-            m.as_mut_slice().fill(0.0);
-        }
-        let closed = closed_form
-            && match system.closed_form_factors(h, theta, &mut self.t, &mut self.a_inv) {
-                ClosedForm::None => false,
-                ClosedForm::Polynomial => all_finite(&self.t) && all_finite(&self.a_inv),
-                ClosedForm::Rational => {
-                    solves_linear_part::<Sys, S, M, R>(&a, &b, &self.t, &self.a_inv)
-                }
-            };
-        if !closed {
-            if closed_form {
-                // (a refused closed form may have written entries)
-                self.t.as_mut_slice().fill(0.0);
-                self.a_inv.as_mut_slice().fill(0.0);
+        for &q in Sys::FORCED {
+            for m in [&mut self.a_inv, &mut self.a_inv_lo] {
+                m.column_mut(q).as_mut_slice().fill(0.0);
             }
-            // A T = -B, A a_inv = E (the unit columns at the forced rows)
-            solve_blocks::<Sys, S, M, R>(
-                &a,
-                |r, c| -b[(r, c)],
-                |r, q| if r == q { 1.0 } else { 0.0 },
-                (&mut self.t, &mut self.a_inv),
-            )?;
         }
-        corrections::<Sys, S, M, R>(
-            &a,
-            &b,
-            (&self.t, &self.a_inv),
-            (&mut self.t_lo, &mut self.a_inv_lo),
-        )?;
-        self.derive::<Sys>();
+        let closed = if closed_form {
+            system.closed_form_factors(h, theta, &mut self.t, &mut self.a_inv)
+        } else {
+            ClosedForm::None
+        };
+        let mut work = BlockWork::new();
+        let (mut covered, mut largest) = (0, 0.0f64);
+        for &(rows, cols) in Sys::BLOCKS {
+            covered += rows.len();
+            let block = work.factor::<Sys, R>(&a, &b, Block { rows, cols }, closed, self)?;
+            largest = largest.max(block);
+        }
+        if covered != M {
+            return Err(Error::SingularJacobian { iteration: 0 });
+        }
+        self.derive::<Sys>(largest);
         Ok(())
     }
 
-    /// $K$, $G$ and the finiteness bound from $T$ and $A^{-1}$.
-    fn derive<Sys>(&mut self)
+    /// $K$, $G$ and the finiteness bound from $T$, $A^{-1}$ and the largest magnitude of
+    /// their entries.
+    fn derive<Sys>(&mut self, largest: f64)
     where
         Sys: ReducedScheme<S, M, R> + ?Sized,
     {
@@ -318,200 +319,8 @@ impl<const S: usize, const M: usize, const R: usize> ReducedFactors<S, M, R> {
                 self.g[(m, c)] = theta * self.t[(core, c)] + own;
             }
         }
-        let largest = max_abs(&self.t).max(max_abs(&self.a_inv));
         self.finite_below = f64::MAX / (2.0 * largest.max(1.0));
     }
-}
-
-/// $A$ and $B$, or [`Error::NonFinite`] if a parameter makes an entry non-finite.
-fn linear_parts<Sys, const S: usize, const M: usize, const R: usize>(
-    system: &Sys,
-    h: f64,
-    theta: f64,
-) -> Result<(SMatrix<f64, M, M>, SMatrix<f64, M, S>), Error>
-where
-    Sys: ReducedScheme<S, M, R> + ?Sized,
-{
-    let (a, b) = (system.linear_part(h, theta), system.initial_part(h, theta));
-    if all_finite(&a) && all_finite(&b) {
-        Ok((a, b))
-    } else {
-        Err(Error::NonFinite {
-            iteration: 0,
-            location: "linear part of the reduced step",
-        })
-    }
-}
-
-/// Writes the rounding errors of `t` and `a_inv` as solutions of $A T = -B$ and
-/// $A\thinspace a^{-1} = E$ ($E$ the unit columns at the forced rows) into `t_lo` and
-/// `a_inv_lo` (zero on entry): $T_{lo} = -A^{-1}(A T + B)$ and $A^{-1}(E - A\thinspace a^{-1})$.
-/// The residuals are summed compensated ([`Dot2`]: one rounding per entry, so they are the
-/// residuals of the rounded factors, not rounding noise), then solved for by the LU of the
-/// blocks of $A$; the corrections' own relative error is that of the solve, so `t` plus
-/// $T_{lo}$ is $-A^{-1} B$ to about $u^2$ (relative, $u$ the unit roundoff), and the same for
-/// $A^{-1}$.
-#[allow(clippy::type_complexity)]
-fn corrections<Sys, const S: usize, const M: usize, const R: usize>(
-    a: &SMatrix<f64, M, M>,
-    b: &SMatrix<f64, M, S>,
-    (t, a_inv): (&SMatrix<f64, M, S>, &SMatrix<f64, M, M>),
-    (t_lo, a_inv_lo): (&mut SMatrix<f64, M, S>, &mut SMatrix<f64, M, M>),
-) -> Result<(), Error>
-where
-    Sys: ReducedScheme<S, M, R> + ?Sized,
-{
-    let rows = SparseRows::new(a);
-    // A T + B, column by column (a zero column of T stays one of T_lo)
-    let mut t_residual = SMatrix::<f64, M, S>::zeros();
-    let mut any = false;
-    for c in 0..S {
-        let column = t.column(c);
-        if column.as_slice().iter().any(|&v| v != 0.0) {
-            let column = Split::column(column.as_slice());
-            for i in 0..M {
-                let r = rows.residual(i, &column, -b[(i, c)]);
-                any |= r != 0.0;
-                t_residual[(i, c)] = r;
-            }
-        }
-    }
-    // A a_inv - E at the forced columns
-    let mut inverse_residual = SMatrix::<f64, M, M>::zeros();
-    for &q in Sys::FORCED {
-        let column = Split::column(a_inv.column(q).as_slice());
-        for i in 0..M {
-            let unit = if i == q { 1.0 } else { 0.0 };
-            let r = rows.residual(i, &column, unit);
-            any |= r != 0.0;
-            inverse_residual[(i, q)] = r;
-        }
-    }
-    if !any {
-        return Ok(());
-    }
-    solve_blocks::<Sys, S, M, R>(
-        a,
-        |r, c| -t_residual[(r, c)],
-        |r, q| -inverse_residual[(r, q)],
-        (t_lo, a_inv_lo),
-    )
-}
-
-/// Writes $X$ and $Y$ with $A X = B$ and $A Y = D$ into `x` and `y` (zero on entry), by LU
-/// with partial pivoting of each block of $A$; $B$ and $D$ are given by their entries
-/// $(r, c)$, $D$ read at the forced columns only (the columns of $Y$ outside them stay
-/// zero).
-fn solve_blocks<Sys, const S: usize, const M: usize, const R: usize>(
-    a: &SMatrix<f64, M, M>,
-    b: impl Fn(usize, usize) -> f64,
-    d: impl Fn(usize, usize) -> f64,
-    (x, y): (&mut SMatrix<f64, M, S>, &mut SMatrix<f64, M, M>),
-) -> Result<(), Error>
-where
-    Sys: ReducedScheme<S, M, R> + ?Sized,
-{
-    // A [x, y] = [b, d], block by block: the rows of a block of A, times its columns of the
-    // unknowns, give the block's rows of the right-hand sides; only the right-hand-side
-    // columns that are nonzero on those rows are solved for (each block's leading n x n
-    // entries and n rows of its columns written before they are read: one buffer each)
-    let mut covered = 0;
-    let mut block = SMatrix::<f64, M, M>::zeros();
-    let mut b_block = SMatrix::<f64, M, S>::zeros();
-    let mut d_block = SMatrix::<f64, M, M>::zeros();
-    for &(rows, cols) in Sys::BLOCKS {
-        let n = rows.len();
-        if n != cols.len() || n > M {
-            return Err(Error::SingularJacobian { iteration: 0 });
-        }
-        covered += n;
-        for (j, &c) in cols.iter().enumerate() {
-            for (i, &r) in rows.iter().enumerate() {
-                block[(i, j)] = a[(r, c)];
-            }
-        }
-        // the columns of B and of D (at the forced columns) touching the block
-        let mut b_cols = [0usize; S];
-        let mut nb = 0;
-        for c in 0..S {
-            if rows.iter().any(|&r| b(r, c) != 0.0) {
-                for (i, &r) in rows.iter().enumerate() {
-                    b_block[(i, nb)] = b(r, c);
-                }
-                b_cols[nb] = c;
-                nb += 1;
-            }
-        }
-        let mut d_cols = [0usize; M];
-        let mut nd = 0;
-        for &q in Sys::FORCED {
-            if rows.iter().any(|&r| d(r, q) != 0.0) {
-                for (i, &r) in rows.iter().enumerate() {
-                    d_block[(i, nd)] = d(r, q);
-                }
-                d_cols[nd] = q;
-                nd += 1;
-            }
-        }
-        let solved = crate::numeric::linalg::solve_columns_overwriting(
-            &mut block,
-            n,
-            &mut b_block.as_mut_slice()[..nb * M],
-            &mut d_block.as_mut_slice()[..nd * M],
-        );
-        if !solved {
-            return Err(Error::SingularJacobian { iteration: 0 });
-        }
-        for (i, &c) in cols.iter().enumerate() {
-            for (k, &col) in b_cols[..nb].iter().enumerate() {
-                x[(c, col)] = b_block[(i, k)];
-            }
-            for (k, &q) in d_cols[..nd].iter().enumerate() {
-                y[(c, q)] = d_block[(i, k)];
-            }
-        }
-    }
-    if covered != M {
-        return Err(Error::SingularJacobian { iteration: 0 });
-    }
-    Ok(())
-}
-
-/// Whether `t` and `a_inv` (from [`ReducedScheme::closed_form_factors`]) solve
-/// $A T = -B$ and $A\thinspace a^{-1}_q = e_q$ for the forced rows $q$, checked on one test vector
-/// each to a relative $10^{-10}$; a closed form whose elimination divided by a nearly vanishing
-/// pivot, or any non-finite entry, fails.
-fn solves_linear_part<Sys, const S: usize, const M: usize, const R: usize>(
-    a: &SMatrix<f64, M, M>,
-    b: &SMatrix<f64, M, S>,
-    t: &SMatrix<f64, M, S>,
-    a_inv: &SMatrix<f64, M, M>,
-) -> bool
-where
-    Sys: ReducedScheme<S, M, R> + ?Sized,
-{
-    if !(all_finite(t) && all_finite(a_inv)) {
-        return false;
-    }
-    // distinct weights, so that no cancellation hides an error
-    let x = SVector::<f64, S>::from_fn(|i, _| 1.0 + 0.1 * i as f64);
-    let tx = t * x;
-    let residual = a * tx + b * x;
-    let scale = max_abs(&(a.abs() * tx.abs())) + max_abs(&(b.abs() * x));
-    if max_abs(&residual) > 1e-10 * scale {
-        return false;
-    }
-    let e = SVector::<f64, M>::from_fn(|q, _| {
-        if Sys::FORCED.contains(&q) {
-            1.0 + 0.1 * q as f64
-        } else {
-            0.0
-        }
-    });
-    let inverse_e = a_inv * e;
-    let residual = a * inverse_e - e;
-    let scale = max_abs(&(a.abs() * inverse_e.abs())) + max_abs(&e);
-    max_abs(&residual) <= 1e-10 * scale
 }
 
 /// $s = \mathrm{fl}(a + b)$ and its rounding error $a + b - s$ (Knuth's TwoSum: exact
@@ -567,12 +376,6 @@ impl Split {
         Self { value }
     }
 
-    /// Every entry of `column` split ([`Self::new`]).
-    #[inline(always)]
-    fn column<const M: usize>(column: &[f64]) -> [Self; M] {
-        core::array::from_fn(|k| Self::new(column[k]))
-    }
-
     /// $x y - p$ for $p = \mathrm{fl}(x y)$: exact (Dekker:
     /// $((x_{hi} y_{hi} - p) + x_{hi} y_{lo} + x_{lo} y_{hi}) + x_{lo} y_{lo}$, or one fused
     /// multiply-add) unless it underflows; 0 where it is not finite.
@@ -584,69 +387,6 @@ impl Split {
         let e = ((self.hi * other.hi - p) + self.hi * other.lo + self.lo * other.hi)
             + self.lo * other.lo;
         if e.is_finite() { e } else { 0.0 }
-    }
-}
-
-/// The nonzeros of each row of a square matrix (a few per row for $A$), split once
-/// ([`Split`]), for the compensated residuals of [`corrections`]. A row's nonzeros that are
-/// powers of two ($\pm 1$ among them) come first: their products are exact (unless they
-/// underflow), so only their sums are compensated.
-struct SparseRows<const M: usize> {
-    /// Row $i$'s nonzeros: their columns and values, the first `counts[i]` used, the first
-    /// `exact[i]` of them powers of two.
-    columns: [[usize; M]; M],
-    values: [[Split; M]; M],
-    counts: [usize; M],
-    exact: [usize; M],
-}
-
-impl<const M: usize> SparseRows<M> {
-    fn new(a: &SMatrix<f64, M, M>) -> Self {
-        let mut rows = Self {
-            columns: [[0; M]; M],
-            values: [[Split::new(0.0); M]; M],
-            counts: [0; M],
-            exact: [0; M],
-        };
-        // a normal double with a zero significand field is a power of two
-        let power_of_two = |v: f64| v.is_normal() && v.to_bits() & ((1 << 52) - 1) == 0;
-        for i in 0..M {
-            for exact in [true, false] {
-                for k in 0..M {
-                    let v = a[(i, k)];
-                    if v != 0.0 && power_of_two(v) == exact {
-                        let n = rows.counts[i];
-                        rows.columns[i][n] = k;
-                        rows.values[i][n] = Split::new(v);
-                        rows.counts[i] = n + 1;
-                    }
-                }
-                if exact {
-                    rows.exact[i] = rows.counts[i];
-                }
-            }
-        }
-        rows
-    }
-
-    /// $\sum_k a_{ik} x_k - y$ over the nonzeros of row $i$, compensated as [`Dot2`]
-    /// (every product's and addition's error summed apart, added once at the end; the
-    /// products by powers of two have none).
-    #[inline(always)]
-    fn residual(&self, i: usize, x: &[Split; M], y: f64) -> f64 {
-        let mut sum = Dot2::exact(-y);
-        let (n, exact) = (self.counts[i], self.exact[i]);
-        let (columns, values) = (&self.columns[i][..n], &self.values[i][..n]);
-        for (&k, a) in columns[..exact].iter().zip(&values[..exact]) {
-            sum.add_exact(a.value * x[k].value);
-        }
-        for (&k, &a) in columns[exact..].iter().zip(&values[exact..]) {
-            let x = x[k];
-            if x.value != 0.0 {
-                sum.add_split_product(a, x);
-            }
-        }
-        sum.value()
     }
 }
 

@@ -489,6 +489,88 @@ fn closed_form_agrees<Sys, const S: usize, const M: usize, const R: usize>(
     }
 }
 
+/// $s = \mathrm{fl}(a + b)$ and its rounding error (Knuth's TwoSum).
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let b_virtual = s - a;
+    (s, (a - (s - b_virtual)) + (b - b_virtual))
+}
+
+/// $\sum_k a_k x_k + y$ in twice the working precision (every product's rounding error from a
+/// fused multiply-add, every sum's from [`two_sum`]), as (high, low) parts.
+fn double_double_dot(a: impl Iterator<Item = (f64, f64)>, y: f64) -> (f64, f64) {
+    let (mut hi, mut lo) = (y, 0.0);
+    for (a, x) in a {
+        let p = a * x;
+        let (s, f) = two_sum(hi, p);
+        (hi, lo) = (s, lo + a.mul_add(x, -p) + f);
+    }
+    two_sum(hi, lo)
+}
+
+/// The factors' corrections carry their rounding errors: `t + t_lo` solves $A T = -B$ and
+/// `a_inv + a_inv_lo` solves $A X = E$ (the forced unit columns) to about $u^2$, while the
+/// rounded factors alone leave residuals of about $u$. Residuals in double-double: the
+/// residual of $T$ is $r = A T + B$ with its low part, and that of $T + T_{lo}$ is
+/// $r + A T_{lo}$; the second is below $10^{-3}$ times the first's size and below
+/// $10^{-26}$ times $|A| |T| + |B|$ (the corrections from the same LU factors as the
+/// factors, closed form or not).
+fn corrections_solve_the_linear_part<Sys, const S: usize, const M: usize, const R: usize>(sys: &Sys)
+where
+    Sys: retract::ReducedScheme<S, M, R>,
+{
+    for (h, theta) in [(0.01, 0.5), (0.3, 0.5), (0.05, 0.3), (0.2, 1.0), (0.1, 0.0)] {
+        let (a, b) = (sys.linear_part(h, theta), sys.initial_part(h, theta));
+        let closed = retract::ReducedFactors::new(sys, h, theta).expect("closed form");
+        let lu = retract::ReducedFactors::factorised(sys, h, theta).expect("LU");
+        for f in [&closed, &lu] {
+            let unit = |r: usize, q: usize| if r == q { 1.0 } else { 0.0 };
+            // (x, x_lo, y) of each column: T against -B, the forced columns of A^{-1} against E
+            let mut columns: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..S)
+                .map(|c| {
+                    let column = |m: &SMatrix<f64, M, S>| m.column(c).iter().copied().collect();
+                    (column(&f.t), column(&f.t_lo), column(&b))
+                })
+                .collect();
+            columns.extend(Sys::FORCED.iter().map(|&q| {
+                let column = |m: &SMatrix<f64, M, M>| m.column(q).iter().copied().collect();
+                let e = (0..M).map(|r| -unit(r, q)).collect();
+                (column(&f.a_inv), column(&f.a_inv_lo), e)
+            }));
+            let (mut before, mut after, mut scale) = (0.0f64, 0.0f64, 0.0f64);
+            for (x, x_lo, y) in &columns {
+                for i in 0..M {
+                    let row = || (0..M).map(|k| a[(i, k)]);
+                    let (r_hi, r_lo) = double_double_dot(row().zip(x.iter().copied()), y[i]);
+                    let correction: f64 = row().zip(x_lo).map(|(a, x)| a * x).sum();
+                    before = before.max(r_hi.abs());
+                    after = after.max((r_hi + (r_lo + correction)).abs());
+                    let size: f64 = row().zip(x).map(|(a, x)| (a * x).abs()).sum();
+                    scale = scale.max(size + y[i].abs());
+                }
+            }
+            assert!(
+                after <= 1e-3 * before && after <= 1e-26 * scale,
+                "h {h}, theta {theta}: residual {before:e} before the corrections, {after:e} \
+                 after (scale {scale:e})"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_corrections_carry_the_rounding_errors_of_the_factors() {
+    corrections_solve_the_linear_part(&Pendulum { m: 1.3, g: 9.81 });
+    corrections_solve_the_linear_part(&Anharmonic { w: 1.5 });
+    let obstacles = [[0.0, 0.0, 1.0]];
+    corrections_solve_the_linear_part(&Se2Barrier {
+        tau: 0.3,
+        obstacles: &obstacles,
+    });
+    corrections_solve_the_linear_part(&Jerk { kappa: 0.7 });
+    corrections_solve_the_linear_part(&Snap {});
+}
+
 #[test]
 fn closed_form_factors_equal_the_lu_ones() {
     use retract::ClosedForm::{Polynomial, Rational};
