@@ -209,8 +209,11 @@ pub fn hand_guarded_step(z0: &Z) -> Result<Z, Error> {
 /// library's default tests). The Jacobian $a I + b\thinspace w w^T$
 /// ($b = 8\tau k/s^3$) is solved in closed form (Sherman-Morrison,
 /// $J^{-1} r = (r - t\thinspace w)/a$ with $t = b\thinspace (w \cdot r)/m$,
-/// $m = a + b|w|^2$), with three divisions an iteration ($1/s$, then $1/a$ and $1/m$ together). The guard is one
-/// expression: $s$ finite and of one sign at $q_0$, $q_\theta$ and $q_1$. No rounding
+/// $m = a + b|w|^2$), with three divisions an iteration ($1/s$, then $1/a$ and $1/m$
+/// together). The guard is the generated guard's test in one expression: $s$ finite and of
+/// one sign at $q_0$, $q_\theta$ and $q_1$, and outside the disc the minimum of $s$ along
+/// the chord (a quadratic, $s_0 - p^2/|d|^2$ with $d = q_1 - q_0$, $p = q_0 \cdot d$, where
+/// its vertex lies inside the step) above $10^{-9}$ of the largest sample. No rounding
 /// compensation.
 ///
 /// # Errors
@@ -253,7 +256,15 @@ pub fn tight_guarded_step(z0: &Z) -> Result<Z, Error> {
     let q1 = Vector3::new(2.0 * x - q[0], 2.0 * y - q[1], 2.0 * c[2] - q[2]);
     let s0 = q[0] * q[0] + q[1] * q[1] - 1.0;
     let s1 = q1[0] * q1[0] + q1[1] * q1[1] - 1.0;
-    if !(s0 * s_th > 0.0 && s0 * s1 > 0.0 && (s0 * s_th * s1).is_finite()) {
+    // s along the chord q0 + sigma d is the quadratic s0 + 2 sigma p + sigma^2 |d|^2; outside
+    // the disc its minimum inside the step, s0 - p^2/|d|^2, must stay clear of zero (relative
+    // 1e-9, as the generated guard's fit); inside, s is convex along the chord
+    let (dx, dy) = (q1[0] - q[0], q1[1] - q[1]);
+    let (p, dd) = (q[0] * dx + q[1] * dy, dx * dx + dy * dy);
+    let scale = s0.max(s_th).max(s1);
+    let clear = !(p < 0.0 && -p < dd) || s0 * dd - p * p > 1e-9 * scale * dd;
+    let one_sign = s0 * s_th > 0.0 && s0 * s1 > 0.0 && (s0 * s_th * s1).is_finite();
+    if !(one_sign && (s0 < 0.0 || clear)) {
         return Err(Error::Domain("the tight hand-written step: the guard"));
     }
     let g = Vector3::new(x, y, 0.0) * (-2.0 * TAU * inv_s2);

@@ -1,7 +1,7 @@
 //! The tight hand-written reduced step, the limit the report measures the generated step
 //! against, is the scheme's step: it agrees with the general generated step (Newton on all
 //! unknowns) at every state of the paper's 400-step run, and its guard refuses a step that
-//! crosses the disc.
+//! crosses the disc, also between its three samples.
 
 use retract::{StepOptions, step};
 use retract_validation::peers::tight_guarded_step;
@@ -31,6 +31,14 @@ fn the_tight_step_refuses_a_step_across_the_disc() {
         (z[0], z[3]) = (x, v);
         assert!(tight_guarded_step(&z).is_err(), "from x = {x}, v = {v}");
     }
+    // q0, q_theta and q1 all outside, the chord through the disc between q_theta and q1
+    // (its closest point to the centre, near (0, 0.95), is inside): the fit refuses it, as
+    // the generated step's guard does
+    let mut chord = Z::zeros();
+    (chord[0], chord[1], chord[3]) = (-3.0, 0.95, 4.0 / H);
+    let system = paper_system();
+    assert!(step(&system, &chord, H, &StepOptions::default()).is_err());
+    assert!(tight_guarded_step(&chord).is_err());
     let mut outside = Z::zeros();
     (outside[0], outside[3]) = (1.5, 1.0);
     let q1 = tight_guarded_step(&outside).expect("a step outside the disc")[0];

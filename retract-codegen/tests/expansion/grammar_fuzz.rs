@@ -558,6 +558,12 @@ fn run(seed: u64) -> (usize, usize) {
         if elapsed > slowest {
             (slowest, slowest_case) = (elapsed, i);
         }
+        if elapsed.as_secs() >= 5 {
+            println!(
+                "seed {seed:#x}, case {i}: {elapsed:?} ({} graph nodes)",
+                stats.graph_nodes
+            );
+        }
         over_10s += usize::from(elapsed.as_secs() >= 10);
         expanded += usize::from(ok);
         nodes += stats.graph_nodes;
