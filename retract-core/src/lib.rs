@@ -104,6 +104,7 @@ pub mod __private {
     pub use crate::mechanical::{InputComponent, MechanicalSystem, TorqueComponent};
     pub use crate::numeric::linalg::solve;
     pub use crate::numeric::special::stumpff;
+    pub use crate::scheme::guard_fit::clear_of_zero;
     pub use crate::scheme::lifted::{
         hamiltonian, jacobian, jacobian_initial, legendre, predictor, residual, step_cost,
         vector_field,

@@ -6,13 +6,14 @@
 //! must be finite, non-zero and of one sign at the three points, a `sqrt` argument `>= 0`,
 //! `ln` and `powf` arguments `> 0`; and every irreducible factor must stay clear of zero
 //! between them: the quadratic through the three samples may not come within
-//! `VANISH_TOLERANCE` of the largest sample of zero inside the step (`clear_of_zero_fn`).
+//! 10^-9 of the largest sample of zero inside the step
+//! (`retract_core::scheme::guard_fit::clear_of_zero`, called by the emitted code).
 //! Where every guard is a polynomial of degree at most 2 in the jet, that quadratic is the
 //! guard along the chord, and the impl also says `guards_quadratic` (the step's check then
 //! skips the chord's pieces).
 //! The first violation is returned as a `DomainViolation` naming the expression as written.
 
-use proc_macro2::{Literal, TokenStream};
+use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Emission;
@@ -76,62 +77,15 @@ pub(crate) fn check_domain(e: &Emission<'_>) -> Option<TokenStream> {
     })
 }
 
-/// The relative distance from zero below which a guarded factor counts as vanished.
-const VANISH_TOLERANCE: f64 = 1e-9;
-/// The rounding error of the fitted minimum, relative to the largest sample, over
-/// `min(theta, 1 - theta)`: below it the fit cannot resolve anything.
-const FIT_NOISE: f64 = 1e-13;
-
-/// The "vanishes" rule of `check_domain`, emitted once as a local function: where the
-/// quadratic through the samples `(0, a)`, `(theta, c)`, `(1, b)` (of one sign, by the sign
-/// rule) has its extremum towards zero inside the step, it must stay more than
-/// `VANISH_TOLERANCE` times the largest sample away from zero. The fit is exact for a factor
-/// quadratic along the step (`x^2 + y^2 - r^2`, `|q'|^2`, `x^2 + y^2` of `atan2` and
-/// `hypot`), so a step that passes through such a zero between the samples is caught. When
-/// the smallest sample is below the fit's rounding error `margin` (a step starting on the
-/// boundary, or a factor growing by 13 orders of magnitude within one step), the fit cannot
-/// tell a touch from rounding: then only a minimum below `-margin` (a clear dip through zero)
-/// is rejected. It is skipped (only the sign rule applies) for `theta` within `1e-3` of an
-/// end.
-fn clear_of_zero_fn() -> TokenStream {
-    let tol = Literal::f64_suffixed(VANISH_TOLERANCE);
-    let noise = Literal::f64_suffixed(FIT_NOISE);
-    quote! {
-        #[inline(always)]
-        #[allow(dead_code)]
-        fn __clear_of_zero(a: f64, b: f64, c: f64, theta: f64) -> bool {
-            if !(theta > 1e-3 && theta < 1.0 - 1e-3) {
-                return true;
-            }
-            let sign = if a < 0.0 { -1.0 } else { 1.0 };
-            let (a, b, c) = (sign * a, sign * b, sign * c);
-            let scale = a.max(b).max(c);
-            let margin = #noise * scale / theta.min(1.0 - theta);
-            // p(s) = a + beta s + alpha s^2 through the three samples
-            let alpha = ((c - a) - theta * (b - a)) / (theta * theta - theta);
-            let beta = (b - a) - alpha;
-            let vertex = -beta / (2.0 * alpha);
-            if !(alpha > 0.0 && vertex > 0.0 && vertex < 1.0) {
-                return true;
-            }
-            let minimum = a + 0.5 * beta * vertex;
-            if a.min(b).min(c) <= margin {
-                minimum > -margin
-            } else {
-                minimum > #tol * scale
-            }
-        }
-    }
-}
-
 /// `check_domain`: each guard at the three points of a step, one loop per slice guard. A
 /// denominator (and each factor of a guarded expression) must be finite, non-zero and of one
 /// sign at the three points, a `sqrt` argument `>= 0`, `ln` and `powf` arguments `> 0`; and
-/// every guarded expression must stay clear of zero between them (`clear_of_zero_fn`).
+/// every guarded expression must stay clear of zero between them
+/// (`retract_core::scheme::guard_fit::clear_of_zero`).
 fn domain_check(e: &Emission<'_>) -> TokenStream {
     let Emission { g, sig, guards, .. } = e;
     let scheme = e.scheme();
-    let mut out = clear_of_zero_fn();
+    let mut out = TokenStream::new();
     let plain: Vec<&(Guard, [Id; 3])> = guards
         .iter()
         .filter(|(guard, _)| guard.slice.is_none())
@@ -207,7 +161,7 @@ fn check(
         GuardKind::AsinArgument => quote!(AsinArgument),
     };
     let condition = if guard.touch {
-        quote!((#condition) && __clear_of_zero(#a, #b, #c, theta))
+        quote!((#condition) && #core::clear_of_zero(#a, #b, #c, theta))
     } else {
         condition
     };

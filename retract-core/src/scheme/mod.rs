@@ -9,6 +9,7 @@
 //!   compensated arithmetic that carries their rounding errors);
 //! - [`compose`]: symmetric compositions of the midpoint step (orders 4, 6, 8);
 //! - [`forced`]: a step under an external force (discrete Lagrange-d'Alembert);
+//! - [`guard_fit`]: the guard's rule between the three samples of a step;
 //! - [`diagnostics`]: energy, symplecticity, momentum drift, and RK4 for comparison;
 //! - [`split`], [`split_methods`], [`split_stepper`]: the explicit splitting for
 //!   $L = \tfrac{c}{2}|q^{(k)}|^2 + V(q)$, its methods and their stepper;
@@ -18,6 +19,7 @@
 pub mod compose;
 pub mod diagnostics;
 pub mod forced;
+pub mod guard_fit;
 pub mod lifted;
 pub mod map;
 pub mod reduced;
