@@ -115,7 +115,7 @@ pub mod __private {
     };
     pub use crate::scheme::split::Separable;
     pub use crate::system::{
-        Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction,
+        Derivatives, Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction,
     };
     pub use crate::{DomainKind, DomainViolation, Error, Float, nalgebra};
 }
@@ -136,7 +136,9 @@ pub use state::{Jet, State};
 #[cfg(feature = "std")]
 pub use step::{Interrupted, Trajectory, trajectory};
 pub use step::{StepOptions, StepReport, step};
-pub use system::{Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction};
+pub use system::{
+    Derivatives, Gradient, Hessian, JetFunction, Lagrangian, LiftedSystem, VectorJetFunction,
+};
 
 /// The linear-algebra crate of the public API, re-exported so users and generated code
 /// name the same version.

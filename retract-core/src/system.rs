@@ -42,6 +42,18 @@ pub struct Hessian<const N: usize, const K: usize> {
     pub uu: SMatrix<f64, N, N>,
 }
 
+/// A scalar function of the jet at one point $(x, u)$ with its first and second
+/// derivatives there ([`Lagrangian::derivatives`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Derivatives<const N: usize, const K: usize> {
+    /// The value, $L(x, u)$.
+    pub value: f64,
+    /// The gradient in $(x, u)$.
+    pub gradient: Gradient<N, K>,
+    /// The Hessian in $(x, u)$.
+    pub hessian: Hessian<N, K>,
+}
+
 impl<const N: usize, const K: usize> Gradient<N, K> {
     /// The zero gradient.
     #[inline]
@@ -147,6 +159,20 @@ pub trait Lagrangian<const N: usize, const K: usize> {
 
     /// The Hessian of $L$ in $(x, u)$, by blocks.
     fn hessian(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Hessian<N, K>;
+
+    /// $L(x, u)$, its gradient and its Hessian at one point: [`Self::lagrangian`],
+    /// [`Self::gradient`] and [`Self::hessian`] in one call (the default makes the three
+    /// calls). `#[higher_order_lagrangian]` emits one straight-line body for the three, so
+    /// that the subexpressions they share (the trigonometric functions of a mechanical
+    /// system, the residual of a least-squares cost) are computed once; its values equal the
+    /// three methods' up to the reassociation of sums and products (the last bits).
+    fn derivatives(&self, x: &[SVector<f64, N>; K], u: &SVector<f64, N>) -> Derivatives<N, K> {
+        Derivatives {
+            value: self.lagrangian(x, u),
+            gradient: self.gradient(x, u),
+            hessian: self.hessian(x, u),
+        }
+    }
 
     /// The Ostrogradsky momenta from derivative data, with `lower` $= (q, \dots, q^{(k-1)})$
     /// and `upper` $= (q^{(k)}, \dots, q^{(2k-1)})$:

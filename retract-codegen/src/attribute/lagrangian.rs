@@ -249,6 +249,37 @@ mod tests {
         assert!(out.contains("pub fn all("), "{out}");
     }
 
+    /// `derivatives` is one straight-line code for the value, the gradient and the Hessian:
+    /// each trigonometric function of an angle is evaluated once in it (the separate
+    /// `gradient` and `hessian` evaluate it once each).
+    #[test]
+    fn derivatives_evaluate_each_shared_subexpression_once() {
+        let out = pretty(
+            "order = 2",
+            "fn l(q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]) -> f64 {
+                let t = (2.0 + q[1].cos()) * ddq[0] + q[1].sin() * dq[0] * dq[1]
+                    + 9.81 * (q[0] + q[1]).sin();
+                0.5 * t * t + ddq[1] * ddq[1]
+            }",
+        )
+        .unwrap();
+        let body = |name: &str| {
+            let from = out.find(&format!("fn {name}(")).unwrap_or(0);
+            let to = out[from..]
+                .find("\n    fn ")
+                .map_or(out.len(), |n| from + n);
+            out[from..to].to_string()
+        };
+        let derivatives = body("derivatives");
+        assert!(derivatives.contains("Derivatives"), "{out}");
+        for call in [".sin()", ".cos()"] {
+            // sin q1, sin(q0 + q1) / cos q1, cos(q0 + q1) (each maybe with its argument bound)
+            assert_eq!(derivatives.matches(call).count(), 2, "{derivatives}");
+            assert_eq!(body("gradient").matches(call).count(), 2, "{out}");
+            assert_eq!(body("hessian").matches(call).count(), 2, "{out}");
+        }
+    }
+
     #[test]
     fn errors_name_what_is_supported() {
         let err = |body: &str| {

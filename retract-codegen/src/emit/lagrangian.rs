@@ -1,15 +1,15 @@
 //! The `Lagrangian` impl: L(x, u), its gradient (dL/dx_0, ..., dL/dx_{k-1}, dL/du) and
-//! Hessian in (x, u) (`scalar`), the Ostrogradsky momenta p_{k-1} = dL/dq^(k),
-//! p_{j-1} = dL/dq^(j) - D p_j, and, where L is quadratic in u = q^(k), the Legendre inverse
-//! u = A^{-1} (p_{k-1} - dL/du(x, 0)) with A = d2L/du2: A^{-1} computed at compile time when
-//! A is constant, else an LU solve at run time.
+//! Hessian in (x, u), and the three in one body (`scalar`), the Ostrogradsky momenta
+//! p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j, and, where L is quadratic in u = q^(k),
+//! the Legendre inverse u = A^{-1} (p_{k-1} - dL/du(x, 0)) with A = d2L/du2: A^{-1} computed
+//! at compile time when A is constant, else an LU solve at run time.
 
 use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::Emission;
 use super::helpers::{Names, index, xu_leaf};
-use super::scalar::{ScalarBodies, scalar_bodies};
+use super::scalar::{ScalarBodies, derivatives_body, scalar_bodies};
 use super::structural;
 use crate::emit::codegen::{constant, emit};
 use crate::ir::graph::Id;
@@ -41,6 +41,18 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
         gradient: g_body,
         hessian: h_body,
     } = scalar_bodies(g, sig, mech.lagrangian, &mech.gradient, entries);
+    // (the three in one body, sharing their subexpressions; with a Hessian-vector product
+    // the trait's default, which calls the three)
+    let derivatives = mech.hessian_vector.is_none().then(|| {
+        let body = derivatives_body(g, sig, mech.lagrangian, &mech.gradient, entries);
+        quote! {
+            /// L, its gradient and its Hessian in (x, u) as one straight-line code: the
+            /// subexpressions they share are computed once.
+            fn derivatives(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Derivatives<#n_lit, #k_lit> {
+                #body
+            }
+        }
+    });
     let (h_body, h_doc, hessian_vectors) = match &mech.hessian_vector {
         Some(hv) => (
             {
@@ -95,6 +107,8 @@ pub(crate) fn lagrangian_impl(e: &Emission<'_>) -> TokenStream {
             fn hessian(&self, x: &#jet_blocks, u: &#vec_n) -> #core::Hessian<#n_lit, #k_lit> {
                 #h_body
             }
+
+            #derivatives
 
             /// Ostrogradsky momenta p_{k-1} = dL/dq^(k), p_{j-1} = dL/dq^(j) - D p_j.
             fn momenta(&self, lower: &#jet_blocks, upper: &#jet_blocks) -> #jet_blocks {

@@ -179,8 +179,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         let shifted = first_step(rti);
         let (mut iterations, mut largest, mut last) = (0, 0.0_f64, f64::INFINITY);
         for i in 0..options.iterations.max(1) {
-            // (the later iterations' preparations report nothing: their cost is not evaluated)
-            if i > 0 && self.prepare_with::<S, M>(rti, false).is_err() {
+            if i > 0 && self.prepare::<S, M>(rti).is_err() {
                 break;
             }
             let Ok(fed) = self.feedback::<S, M>(rti, start) else {

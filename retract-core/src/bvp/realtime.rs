@@ -224,25 +224,10 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     where
         Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
     {
-        self.prepare_with::<S, M>(rti, true)
-    }
-
-    /// [`Self::prepare`], with the cost in the [`Preparation`] evaluated only if `with_cost`
-    /// (else 0: a control period's later iterations, which report none).
-    pub(super) fn prepare_with<const S: usize, const M: usize>(
-        &self,
-        rti: &mut RealTimeIteration<N, X>,
-        with_cost: bool,
-    ) -> Result<Preparation, Failure>
-    where
-        Sys: Lagrangian<N, K> + LiftedSystem<S, M>,
-    {
         rti.drop_linearization();
-        let lin = self.sqp::<S, M>(&rti.workspace).linearize(
-            &rti.iterate,
-            &rti.y,
-            (rti.rho, with_cost),
-        )?;
+        let lin = self
+            .sqp::<S, M>(&rti.workspace)
+            .linearize(&rti.iterate, &rti.y, rti.rho)?;
         rti.rho = lin.rho;
         let preparation = Preparation {
             violation: lin.violation,

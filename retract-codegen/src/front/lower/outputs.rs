@@ -23,6 +23,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "ne",
     "gradient",
     "hessian",
+    "derivatives",
     "lagrangian",
     "momenta",
     "top_derivative",

@@ -42,14 +42,13 @@ where
 {
     /// The preparation phase at `iterate` with the stage equalities' multipliers `y`: the
     /// models, the factorisation with the inertia correction (from a third of `rho_last`,
-    /// as [`Self::factor_corrected`]) and the backward pass of the solve; the cost $J$ at
-    /// the iterate only if `with_cost` (else 0). Problems without inequalities only (the
-    /// caller checks): the barrier is empty.
+    /// as [`Self::factor_corrected`]) and the backward pass of the solve. Problems without
+    /// inequalities only (the caller checks): the barrier is empty.
     pub(in crate::bvp) fn linearize(
         &self,
         iterate: &Iterate<N, X>,
         y: &[SVector<f64, N>],
-        (rho_last, with_cost): (f64, bool),
+        rho_last: f64,
     ) -> Result<Linearization<N, X>, Failure> {
         let steps = iterate.u.len();
         let none = [Vec::new(), Vec::new(), Vec::new()];
@@ -60,7 +59,7 @@ where
             |_| (0.0, 0.0),
             none,
         );
-        let mut models = self.models_with(iterate, y, &barrier, with_cost)?;
+        let mut models = self.models(iterate, y, &barrier)?;
         let factored = self.factor_corrected(&mut models, &barrier, rho_last);
         let (riccati, rho) = match factored {
             Ok(found) => found,

@@ -23,21 +23,24 @@ where
     /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h y_g^T g^{\ge}$
     /// ($y_g$: the multipliers of $g - s = 0$, [`Barrier::y`]),
     /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
-    /// own terms are added by [`Barrier::add_to_stage`]).
+    /// own terms are added by [`Barrier::add_to_stage`]), pushed onto `stages`; returned: $L$
+    /// at the stage ([`Lagrangian::derivatives`]: one call for $L$, its gradient and its
+    /// Hessian).
     #[inline(always)]
-    pub(super) fn stage(
+    pub(super) fn push_stage(
         &self,
-        iterate: &Iterate<N, X>,
-        i: usize,
+        stages: &mut Vec<StageModel<N, X>>,
+        (iterate, i): (&Iterate<N, X>, usize),
         y: &SVector<f64, N>,
         barrier: &Barrier,
-    ) -> StageModel<N, X> {
+    ) -> f64 {
         let (h, system) = (self.dynamics.h, self.problem.system_at(i));
         let u = &iterate.u[i];
         let xt = self.x_theta(iterate, i);
         let xb = blocks::<N, K, X>(&xt);
-        let g = system.gradient(&xb, u);
-        let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&system.hessian(&xb, u), h);
+        let derivatives = system.derivatives(&xb, u);
+        let g = &derivatives.gradient;
+        let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&derivatives.hessian, h);
         let mut stage = StageModel {
             hxx,
             hux,
@@ -76,8 +79,13 @@ where
             }
         }
         (stage.hxx, stage.hux, stage.huu) = (hxx, hux, huu);
-        stage.node = self.node_curvature(iterate, i, barrier);
-        stage
+        stages.push(stage);
+        // (the node's terms set in place, and only where there are node inequalities: an
+        // option of a few hundred bytes, it was copied twice even when `None`)
+        if let Some(stage) = stages.last_mut().filter(|_| !self.at_nodes.is_empty()) {
+            stage.node = self.node_curvature(iterate, i, barrier);
+        }
+        derivatives.value
     }
 
     /// The curvature $-h y \nabla^2 g$ of the inequalities at node `i` (interior nodes
@@ -131,18 +139,6 @@ where
         y: &[SVector<f64, N>],
         barrier: &Barrier,
     ) -> Result<Models<N, X>, Failure> {
-        self.models_with(iterate, y, barrier, true)
-    }
-
-    /// [`Self::models`], with the cost $J$ evaluated only if `with_cost` (else it is 0: a
-    /// real-time iteration's second and later steps of a period, which report no cost).
-    pub(super) fn models_with(
-        &self,
-        iterate: &Iterate<N, X>,
-        y: &[SVector<f64, N>],
-        barrier: &Barrier,
-        with_cost: bool,
-    ) -> Result<Models<N, X>, Failure> {
         let steps = iterate.u.len();
         let inequalities = self.inequalities(iterate);
         let (mut stages, mut cost_gradient) = {
@@ -150,7 +146,7 @@ where
             (pool.stages.take(steps), pool.gradients.take(steps))
         };
         let filled = self.fill_stages(
-            (iterate, y, barrier, with_cost),
+            (iterate, y, barrier),
             &inequalities,
             &mut stages,
             &mut cost_gradient,
@@ -198,31 +194,27 @@ where
         })
     }
 
-    /// Builds the stage models of [`Self::models_with`] into `stages` (with the cost
-    /// gradients into `cost_gradient`, before the barrier terms are added) and returns
-    /// $J = \sum_i h L(x_{i+\theta}, u_i)$ (0 unless `with_cost`); [`Failure::NonFinite`]
-    /// if a model is not finite, [`Failure::TimeLimit`] if the budget runs out.
+    /// Builds the stage models of [`Self::models`] into `stages` (with the cost gradients
+    /// into `cost_gradient`, before the barrier terms are added) and returns
+    /// $J = \sum_i h L(x_{i+\theta}, u_i)$; [`Failure::NonFinite`] if a model is not finite,
+    /// [`Failure::TimeLimit`] if the budget runs out.
     fn fill_stages(
         &self,
-        (iterate, y, barrier, with_cost): (&Iterate<N, X>, &[SVector<f64, N>], &Barrier, bool),
+        (iterate, y, barrier): (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         inequalities: &[Linearized<N, X>],
         stages: &mut Vec<StageModel<N, X>>,
         cost_gradient: &mut Vec<(SVector<f64, X>, SVector<f64, N>)>,
     ) -> Result<f64, Failure> {
         let h = self.dynamics.h;
+        let steps = iterate.u.len();
         let mut cost = 0.0;
-        for (i, u) in iterate.u.iter().enumerate() {
+        for i in 0..steps {
             if i % STEPS_PER_CLOCK_CHECK == STEPS_PER_CLOCK_CHECK - 1 && self.out_of_time() {
                 return Err(Failure::TimeLimit);
             }
-            if with_cost {
-                let system = self.problem.system_at(i);
-                cost += h * system.lagrangian(&blocks::<N, K, X>(&self.x_theta(iterate, i)), u);
-            }
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
-            // (built in place: a stage model is a few hundred bytes)
-            stages.push(self.stage(iterate, i, &y[i], barrier));
+            cost += h * self.push_stage(stages, (iterate, i), &y[i], barrier);
             let stage = stages.last_mut().ok_or(Failure::NonFinite)?;
             cost_gradient.push((stage.gx, stage.gu));
             barrier.add_to_stage(stage, i, own, h);

@@ -153,7 +153,9 @@ where
             let mut pool = self.pool.borrow_mut();
             (pool.stages.take(steps), pool.stages.take(steps))
         };
-        base.extend((0..steps).map(|i| self.stage(iterate, i, &y[i], barrier)));
+        for (i, y) in y.iter().enumerate().take(steps) {
+            self.push_stage(&mut base, (iterate, i), y, barrier);
+        }
         stages.extend_from_slice(&base);
         let scale = self.hessian_scale(&base);
         let lin = &models.inequalities;
