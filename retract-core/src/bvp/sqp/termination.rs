@@ -165,7 +165,11 @@ where
     }
 
     /// The error of the barrier problem (IPOPT's $E_\mu$ per unit time, [`Subproblem`]'s
-    /// `barrier_error`) at the models' iterate with the subproblem's solution `direction`:
+    /// `barrier_error`), $\max(\text{stationarity}/s_d,\ \text{feasibility}/h,\
+    /// \text{complementarity}/s_c)$: the feasibility (defects, equalities, ends, $|g - s|$) is
+    /// in the transcribed problem's units, where $\mu$ is $h\mu$, so it is divided by $h$ and
+    /// the test $E \le 10\mu$ is IPOPT's $E \le 10 h\mu$. At the models' iterate with the
+    /// subproblem's solution `direction`:
     /// the smaller of its values with the predicted inequality multipliers `z` and with the
     /// current ones (the predicted ones are off by the whole dual step when the primal step
     /// is short). $\infty$ without inequalities or with $\mu$ at its floor (it only decides
@@ -194,7 +198,7 @@ where
             self.pool.borrow_mut().jets.give(momenta);
             let (s_d, s_c) = barrier.error_scales(z, h, (others, count));
             (scale * certificate.stationarity / s_d)
-                .max(certificate.feasibility)
+                .max(certificate.feasibility / h)
                 .max(compl / s_c)
         };
         error(z).min(error(&barrier.z))
