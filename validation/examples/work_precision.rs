@@ -8,9 +8,13 @@
 //! 2. The bounded Pais-Uhlenbeck oscillator over 10^6 midpoint steps of h = 0.1
 //!    (T = 10^5): max |H - H(0)| so far against time at matched cost
 //!    (`retract_validation::long_run`).
+//! 3. The Riemannian cubic on S^2: the largest geodesic distance to the exact cubic against
+//!    the time of building the curve, for `retract` (order 2 and extrapolated) and the
+//!    adjusted geodesic de Casteljau construction (`retract_validation::sphere_cubic`).
 //!
-//! Writes docs/work_precision.svg and docs/energy_long_run.svg and prints the tables (the
-//! same as `examples/report.rs` prints, which has every other speed figure too).
+//! Writes docs/work_precision.svg, docs/energy_long_run.svg and docs/sphere_cubic.svg and
+//! prints the tables (the same as `examples/report.rs` prints, which has every other speed
+//! figure too).
 //! Run: `cargo run --release -p retract-validation --example work_precision`
 
 #[path = "../../examples/common/mod.rs"]
@@ -18,7 +22,7 @@ mod common;
 
 use retract::plot::{self, Scale};
 use retract_validation::report::Size;
-use retract_validation::{long_run, work_precision};
+use retract_validation::{long_run, sphere_cubic, work_precision};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
@@ -74,9 +78,36 @@ fn long_run(size: &Size) -> Result<()> {
     Ok(())
 }
 
+/// The cubic on S^2: its table and the figure of error against time.
+fn sphere(size: &Size) -> Result<()> {
+    let result = sphere_cubic::run(&mut std::io::stdout(), size.planner_rounds)?;
+    let curve = |label: &str, points: &[sphere_cubic::Point]| {
+        let xy = points.iter().map(|p| (p.time_ns * 1e-9, p.error)).collect();
+        plot::Curve::new(label, xy)
+    };
+    let curves = vec![
+        curve("retract, order 2", &result.retract),
+        curve("retract, extrapolated (N, 2N, 4N)", &result.extrapolated),
+        curve("geodesic de Casteljau", &result.decasteljau),
+    ];
+    let figure = common::docs_path("sphere_cubic.svg");
+    plot::panels(
+        &figure,
+        "Riemannian cubic on S^2: error against the time of building the curve",
+        "time [s]",
+        &[("max geodesic distance to the exact cubic", curves)],
+        Scale::Log,
+    )?;
+    println!("\nfigure: {}", figure.display());
+    Ok(())
+}
+
 fn main() {
     let size = Size::full();
-    if let Err(e) = obstacle_ivp(&size).and_then(|()| long_run(&size)) {
+    let all = obstacle_ivp(&size)
+        .and_then(|()| long_run(&size))
+        .and_then(|()| sphere(&size));
+    if let Err(e) = all {
         eprintln!("error: {e}");
         std::process::exit(1);
     }
