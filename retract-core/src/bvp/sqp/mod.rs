@@ -266,6 +266,13 @@ where
             };
             let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
                 Ok(sub) => sub,
+                Err(Failure::TimeLimit) => {
+                    // (no least-squares multipliers: they would cost another factorisation)
+                    let certificate = Self::unsolved_certificate(&models, &st.barrier);
+                    let cost = models.cost;
+                    self.give_models(models);
+                    return Err(fail(Failure::TimeLimit, cost, certificate, vec![]));
+                }
                 Err(failure) => {
                     let partial = self.failure_certificate(&models, &st.barrier);
                     let failure = self.name_infeasibility(failure, &st.iterate);

@@ -108,16 +108,24 @@ where
         barrier: &Barrier,
     ) -> Certificate {
         let Some(direction) = self.least_squares_direction(models, barrier) else {
-            let mut certificate = crate::bvp::plan::certificate::unknown_certificate();
-            certificate.stationarity = f64::INFINITY;
-            certificate.feasibility = models.violation_max();
-            certificate.complementarity = barrier.complementarity().0;
-            return certificate;
+            return Self::unsolved_certificate(models, barrier);
         };
         let (momenta, certificate, _) = self.residuals(models, barrier, 0, &direction, &barrier.z);
         let mut pool = self.pool.borrow_mut();
         pool.jets.give(momenta);
         direction.recycle(&mut *pool);
+        certificate
+    }
+
+    /// The certificate at the iterate of `models` without a stationarity (not computed:
+    /// $\infty$): the feasibility of the models and the barrier's complementarity. For a
+    /// budget that ran out in the factorisation, where the least-squares multipliers of
+    /// [`Self::failure_certificate`] would cost another factorisation.
+    pub(super) fn unsolved_certificate(models: &Models<N, X>, barrier: &Barrier) -> Certificate {
+        let mut certificate = crate::bvp::plan::certificate::unknown_certificate();
+        certificate.stationarity = f64::INFINITY;
+        certificate.feasibility = models.violation_max();
+        certificate.complementarity = barrier.complementarity().0;
         certificate
     }
 
