@@ -26,6 +26,20 @@ use retract_validation::{long_run, sphere_cubic, work_precision};
 
 type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
+/// Writes the log-log figure `name` under docs/ (one panel of `curves`, axes labelled
+/// `labels` = (x, y)) and prints its path.
+fn log_figure(
+    name: &str,
+    title: &str,
+    labels: (&str, &str),
+    curves: Vec<plot::Curve>,
+) -> Result<()> {
+    let figure = common::docs_path(name);
+    plot::panels(&figure, title, labels.0, &[(labels.1, curves)], Scale::Log)?;
+    println!("\nfigure: {}", figure.display());
+    Ok(())
+}
+
 /// The obstacle IVP's sweeps, the times at 1e-8 and the figure.
 fn obstacle_ivp(size: &Size) -> Result<()> {
     let ivp = work_precision::Ivp::paper();
@@ -46,16 +60,12 @@ fn obstacle_ivp(size: &Size) -> Result<()> {
         .iter()
         .map(|s| plot::Curve::new(s.label, s.curve()))
         .collect();
-    let figure = common::docs_path("work_precision.svg");
-    plot::panels(
-        &figure,
+    log_figure(
+        "work_precision.svg",
         "Obstacle IVP to T = 4: final error against wall time",
-        "wall time [s]",
-        &[("max-norm error at T", curves)],
-        Scale::Log,
-    )?;
-    println!("\nfigure: {}", figure.display());
-    Ok(())
+        ("wall time [s]", "max-norm error at T"),
+        curves,
+    )
 }
 
 /// The long run's table and figure.
@@ -66,16 +76,12 @@ fn long_run(size: &Size) -> Result<()> {
         .into_iter()
         .map(|r| plot::Curve::new(r.name, r.record))
         .collect();
-    let figure = common::docs_path("energy_long_run.svg");
-    plot::panels(
-        &figure,
+    log_figure(
+        "energy_long_run.svg",
         "Pais-Uhlenbeck: max |H - H(0)| up to time t, matched cost",
-        "t",
-        &[("max energy error", curves)],
-        Scale::Log,
-    )?;
-    println!("\nfigure: {}", figure.display());
-    Ok(())
+        ("t", "max energy error"),
+        curves,
+    )
 }
 
 /// The cubic on S^2: its table and the figure of error against time.
@@ -90,16 +96,12 @@ fn sphere(size: &Size) -> Result<()> {
         curve("retract, extrapolated (N, 2N, 4N)", &result.extrapolated),
         curve("geodesic de Casteljau", &result.decasteljau),
     ];
-    let figure = common::docs_path("sphere_cubic.svg");
-    plot::panels(
-        &figure,
+    log_figure(
+        "sphere_cubic.svg",
         "Riemannian cubic on S^2: error against the time of building the curve",
-        "time [s]",
-        &[("max geodesic distance to the exact cubic", curves)],
-        Scale::Log,
-    )?;
-    println!("\nfigure: {}", figure.display());
-    Ok(())
+        ("time [s]", "max geodesic distance to the exact cubic"),
+        curves,
+    )
 }
 
 fn main() {
