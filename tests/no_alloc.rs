@@ -201,6 +201,43 @@ fn a_solve_interrupted_in_the_models_keeps_the_workspace_whole() {
     assert!(again.certificate.min_reduced_hessian_eig > 0.0);
 }
 
+/// A solve that ends at its iteration limit gives the models' and the subproblem's vectors
+/// back to the workspace: after one iteration from the spline (N = 1024) and the failed
+/// iterate recycled, a warm re-solve allocates nothing.
+#[test]
+fn a_solve_at_its_iteration_limit_keeps_the_workspace_whole() {
+    use cart_pole::{CartForce, CartPole, PoleTorque};
+    use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Workspace};
+    let system = CartPole::new(1.0, 0.3, 0.5);
+    let unactuated = PoleTorque::new(0.3, 0.5, 9.81);
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    let problem = OptimalControlProblem::new(&system, &[0.0; 4], &[0.5, 0.0, 0.0, 0.0], 2.0, 1024)
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -1.0, 1.0);
+    let mut workspace = Workspace::new();
+    let cold = problem
+        .solve_with(PlanGuess::Spline, &mut workspace)
+        .expect("cold");
+    let warm = problem
+        .solve_with(PlanGuess::Plan(&cold), &mut workspace)
+        .expect("warm");
+    workspace.recycle(cold);
+    let stopped = problem
+        .clone()
+        .with_options(PlanOptions::default().with_max_iterations(1))
+        .solve_with(PlanGuess::Spline, &mut workspace)
+        .expect_err("one iteration from the spline");
+    assert_eq!(stopped.failure, Failure::IterationLimit, "{stopped}");
+    workspace.recycle(*stopped.last.expect("the iterate"));
+    let before = allocations();
+    let again = problem
+        .solve_with(PlanGuess::Plan(&warm), &mut workspace)
+        .expect("warm again");
+    let count = allocations() - before;
+    assert_eq!(count, 0, "{count} allocations after the failed solve");
+    assert!(again.certificate.min_reduced_hessian_eig > 0.0);
+}
+
 // the double pendulum's receding-horizon controller, shared with the examples
 #[path = "../examples/common/pendulum.rs"]
 mod pendulum;

@@ -276,14 +276,17 @@ where
                 Err(failure) => {
                     let partial = self.failure_certificate(&models, &st.barrier);
                     let failure = self.name_infeasibility(failure, &st.iterate);
-                    return Err(fail(failure, models.cost, partial, vec![]));
+                    let cost = models.cost;
+                    self.give_models(models);
+                    return Err(fail(failure, cost, partial, vec![]));
                 }
             };
             rho_last = sub.rho;
             match self.unreachable_goal(&models, &sub) {
                 Some((component, miss)) if unreachable + 1 >= UNREACHABLE_ITERATIONS => {
                     let failure = Failure::UnreachableGoal { component, miss };
-                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                    let (cost, certificate, momenta) = self.hand_back(models, sub);
+                    return Err(fail(failure, cost, certificate, momenta));
                 }
                 Some(_) => unreachable += 1,
                 None => unreachable = 0,
@@ -309,7 +312,8 @@ where
                             return Ok((plan, true));
                         }
                         Finished::Failed(failure, certificate, sub) => {
-                            return Err(fail(failure, models.cost, certificate, sub.momenta));
+                            let (cost, _, momenta) = self.hand_back(models, sub);
+                            return Err(fail(failure, cost, certificate, momenta));
                         }
                         Finished::Not(sub) => sub,
                     }
@@ -331,7 +335,8 @@ where
                 } else {
                     Failure::IterationLimit
                 };
-                return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                let (cost, certificate, momenta) = self.hand_back(models, sub);
+                return Err(fail(failure, cost, certificate, momenta));
             }
             iterations += 1;
             let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
@@ -352,7 +357,9 @@ where
                 }
                 Err(failure) => {
                     let failure = self.name_infeasibility(failure, &st.iterate);
-                    return Err(fail(failure, models.cost, sub.certificate, sub.momenta));
+                    self.pool.borrow_mut().reals.give(ds);
+                    let (cost, certificate, momenta) = self.hand_back(models, sub);
+                    return Err(fail(failure, cost, certificate, momenta));
                 }
             };
             let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);

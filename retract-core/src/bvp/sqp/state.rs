@@ -163,6 +163,24 @@ where
         pool.jets.give(sub.momenta);
     }
 
+    /// Gives the models' and the subproblem's vectors back to the pool at a failure, keeping
+    /// what its last iterate reports: the models' cost, the subproblem's certificate and its
+    /// momenta.
+    pub(super) fn hand_back(
+        &self,
+        models: Models<N, X>,
+        mut sub: Subproblem<N, X>,
+    ) -> (f64, Certificate, Vec<SVector<f64, X>>) {
+        let kept = (
+            models.cost,
+            sub.certificate,
+            core::mem::take(&mut sub.momenta),
+        );
+        self.give_models(models);
+        self.give_subproblem(sub);
+        kept
+    }
+
     pub(super) fn x_theta(&self, iterate: &Iterate<N, X>, i: usize) -> SVector<f64, X> {
         let theta = self.dynamics.theta;
         iterate.x[i] * (1.0 - theta) + iterate.x[i + 1] * theta
