@@ -86,12 +86,32 @@ fn pendulum_problem(
 /// basis of the scheme's x-equations, formed densely (SVD) in the variables
 /// (x_1, ..., x_{N-1}, u_0, ..., u_{N-1}).
 fn dense_min_reduced_eigenvalue<Sys: Lagrangian<2, 2>>(system: &Sys, plan: &Plan<2, 4>) -> f64 {
+    dense_min_reduced_eigenvalue_free(system, plan, (&[], &[]))
+}
+
+/// [`dense_min_reduced_eigenvalue`] with the components `free.0` of x_0 and `free.1` of x_N
+/// free (variables too, after the interior nodes' and before the top derivatives').
+fn dense_min_reduced_eigenvalue_free<Sys: Lagrangian<2, 2>>(
+    system: &Sys,
+    plan: &Plan<2, 4>,
+    free: (&[usize], &[usize]),
+) -> f64 {
     let (h, theta) = (plan.h, plan.theta);
     let steps = plan.u.len();
-    let inner = (steps - 1) * 4;
+    let ends = free.0.len() + free.1.len();
+    let inner = (steps - 1) * 4 + ends;
     let dim = inner + steps * 2;
-    // column of x_i entry r (None for the fixed x_0, x_N) and of u_i entry a
-    let xcol = |i: usize, r: usize| (i >= 1 && i < steps).then(|| (i - 1) * 4 + r);
+    // column of x_i entry r (None for the fixed components of x_0, x_N) and of u_i entry a
+    let xcol = |i: usize, r: usize| {
+        let at = |list: &[usize]| list.iter().position(|c| *c == r);
+        if i == 0 {
+            at(free.0)
+        } else if i == steps {
+            at(free.1).map(|j| free.0.len() + (steps - 1) * 4 + j)
+        } else {
+            Some(free.0.len() + (i - 1) * 4 + r)
+        }
+    };
     let ucol = |i: usize, a: usize| inner + i * 2 + a;
     let mut hessian = DMatrix::<f64>::zeros(dim, dim);
     let mut constraints = DMatrix::<f64>::zeros(steps * 4, dim);
@@ -176,6 +196,28 @@ fn certificate_eigenvalue_matches_a_dense_computation() {
         (lanczos - dense).abs() < 1e-6 * dense.abs(),
         "Lanczos {lanczos:e}, dense {dense:e}"
     );
+}
+
+/// With free components of x_0 or x_N the certificate's smallest eigenvalue is that of the
+/// reduced Hessian in those components too (a dense computation agrees to 1e-6).
+#[test]
+fn certificate_eigenvalue_with_free_ends_matches_a_dense_computation() {
+    let system = DoublePendulum { g: 9.81 };
+    let cases: [(&[usize], &[usize]); 3] = [(&[], &[2, 3]), (&[3], &[]), (&[2], &[1, 3])];
+    for (start, end) in cases {
+        let plan = pendulum_problem(&system, 1.0, 24)
+            .with_free_start(start)
+            .with_free_end(end)
+            .solve(PlanGuess::Spline)
+            .unwrap();
+        let dense = dense_min_reduced_eigenvalue_free(&system, &plan, (start, end));
+        let lanczos = plan.certificate.min_reduced_hessian_eig;
+        assert!(dense > 0.0, "free {start:?} {end:?}: dense {dense:e}");
+        assert!(
+            (lanczos - dense).abs() < 1e-6 * dense.abs(),
+            "free {start:?} {end:?}: Lanczos {lanczos:e}, dense {dense:e}"
+        );
+    }
 }
 
 /// The root finder on the optimality conditions returns a stationary point of the T = 2

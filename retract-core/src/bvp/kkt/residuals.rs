@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use super::model::{StageLinear, StageModel};
+use super::model::{StageLinear, StageModel, Terminal};
 use super::riccati::{Direction, Riccati, Vectors};
 use crate::bvp::dynamics::Dynamics;
 use crate::newton::max_abs;
@@ -101,23 +101,26 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
 /// a positive definite factorisation, by Lanczos on its inverse: the subproblem's solution
 /// operator $v \mapsto \delta$ (min $\tfrac12 \delta^T \nabla^2 J \delta - v^T \delta$ subject
 /// to the homogeneous constraints) is $Z (Z^T \nabla^2 J Z)^{-1} Z^T$, whose largest
-/// eigenvalue is the reciprocal of the one sought. Lanczos stops when the Ritz residual of
+/// eigenvalue is the reciprocal of the one sought. The variables ([`Packing`]) are the free
+/// components of $x_0$ (`end`'s `start_fixed` 0), the interior nodes, the free components of
+/// $x_N$ (`fixed` 0) and the top derivatives. Lanczos stops when the Ritz residual of
 /// the top Ritz value $\vartheta$ is below $10^{-3}\vartheta$ (the eigenvalue then has about
 /// six digits; 2 to 12 solves on the constrained suite and the swing-ups, less than one SQP
 /// iteration). NaN if the start vector vanishes.
 pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
+    end: &Terminal<X>,
     pool: &mut impl Vectors<N, X>,
 ) -> f64 {
-    let steps = riccati.steps();
-    let dim = (steps - 1) * X + steps * N;
+    let packing = Packing::new(riccati.steps(), end);
+    let dim = packing.dim::<N>();
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector
     let mut seed = pool.lanczos().take(dim);
     seed.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
     let mut q = pool.lanczos().take(dim);
-    apply_inverse(riccati, dynamics, &seed, &mut q, pool);
+    apply_inverse(riccati, dynamics, &packing, &seed, &mut q, pool);
     let (mut q_prev, mut w) = (seed, pool.lanczos().take(dim));
     q_prev.iter_mut().for_each(|x| *x = 0.0);
     let (mut alphas, mut betas) = (
@@ -130,7 +133,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
         q.iter_mut().for_each(|x| *x /= norm);
         let mut beta = 0.0;
         for m in 0..dim.min(LANCZOS_STEPS) {
-            apply_inverse(riccati, dynamics, &q, &mut w, pool);
+            apply_inverse(riccati, dynamics, &packing, &q, &mut w, pool);
             for (wi, pi) in w.iter_mut().zip(&q_prev) {
                 *wi -= beta * pi;
             }
@@ -162,39 +165,91 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
 /// The most Lanczos steps of [`min_reduced_eigenvalue`].
 const LANCZOS_STEPS: usize = 150;
 
-/// `out` $= Z (Z^T \nabla^2 J Z)^{-1} Z^T v$: the subproblem's solution for the linear terms
-/// $-v$ on the interior nodes and the top derivatives, with homogeneous constraints.
+/// Where the variables of [`min_reduced_eigenvalue`] sit in one vector: the free components
+/// of $x_0$ (`start`), then the interior nodes $x_1, \dots, x_{N-1}$, the free components of
+/// $x_N$ (`end`), and $u_0, \dots, u_{N-1}$.
+struct Packing<const X: usize> {
+    steps: usize,
+    start: SVector<bool, X>,
+    end: SVector<bool, X>,
+}
+
+impl<const X: usize> Packing<X> {
+    fn new(steps: usize, end: &Terminal<X>) -> Self {
+        Self {
+            steps,
+            start: end.start_fixed.map(|f| f == 0.0),
+            end: end.fixed.map(|f| f == 0.0),
+        }
+    }
+
+    /// The offsets of the interior nodes, the free end components and the top derivatives.
+    fn offsets(&self) -> (usize, usize, usize) {
+        let count = |free: &SVector<bool, X>| free.iter().filter(|f| **f).count();
+        let inner = count(&self.start);
+        let end = inner + (self.steps - 1) * X;
+        (inner, end, end + count(&self.end))
+    }
+
+    fn dim<const N: usize>(&self) -> usize {
+        self.offsets().2 + self.steps * N
+    }
+
+    /// The packed entries of node `i`'s components: the vector's indices of its free
+    /// components (all of an interior node's).
+    fn node(&self, i: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let (inner, end, _) = self.offsets();
+        let (free, base) = if i == 0 {
+            (Some(&self.start), 0)
+        } else if i == self.steps {
+            (Some(&self.end), end)
+        } else {
+            (None, inner + (i - 1) * X)
+        };
+        (0..X)
+            .filter(move |r| free.is_none_or(|f| f[*r]))
+            .enumerate()
+            .map(move |(j, r)| (base + j, r))
+    }
+}
+
+/// `out` $= Z (Z^T \nabla^2 J Z)^{-1} Z^T v$ in the variables of `packing`: the subproblem's
+/// solution for the linear terms $-v$, with homogeneous constraints.
 fn apply_inverse<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
+    packing: &Packing<X>,
     v: &[f64],
     out: &mut Vec<f64>,
     pool: &mut impl Vectors<N, X>,
 ) {
     let steps = riccati.steps();
-    let inner = (steps - 1) * X;
-    let linear = |i: usize| {
-        let lx = if i >= 1 && i < steps {
-            SVector::<f64, X>::from_fn(|r, _| -v[(i - 1) * X + r])
-        } else {
-            SVector::zeros()
-        };
-        let lu = SVector::<f64, N>::from_fn(|a, _| -v[inner + i * N + a]);
-        StageLinear {
-            lx,
-            lu,
-            defect: SVector::zeros(),
-            constraint: SVector::zeros(),
+    let tops = packing.offsets().2;
+    let node = |i: usize| {
+        let mut l = SVector::<f64, X>::zeros();
+        for (j, r) in packing.node(i) {
+            l[r] = -v[j];
         }
+        l
+    };
+    let linear = |i: usize| StageLinear {
+        lx: node(i),
+        lu: SVector::<f64, N>::from_fn(|a, _| -v[tops + i * N + a]),
+        defect: SVector::zeros(),
+        constraint: SVector::zeros(),
     };
     let zero = SVector::<f64, X>::zeros();
-    let d = riccati.solve_linear(dynamics, &linear, &zero, (&zero, &zero), pool);
+    let s_end = node(steps);
+    let d = riccati.solve_linear(dynamics, &linear, &zero, (&zero, &s_end), pool);
     out.clear();
-    for dx in &d.dx[1..steps] {
-        out.extend_from_slice(dx.as_slice());
+    out.resize(packing.dim::<N>(), 0.0);
+    for (i, dx) in d.dx.iter().enumerate() {
+        for (j, r) in packing.node(i) {
+            out[j] = dx[r];
+        }
     }
-    for du in &d.du {
-        out.extend_from_slice(du.as_slice());
+    for (i, du) in d.du.iter().enumerate() {
+        out[tops + i * N..tops + (i + 1) * N].copy_from_slice(du.as_slice());
     }
     d.recycle(pool);
 }

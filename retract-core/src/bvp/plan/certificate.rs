@@ -27,13 +27,13 @@ pub struct Certificate {
     pub negative_directions: usize,
     /// The smallest eigenvalue of $Z^T \nabla^2 J\thinspace Z$, $Z$ an orthonormal basis of the
     /// null space of the constraint Jacobian in the variables $(x_1, \dots, x_{N-1}, u_0, \dots,
-    /// u_{N-1})$; positive for a strict local minimum. With inequalities, the active ones
-    /// enter as the penalties of the second-order check (a lower bound on the value on their
-    /// null space too). Exactly 0 where the reduced Hessian is positive semidefinite and
-    /// singular: a minimum, but not a strict one (the cost is flat to second order along
-    /// some direction, e.g. ends that nothing fixes).
-    /// NaN if [`PlanOptions::min_eigenvalue`](crate::bvp::PlanOptions::min_eigenvalue) is off or the end $x_N$ has free
-    /// components (the inertia count proves positivity either way).
+    /// u_{N-1})$ and the free components of $x_0$ and $x_N$; positive for a strict local
+    /// minimum. With inequalities, the active ones enter as the penalties of the second-order
+    /// check (a lower bound on the value on their null space too). Exactly 0 where the
+    /// reduced Hessian is positive semidefinite and singular: a minimum, but not a strict one
+    /// (the cost is flat to second order along some direction, e.g. ends that nothing fixes).
+    /// NaN if [`PlanOptions::min_eigenvalue`](crate::bvp::PlanOptions::min_eigenvalue) is off
+    /// (the inertia count proves positivity either way).
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub min_reduced_hessian_eig: f64,
 }

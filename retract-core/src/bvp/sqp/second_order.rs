@@ -97,11 +97,10 @@ where
             };
             return Err((failure, certificate));
         }
-        // (the Lanczos operator takes x_N as fixed)
-        if self.options.min_eigenvalue && models.terminal.fixed.iter().all(|f| *f != 0.0) {
+        if self.options.min_eigenvalue {
             let pool = &mut *self.pool.borrow_mut();
             certificate.min_reduced_hessian_eig =
-                min_reduced_eigenvalue(exact, &self.dynamics, pool);
+                min_reduced_eigenvalue(exact, &self.dynamics, &models.terminal, pool);
         }
         Ok(certificate)
     }
