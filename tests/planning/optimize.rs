@@ -253,8 +253,9 @@ fn the_optimizer_descends_where_the_root_finder_stops_at_a_saddle() {
         .iter()
         .map(|w| w.fixed_rows::<2>(8).into_owned())
         .collect();
+    let without_escapes = PlanOptions::default().with_saddle_escapes(0);
     let error = pendulum_problem(&system, 2.0, 200)
-        .with_options(PlanOptions::default().with_max_iterations(1))
+        .with_options(without_escapes.with_max_iterations(1))
         .solve(PlanGuess::Path { x: &x, u: &u })
         .unwrap_err();
     let Failure::NotAMinimum {
@@ -267,6 +268,22 @@ fn the_optimizer_descends_where_the_root_finder_stops_at_a_saddle() {
     let last = error.last.expect("the saddle is attached");
     assert!(last.certificate.stationarity < 1e-9 && last.certificate.feasibility < 1e-9);
     assert!((last.cost - root.cost).abs() < 1e-9 * root.cost);
+    // with its escapes (the default) it leaves that saddle downhill to a certified minimum
+    let escaped = pendulum_problem(&system, 2.0, 200)
+        .solve(PlanGuess::Path { x: &x, u: &u })
+        .unwrap();
+    let c = &escaped.certificate;
+    assert!(
+        escaped.cost < root.cost,
+        "{} vs {}",
+        escaped.cost,
+        root.cost
+    );
+    assert!(
+        c.negative_directions == 0 && c.min_reduced_hessian_eig > 0.0,
+        "{c:?}"
+    );
+    assert!(c.stationarity <= 1e-9 && c.feasibility <= 1e-9, "{c:?}");
 }
 
 /// Every swing-up of the suite at reduced size (N = 25 T) converges to a certified minimum;

@@ -78,6 +78,20 @@ pub struct PlanOptions {
     /// minimum 51.7053 instead of 51.5202 (in 45 iterations instead of 32).
     #[cfg_attr(feature = "serde", serde(default = "default_corrections"))]
     pub second_order_corrections: usize,
+    /// The most escapes from saddles per solve (2 by default; 0: a saddle ends the solve in
+    /// [`Failure::NotAMinimum`](super::Failure::NotAMinimum)). Where the iteration converges
+    /// to a KKT point whose reduced Hessian has negative directions, it starts again (a cold
+    /// start, with [`Self::max_iterations`] of its own) from a point below it along the
+    /// direction of its most negative curvature; the plan's iterations count every start.
+    /// Not in [`OptimalControlProblem::solve_real_time`](crate::bvp::OptimalControlProblem::solve_real_time).
+    #[cfg_attr(feature = "serde", serde(default = "default_escapes"))]
+    pub saddle_escapes: usize,
+}
+
+/// [`PlanOptions::saddle_escapes`]'s default.
+#[cfg(feature = "serde")]
+fn default_escapes() -> usize {
+    PlanOptions::default().saddle_escapes
 }
 
 /// IPOPT's `max_soc`, [`PlanOptions::second_order_corrections`]'s default.
@@ -105,6 +119,7 @@ impl Default for PlanOptions {
             min_eigenvalue: true,
             interior_samples: 0,
             second_order_corrections: 0,
+            saddle_escapes: 2,
         }
     }
 }
@@ -199,6 +214,12 @@ impl PlanOptions {
     /// ([`Self::second_order_corrections`]; 0 turns them off).
     pub fn with_second_order_corrections(mut self, corrections: usize) -> Self {
         self.second_order_corrections = corrections;
+        self
+    }
+    /// Sets the most escapes from saddles per solve ([`Self::saddle_escapes`]; 0 turns them
+    /// off).
+    pub fn with_saddle_escapes(mut self, escapes: usize) -> Self {
+        self.saddle_escapes = escapes;
         self
     }
     /// Sets the chord spacing and the cap on chord pieces of the singularity guard

@@ -73,6 +73,58 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     1.0 / largest
 }
 
+/// The power iterations of [`most_negative_direction`].
+const POWER_STEPS: usize = 40;
+
+/// A direction of the most negative curvature of the reduced Hessian, from a positive
+/// definite factorisation of it shifted ($Z^T (\nabla^2 J + \sigma M) Z$, $M$ positive
+/// definite, $\sigma$ above the magnitude of the most negative eigenvalue): the solution
+/// operator's dominant eigenvector, the largest $1/(\lambda + \sigma)$, by [`POWER_STEPS`]
+/// power iterations from a fixed start vector. Written into `dx` (every node, 0 at the fixed
+/// end components, [`Packing`]) and `du` (both emptied first), scaled to max-norm 1; `false`
+/// if it vanishes or is not finite.
+pub(crate) fn most_negative_direction<const N: usize, const X: usize>(
+    riccati: &Riccati<N, X>,
+    dynamics: &Dynamics<N, X>,
+    end: &Terminal<X>,
+    (dx, du): (&mut Vec<SVector<f64, X>>, &mut Vec<SVector<f64, N>>),
+    pool: &mut impl Vectors<N, X>,
+) -> bool {
+    let steps = riccati.steps();
+    let packing = Packing::new(steps, end);
+    let dim = packing.dim::<N>();
+    let mut v = pool.lanczos().take(dim);
+    v.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
+    let mut w = pool.lanczos().take(dim);
+    let mut found = true;
+    for _ in 0..POWER_STEPS {
+        apply_inverse(riccati, dynamics, &packing, &v, &mut w, pool);
+        let norm = w.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        if !(norm > 0.0 && norm.is_finite()) {
+            found = false;
+            break;
+        }
+        w.iter_mut().for_each(|x| *x /= norm);
+        core::mem::swap(&mut v, &mut w);
+    }
+    dx.clear();
+    du.clear();
+    if found {
+        let tops = packing.offsets().2;
+        for i in 0..=steps {
+            let mut d = SVector::<f64, X>::zeros();
+            for (j, r) in packing.node(i) {
+                d[r] = v[j];
+            }
+            dx.push(d);
+        }
+        du.extend((0..steps).map(|i| SVector::<f64, N>::from_fn(|a, _| v[tops + i * N + a])));
+    }
+    pool.lanczos().give(v);
+    pool.lanczos().give(w);
+    found
+}
+
 /// The most Lanczos steps of [`min_reduced_eigenvalue`].
 const LANCZOS_STEPS: usize = 150;
 

@@ -52,7 +52,8 @@ pub enum Failure {
     },
     /// The KKT conditions hold but the reduced Hessian has negative curvature: a saddle, not
     /// a minimum. (With 0 negative directions: the second-order check could not be made,
-    /// the stage constraints being dependent at the point. A reduced Hessian that is only
+    /// the constraints' Jacobian losing rank at the point: its count of negative pivots
+    /// stays under any shift of the Hessian, so it does not come from curvature. A reduced Hessian that is only
     /// singular, positive semidefinite, is a minimum flat along some direction: certified
     /// with [`Certificate::min_reduced_hessian_eig`](crate::bvp::Certificate::min_reduced_hessian_eig) 0.)
     NotAMinimum {
@@ -125,9 +126,10 @@ impl core::fmt::Display for Failure {
                 negative_directions: 0,
             } => write!(
                 f,
-                "the second-order check failed at the KKT point found: the stage \
-                 constraints are dependent there; remove the redundant ones or start from \
-                 another guess"
+                "the second-order check could not be made at the KKT point found: the \
+                 constraints' Jacobian loses rank there (dependent stage constraints, or an \
+                 active inequality whose gradient vanishes); remove the redundant ones or \
+                 start from another guess"
             ),
             Failure::WeaklyActive {
                 constraint,

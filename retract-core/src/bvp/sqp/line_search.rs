@@ -60,7 +60,7 @@ where
     /// trial point whose slacks are $s + \alpha\thinspace\delta s$; `None` if not finite.
     /// The inequalities' values there are kept with $\alpha$ in the pool's `trial_values`
     /// (for [`Self::advance`]).
-    fn merit_parts(
+    pub(super) fn merit_parts(
         &self,
         iterate: &Iterate<N, X>,
         barrier: &Barrier,

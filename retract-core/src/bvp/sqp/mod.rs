@@ -49,6 +49,7 @@ use crate::{Lagrangian, LiftedSystem};
 mod at_solution;
 mod correction;
 mod direction;
+mod escape;
 mod feedback;
 mod filter;
 mod first_multipliers;
@@ -63,6 +64,10 @@ pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
 use state::{State, Subproblem};
 use termination::{Finished, barrier_floor};
+
+/// The end of a solve: the plan and whether it is certified (if not, the iterate of a
+/// real-time iteration at its iteration limit), or the failure.
+type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanError<N, X>>;
 
 /// The error below which a full step's factorisation is kept for a simplified Newton step
 /// at the next iterate.
@@ -136,14 +141,61 @@ where
     /// its own subproblem. Without stage constraints, a full step from an error below
     /// `CHORD_ERROR` keeps its factorisation for the next iterate's subproblem (a simplified
     /// Newton step, [`Self::subproblem`]); a point is never certified with a kept one.
+    /// Where the iteration ends at a saddle ([`Failure::NotAMinimum`] with negative
+    /// directions), it starts again from a point below it ([`Self::escape`]), cold, at most
+    /// [`super::PlanOptions::saddle_escapes`] times (not in a real-time iteration); the
+    /// plan's iterations count every start.
     pub(in crate::bvp) fn run(
         &self,
         iterate: Iterate<N, X>,
         warm: Option<&Duals<N>>,
     ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let (mut iterate, mut warm, mut before, mut escapes) = (iterate, warm, 0, 0);
+        loop {
+            let escaping = escapes < self.options.saddle_escapes && !self.real_time;
+            let (result, below) = self.run_once(iterate, warm, escaping);
+            let Some(next) = below else {
+                return Self::counting(result, before);
+            };
+            // the saddle's iterate goes back to the workspace, its iterations are counted
+            if let Err(PlanError {
+                last: Some(last), ..
+            }) = result
+            {
+                before += last.iterations;
+                self.give_plan(*last);
+            }
+            (iterate, warm) = (next, None);
+            escapes += 1;
+        }
+    }
+
+    /// `result` with `before` iterations of earlier starts added to its plan's.
+    fn counting(result: Solved<N, X>, before: usize) -> Solved<N, X> {
+        result
+            .map(|(mut plan, certified)| {
+                plan.iterations += before;
+                (plan, certified)
+            })
+            .map_err(|mut error| {
+                if let Some(last) = error.last.as_mut() {
+                    last.iterations += before;
+                }
+                error
+            })
+    }
+
+    /// One start of [`Self::run`] from `iterate`: its result and, if `escaping` and it ended
+    /// at a saddle, the point below it that [`Self::escape`] found (none if not `escaping`).
+    fn run_once(
+        &self,
+        iterate: Iterate<N, X>,
+        warm: Option<&Duals<N>>,
+        escaping: bool,
+    ) -> (Solved<N, X>, Option<Iterate<N, X>>) {
         let Some(barrier) = self.initial_barrier(&iterate, warm) else {
             self.give_iterate(iterate);
-            return Err(PlanError::without_iterate(Failure::NonFinite));
+            return (Err(PlanError::without_iterate(Failure::NonFinite)), None);
         };
         // (the stage equalities' multipliers: a warm start's if they fit and are finite, else
         // 0; a plan read back from a file may hold any numbers)
@@ -169,8 +221,13 @@ where
             self.first_barrier_test(&mut state);
         }
         let result = self.iterate_from(&mut state);
+        let saddle = |e: &PlanError<N, X>| matches!(e.failure, Failure::NotAMinimum { negative_directions } if negative_directions > 0);
+        let below = match &result {
+            Err(error) if escaping && saddle(error) => self.escape(&state),
+            _ => None,
+        };
         self.release(state);
-        result
+        (result, below)
     }
 
     /// IPOPT's test of the barrier error before the first step of a cold solve: $\mu$

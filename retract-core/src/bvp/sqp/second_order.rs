@@ -25,6 +25,12 @@ const FINSLER_WEIGHTS: [f64; 3] = [1e2, 1e4, 1e6];
 /// entry.
 const SEMIDEFINITE_SHIFT: f64 = 1e-13;
 
+/// A shift of the stage Hessians, relative to their largest entry, above the magnitude of
+/// any eigenvalue of the reduced Hessian (that is at most a few times $X + N$ times the
+/// largest entry): a negative count that remains under it does not come from curvature
+/// ([`Sqp::second_order`]).
+pub(super) const DECISIVE_SHIFT: f64 = 1e4;
+
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
 where
@@ -84,7 +90,7 @@ where
             // if a shift of the rounding's size makes it definite (a minimum, flat along some
             // direction: not strict); the negative directions that remain under the shift
             // are the ones counted
-            let shifted = self.shifted_factor(state, models);
+            let shifted = self.shifted_factor(state, models, SEMIDEFINITE_SHIFT);
             let (definite, negative) = (shifted.positive_definite(), shifted.negative);
             shifted.recycle(&mut *self.pool.borrow_mut());
             certificate.negative_directions = negative;
@@ -92,8 +98,15 @@ where
                 certificate.min_reduced_hessian_eig = 0.0;
                 return Ok(certificate);
             }
+            // a count that even the largest shift leaves is not curvature: the constraints'
+            // Jacobian loses rank there and the check cannot be made
+            let largest = self.shifted_factor(state, models, DECISIVE_SHIFT);
+            if !largest.positive_definite() {
+                certificate.negative_directions = 0;
+            }
+            largest.recycle(&mut *self.pool.borrow_mut());
             let failure = Failure::NotAMinimum {
-                negative_directions: negative,
+                negative_directions: certificate.negative_directions,
             };
             return Err((failure, certificate));
         }
@@ -106,19 +119,20 @@ where
     }
 
     /// The factorisation of the second-order check ([`Self::certify`]) with every stage
-    /// Hessian shifted by [`SEMIDEFINITE_SHIFT`] times the largest entry of the Lagrangian's
-    /// stage Hessians ($h$ at least): positive definite where the reduced Hessian is
-    /// positive semidefinite and singular, with the negative directions counted where it is
-    /// not.
+    /// Hessian shifted by `shift` times the largest entry of the Lagrangian's stage Hessians
+    /// ($h$ at least). With [`SEMIDEFINITE_SHIFT`]: positive definite where the reduced
+    /// Hessian is positive semidefinite and singular, with the negative directions counted
+    /// where it is not.
     pub(super) fn shifted_factor(
         &self,
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         models: &Models<N, X>,
+        shift: f64,
     ) -> Riccati<N, X> {
         if !state.2.s.is_empty() {
-            return self.penalized_factor(state, models, SEMIDEFINITE_SHIFT);
+            return self.penalized_factor(state, models, shift);
         }
-        let shift = SEMIDEFINITE_SHIFT * self.hessian_scale(&models.stages);
+        let shift = shift * self.hessian_scale(&models.stages);
         let pool = &mut *self.pool.borrow_mut();
         Riccati::factor_with(
             &self.dynamics,
