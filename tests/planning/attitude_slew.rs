@@ -223,3 +223,49 @@ fn a_planar_turn_about_the_largest_inertia_is_a_saddle_the_optimizer_leaves() {
     let gap = (plan.cost - escaped.cost).abs() / plan.cost;
     assert!(gap < 1e-5, "tilted {} escaped {}", plan.cost, escaped.cost);
 }
+
+/// The escape with inequalities (the barrier's slacks and the second-order check's penalties
+/// in play): with input bounds |u| <= 50 that stay inactive the saddle is left for the same
+/// minimum as without; with the bound |q_x| <= 0.3 on the chart, which the minimum would
+/// cross, for a certified minimum on the bound, above the unbounded one and below the saddle.
+#[test]
+fn the_saddle_is_left_with_inequalities_too() {
+    use retract::bvp::Variable;
+    let system = slew_body(&UnitQuaternion::identity());
+    let goal_turn = UnitQuaternion::from_scaled_axis(Vector3::z() * 120f64.to_radians());
+    let y = retract::so3::chart_point(&UnitQuaternion::identity(), &goal_turn).unwrap();
+    let goal = [y[0], y[1], y[2], 0.0, 0.0, 0.0];
+    let problem = gibbs_problem(&system, &[0.0; 6], &goal, 40);
+    let saddle = problem
+        .clone()
+        .with_options(PlanOptions::default().with_saddle_escapes(0))
+        .solve(PlanGuess::Spline)
+        .unwrap_err()
+        .last
+        .expect("the saddle")
+        .cost;
+    let free = problem.clone().solve(PlanGuess::Spline).unwrap();
+    let inputs = problem
+        .clone()
+        .with_bounds(Variable::Top(0), -50.0, 50.0)
+        .with_bounds(Variable::Top(1), -50.0, 50.0)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let chart = problem
+        .with_bounds(Variable::Jet(0), -0.3, 0.3)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    for plan in [&inputs, &chart] {
+        let c = &plan.certificate;
+        assert!(
+            c.negative_directions == 0 && c.min_reduced_hessian_eig > 0.0,
+            "{c:?}"
+        );
+        assert!(c.stationarity <= 1e-9 && c.feasibility <= 1e-9, "{c:?}");
+        assert!(plan.violations.imposed() <= 1e-9, "{:?}", plan.violations);
+    }
+    assert!((inputs.cost - free.cost).abs() < 1e-9 * free.cost);
+    let peak = chart.x.iter().fold(0.0_f64, |m, x| m.max(x[0].abs()));
+    assert!((peak - 0.3).abs() < 1e-6, "|q_x| peaks at {peak}");
+    assert!(free.cost < chart.cost && chart.cost < saddle);
+}
