@@ -154,7 +154,8 @@ impl core::fmt::Display for Failure {
             } => write!(
                 f,
                 "the KKT point found is not a minimum: its reduced Hessian has \
-                 {negative_directions} negative eigenvalue(s); start from another guess"
+                 {negative_directions} negative eigenvalue(s); start from another guess (or \
+                 allow more new starts from below a saddle: PlanOptions::saddle_escapes)"
             ),
         }
     }
