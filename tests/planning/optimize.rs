@@ -220,6 +220,31 @@ fn certificate_eigenvalue_with_free_ends_matches_a_dense_computation() {
     }
 }
 
+/// With N = k steps between fixed ends the constraints leave no direction (the plan is the one
+/// path that meets the ends): the certificate's smallest eigenvalue is the minimum over an
+/// empty set, +infinity, not the reciprocal of a rounding error; one step more and it is
+/// finite and matches a dense computation.
+#[test]
+fn certificate_eigenvalue_is_infinite_where_the_constraints_leave_no_direction() {
+    let system = DoublePendulum { g: 9.81 };
+    let plan = pendulum_problem(&system, 1.0, 2)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let c = &plan.certificate;
+    assert!(c.stationarity <= 1e-9 && c.feasibility <= 1e-9, "{c:?}");
+    assert_eq!(c.min_reduced_hessian_eig, f64::INFINITY, "{c:?}");
+    let plan = pendulum_problem(&system, 1.0, 3)
+        .solve(PlanGuess::Spline)
+        .unwrap();
+    let dense = dense_min_reduced_eigenvalue(&system, &plan);
+    let lanczos = plan.certificate.min_reduced_hessian_eig;
+    assert!(dense.is_finite() && dense > 0.0, "dense {dense:e}");
+    assert!(
+        (lanczos - dense).abs() < 1e-6 * dense.abs(),
+        "Lanczos {lanczos:e}, dense {dense:e}"
+    );
+}
+
 /// The root finder on the optimality conditions returns a stationary point of the T = 2
 /// swing-up with negative curvature; the optimizer descends from the same guess to a point of
 /// lower cost with a positive definite reduced Hessian, and refuses the root finder's point as

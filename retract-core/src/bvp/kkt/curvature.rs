@@ -14,18 +14,24 @@ use crate::bvp::dynamics::Dynamics;
 /// to the homogeneous constraints) is $Z (Z^T \nabla^2 J Z)^{-1} Z^T$, whose largest
 /// eigenvalue is the reciprocal of the one sought. The variables ([`Packing`]) are the free
 /// components of $x_0$ (`end`'s `start_fixed` 0), the interior nodes, the free components of
-/// $x_N$ (`fixed` 0) and the top derivatives. Lanczos stops when the Ritz residual of
+/// $x_N$ (`fixed` 0) and the top derivatives. $+\infty$ where the constraints (the scheme's
+/// $N X$ rows and the stages' `equalities` rows) leave no direction: the minimum over an
+/// empty set (e.g. $N = k$ steps between fixed ends, where the plan is the one path that
+/// meets the ends). Lanczos stops when the Ritz residual of
 /// the top Ritz value $\vartheta$ is below $10^{-3}\vartheta$ (the eigenvalue then has about
 /// six digits; 2 to 12 solves on the constrained suite and the swing-ups, less than one SQP
 /// iteration). NaN if the start vector vanishes.
 pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     riccati: &Riccati<N, X>,
     dynamics: &Dynamics<N, X>,
-    end: &Terminal<X>,
+    (end, equalities): (&Terminal<X>, usize),
     pool: &mut impl Vectors<N, X>,
 ) -> f64 {
     let packing = Packing::new(riccati.steps(), end);
     let dim = packing.dim::<N>();
+    if dim <= riccati.steps() * X + equalities {
+        return f64::INFINITY;
+    }
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector
     let mut seed = pool.lanczos().take(dim);

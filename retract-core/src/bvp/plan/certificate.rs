@@ -32,8 +32,10 @@ pub struct Certificate {
     /// check (a lower bound on the value on their null space too). Exactly 0 where the
     /// reduced Hessian is positive semidefinite and singular: a minimum, but not a strict one
     /// (the cost is flat to second order along some direction, e.g. ends that nothing fixes).
-    /// NaN if [`PlanOptions::min_eigenvalue`](crate::bvp::PlanOptions::min_eigenvalue) is off
-    /// (the inertia count proves positivity either way).
+    /// $+\infty$ where the constraints leave no direction (e.g. $N = k$ steps between fixed
+    /// ends: the plan is the one path that meets them). NaN if
+    /// [`PlanOptions::min_eigenvalue`](crate::bvp::PlanOptions::min_eigenvalue) is off (the
+    /// inertia count proves positivity either way).
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub min_reduced_hessian_eig: f64,
 }

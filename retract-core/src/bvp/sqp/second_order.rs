@@ -111,9 +111,10 @@ where
             return Err((failure, certificate));
         }
         if self.options.min_eigenvalue {
+            let rows = models.stages.iter().map(|s| s.constraints).sum();
             let pool = &mut *self.pool.borrow_mut();
             certificate.min_reduced_hessian_eig =
-                min_reduced_eigenvalue(exact, &self.dynamics, &models.terminal, pool);
+                min_reduced_eigenvalue(exact, &self.dynamics, (&models.terminal, rows), pool);
         }
         Ok(certificate)
     }
