@@ -162,12 +162,13 @@ fn a_warm_re_solve_in_a_workspace_allocates_nothing() {
     assert!(plan.violations.imposed() <= 1e-8 && (plan.x[0][0] - 0.04).abs() < 1e-12);
 }
 
-/// A solve interrupted by its budget while the models are built gives their vectors back to
-/// the workspace: after a zero budget at N = 1024 (the clock is read every 1024 steps of the
-/// build, so the budget runs out at its last step) and the interrupted iterate recycled, a
-/// warm re-solve allocates nothing.
+/// A failed solve gives the vectors it held back to the workspace: after a solve interrupted
+/// by a zero budget while the models are built (the clock is read every 1024 steps of the
+/// build, so the budget runs out at its last step) or one that ends at its iteration limit
+/// after one iteration from the spline (the models' and the subproblem's vectors), both at
+/// N = 1024, and the failed iterate recycled, a warm re-solve allocates nothing.
 #[test]
-fn a_solve_interrupted_in_the_models_keeps_the_workspace_whole() {
+fn a_failed_solve_keeps_the_workspace_whole() {
     use cart_pole::{CartForce, CartPole, PoleTorque};
     use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Workspace};
     use std::time::Duration;
@@ -177,65 +178,46 @@ fn a_solve_interrupted_in_the_models_keeps_the_workspace_whole() {
     let problem = OptimalControlProblem::new(&system, &[0.0; 4], &[0.5, 0.0, 0.0, 0.0], 2.0, 1024)
         .with_equality(&unactuated)
         .with_function_bounds(&force, -1.0, 1.0);
-    let mut workspace = Workspace::new();
-    let cold = problem
-        .solve_with(PlanGuess::Spline, &mut workspace)
-        .expect("cold");
-    let warm = problem
-        .solve_with(PlanGuess::Plan(&cold), &mut workspace)
-        .expect("warm");
-    workspace.recycle(cold);
-    let interrupted = problem
-        .clone()
-        .with_options(PlanOptions::default().with_max_time(Duration::ZERO))
-        .solve_with(PlanGuess::Plan(&warm), &mut workspace)
-        .expect_err("a zero budget");
-    assert_eq!(interrupted.failure, Failure::TimeLimit, "{interrupted}");
-    workspace.recycle(*interrupted.last.expect("the iterate"));
-    let before = allocations();
-    let again = problem
-        .solve_with(PlanGuess::Plan(&warm), &mut workspace)
-        .expect("warm again");
-    let count = allocations() - before;
-    assert_eq!(count, 0, "{count} allocations after the interrupted solve");
-    assert!(again.certificate.min_reduced_hessian_eig > 0.0);
-}
-
-/// A solve that ends at its iteration limit gives the models' and the subproblem's vectors
-/// back to the workspace: after one iteration from the spline (N = 1024) and the failed
-/// iterate recycled, a warm re-solve allocates nothing.
-#[test]
-fn a_solve_at_its_iteration_limit_keeps_the_workspace_whole() {
-    use cart_pole::{CartForce, CartPole, PoleTorque};
-    use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Workspace};
-    let system = CartPole::new(1.0, 0.3, 0.5);
-    let unactuated = PoleTorque::new(0.3, 0.5, 9.81);
-    let force = CartForce::new(1.0, 0.3, 0.5);
-    let problem = OptimalControlProblem::new(&system, &[0.0; 4], &[0.5, 0.0, 0.0, 0.0], 2.0, 1024)
-        .with_equality(&unactuated)
-        .with_function_bounds(&force, -1.0, 1.0);
-    let mut workspace = Workspace::new();
-    let cold = problem
-        .solve_with(PlanGuess::Spline, &mut workspace)
-        .expect("cold");
-    let warm = problem
-        .solve_with(PlanGuess::Plan(&cold), &mut workspace)
-        .expect("warm");
-    workspace.recycle(cold);
-    let stopped = problem
-        .clone()
-        .with_options(PlanOptions::default().with_max_iterations(1))
-        .solve_with(PlanGuess::Spline, &mut workspace)
-        .expect_err("one iteration from the spline");
-    assert_eq!(stopped.failure, Failure::IterationLimit, "{stopped}");
-    workspace.recycle(*stopped.last.expect("the iterate"));
-    let before = allocations();
-    let again = problem
-        .solve_with(PlanGuess::Plan(&warm), &mut workspace)
-        .expect("warm again");
-    let count = allocations() - before;
-    assert_eq!(count, 0, "{count} allocations after the failed solve");
-    assert!(again.certificate.min_reduced_hessian_eig > 0.0);
+    let failures = [
+        (
+            PlanOptions::default().with_max_time(Duration::ZERO),
+            Failure::TimeLimit,
+        ),
+        (
+            PlanOptions::default().with_max_iterations(1),
+            Failure::IterationLimit,
+        ),
+    ];
+    for (options, expected) in failures {
+        let mut workspace = Workspace::new();
+        let cold = problem
+            .solve_with(PlanGuess::Spline, &mut workspace)
+            .expect("cold");
+        let warm = problem
+            .solve_with(PlanGuess::Plan(&cold), &mut workspace)
+            .expect("warm");
+        workspace.recycle(cold);
+        // (the budget from the warm plan, the iteration limit from the spline: one iteration
+        // from the warm plan would converge)
+        let guess = match expected {
+            Failure::TimeLimit => PlanGuess::Plan(&warm),
+            _ => PlanGuess::Spline,
+        };
+        let failed = problem
+            .clone()
+            .with_options(options)
+            .solve_with(guess, &mut workspace)
+            .expect_err("a failure");
+        assert_eq!(failed.failure, expected, "{failed}");
+        workspace.recycle(*failed.last.expect("the iterate"));
+        let before = allocations();
+        let again = problem
+            .solve_with(PlanGuess::Plan(&warm), &mut workspace)
+            .expect("warm again");
+        let count = allocations() - before;
+        assert_eq!(count, 0, "{count} allocations after {expected:?}");
+        assert!(again.certificate.min_reduced_hessian_eig > 0.0);
+    }
 }
 
 // the double pendulum's receding-horizon controller, shared with the examples
