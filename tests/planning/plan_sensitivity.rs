@@ -163,9 +163,8 @@ fn the_one_disc_sensitivities_with_the_disc_active_match_central_differences() {
 
 /// The swing-up (T = 2, N = 40) with |q''| <= 22 on both joints, active on 6 steps: the
 /// derivative of the plan and its cost in gravity against central differences of solves at
-/// g = 9.81 +- 1e-4 (tolerance 1e-12, each from the spline: solves warm-started from the plan
-/// stop within the tolerance after 5 iterations at points whose differences carry a bias of
-/// 2e-4 in du/dg), to 1e-6 relative; the adjoint against the forward directions.
+/// g = 9.81 +- 1e-4 (tolerance 1e-12, each from the spline), to 1e-6 relative; the adjoint
+/// against the forward directions.
 #[test]
 fn the_bounded_swing_up_s_gravity_sensitivity_matches_central_differences() {
     let goal = [PI, 0.0, 0.0, 0.0];

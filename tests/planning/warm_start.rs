@@ -3,10 +3,10 @@
 //! start differs, converges to a certified plan of the new problem in no more iterations than
 //! a cold start from the spline.
 
-use retract::bvp::{OptimalControlProblem, Plan, PlanGuess};
+use retract::bvp::{OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 
 use crate::cart_pole::{CartForce, CartPole, PoleTorque};
-use crate::common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
+use crate::common::models::{DISC_GOAL, DISC_START, DoublePendulum, OneDisc, disc_bump_guess};
 
 /// A warm-started plan `warm` ends at the cold start's cost (to `relative` of it) in no more
 /// iterations.
@@ -27,16 +27,25 @@ pub fn assert_warm_matches_cold(warm: &Plan<2, 4>, cold: &Plan<2, 4>, relative: 
 
 const UPRIGHT: [f64; 4] = [0.0, std::f64::consts::PI, 0.0, 0.0];
 
+/// The double pendulum's upright rest.
+const UPRIGHT_PENDULUM: [f64; 4] = [std::f64::consts::PI, 0.0, 0.0, 0.0];
+
 /// The cart-pole swing-up (T = 2, N = 40) with |F| <= 12, from the cart at `x0`.
 fn solve_from(x0: f64, guess: PlanGuess<'_, 2, 4>) -> Plan<2, 4> {
+    solve_under(x0, guess, PlanOptions::default())
+}
+
+/// [`solve_from`] under `options`.
+fn solve_under(x0: f64, guess: PlanGuess<'_, 2, 4>, options: PlanOptions) -> Plan<2, 4> {
     let system = CartPole::new(1.0, 0.3, 0.5);
     let unactuated = PoleTorque::new(0.3, 0.5, 9.81);
     let force = CartForce::new(1.0, 0.3, 0.5);
     OptimalControlProblem::new(&system, &[x0, 0.0, 0.0, 0.0], &UPRIGHT, 2.0, 40)
         .with_equality(&unactuated)
         .with_function_bounds(&force, -12.0, 12.0)
+        .with_options(options)
         .solve(guess)
-        .unwrap_or_else(|e| panic!("from x0 = {x0}: {e}"))
+        .unwrap_or_else(|e| panic!("tolerance {:e}, x0 = {x0}: {e}", options.tolerance))
 }
 
 #[test]
@@ -100,4 +109,108 @@ fn a_plan_read_back_with_nan_multipliers_warm_starts_without_them() {
     let warm = solve_from(0.02, PlanGuess::Plan(&read));
     let cold = solve_from(0.02, PlanGuess::Spline);
     assert_warm_matches_cold(&warm, &cold, 1e-8, "NaN multiplier");
+}
+
+/// The largest difference between two plans' jets and controls.
+fn plan_distance(a: &Plan<2, 4>, b: &Plan<2, 4>) -> f64 {
+    let jets = a.x.iter().zip(&b.x).map(|(p, q)| (p - q).amax());
+    let controls = a.u.iter().zip(&b.u).map(|(p, q)| (p - q).amax());
+    jets.chain(controls).fold(0.0, f64::max)
+}
+
+/// A warm-started plan `warm` ends with its stationarity and feasibility below `tolerance`
+/// (not at the acceptable level), at the cold start's plan (to `distance`), in no more
+/// iterations.
+fn assert_converged_as_cold(
+    (warm, cold): (&Plan<2, 4>, &Plan<2, 4>),
+    (tolerance, distance): (f64, f64),
+    case: &str,
+) {
+    let c = &warm.certificate;
+    eprintln!(
+        "{case}: warm {} iterations, stationarity {:.1e}; cold {}, {:.1e}; distance {:.1e}",
+        warm.iterations,
+        c.stationarity,
+        cold.iterations,
+        cold.certificate.stationarity,
+        plan_distance(warm, cold)
+    );
+    assert!(
+        c.stationarity <= tolerance && c.feasibility <= tolerance,
+        "{case}: stationarity {:e}, feasibility {:e} (cold {:e})",
+        c.stationarity,
+        c.feasibility,
+        cold.certificate.stationarity
+    );
+    let apart = plan_distance(warm, cold);
+    assert!(
+        apart <= distance,
+        "{case}: warm and cold plans {apart:e} apart"
+    );
+    assert!(
+        warm.iterations <= cold.iterations,
+        "{case}: warm {} iterations, cold {}",
+        warm.iterations,
+        cold.iterations
+    );
+}
+
+/// Warm starts with active bounds converge to the tolerance, not at the acceptable level: the
+/// bounded cart-pole above (|F| <= 12 active on some steps), at the default tolerance and at
+/// 1e-12, re-solved from its own plan and from the plan of the start x0 = 0 at nearby starts,
+/// ends below the tolerance at the cold start's plan (to 1e-8 and 1e-10), in no more
+/// iterations.
+#[test]
+fn warm_starts_with_active_bounds_converge_to_the_tolerance() {
+    let default = PlanOptions::default().tolerance;
+    for tolerance in [default, 1e-12] {
+        let options = PlanOptions::default().with_tolerance(tolerance);
+        let solve = |x0: f64, guess| solve_under(x0, guess, options);
+        let first = solve(0.0, PlanGuess::Spline);
+        let bound = first.duals.step_multipliers.iter().filter(|z| **z > 1e-3);
+        assert!(bound.count() > 0, "the force bound is active at some steps");
+        for x0 in [0.0, 0.02, 0.1, -0.1] {
+            let cold = solve(x0, PlanGuess::Spline);
+            let warm = solve(x0, PlanGuess::Plan(&first));
+            let case = format!("cart-pole, tolerance {tolerance:e}, x0 = {x0}");
+            assert_converged_as_cold(
+                (&warm, &cold),
+                (tolerance, 1e3 * tolerance.max(1e-11)),
+                &case,
+            );
+        }
+    }
+}
+
+/// The swing-up (T = 2, N = 40) with |q''| <= 22 on both joints (active on some steps), at
+/// the default tolerance and at 1e-12: re-solved with gravity moved by 1e-4 and 1e-2 from the
+/// plan at g = 9.81, it ends below the tolerance at the cold start's plan (to 1e-8 and
+/// 1e-10), in no more iterations.
+#[test]
+fn a_bounded_swing_up_warm_starts_to_the_tolerance() {
+    let default = PlanOptions::default().tolerance;
+    for tolerance in [default, 1e-12] {
+        let options = PlanOptions::default().with_tolerance(tolerance);
+        let solve = |g: f64, guess| {
+            let system = DoublePendulum { g };
+            OptimalControlProblem::new(&system, &[0.0; 4], &UPRIGHT_PENDULUM, 2.0, 40)
+                .with_input_bounds([-22.0; 2], [22.0; 2])
+                .with_options(options)
+                .solve(guess)
+                .unwrap_or_else(|e| panic!("tolerance {tolerance:e}, g = {g}: {e}"))
+        };
+        let first = solve(9.81, PlanGuess::Spline);
+        let bound = first.duals.step_multipliers.iter().filter(|z| **z > 1e-3);
+        assert!(bound.count() > 0, "the input bound is active at some steps");
+        for g in [9.81, 9.81 + 1e-4, 9.81 - 1e-4, 9.81 + 1e-2] {
+            let cold = solve(g, PlanGuess::Spline);
+            let warm = solve(g, PlanGuess::Plan(&first));
+            let case = format!("swing-up, tolerance {tolerance:e}, g = {g}");
+            assert_converged_as_cold(
+                (&warm, &cold),
+                (tolerance, 1e3 * tolerance.max(1e-11)),
+                &case,
+            );
+        }
+    }
 }

@@ -27,8 +27,13 @@ use super::constraints::Linearized;
 use super::kkt::model::StageModel;
 use super::kkt::riccati::Direction;
 
-/// The smallest slack of a warm start ([`Barrier::warm`]).
-pub(super) const WARM_SLACK_PUSH: f64 = 1e-3;
+/// The smallest slack of a warm start where the iterate has moved its inequality by more
+/// than this ([`Barrier::warm_pair`]).
+const WARM_SLACK_PUSH: f64 = 1e-3;
+
+/// The largest ratio between a warm start's $z s$ and its $\mu$, either way, where the
+/// iterate is the plan's point ([`Barrier::warm_pair`]).
+const WARM_CENTRE: f64 = 1e2;
 
 /// IPOPT's $\kappa_\Sigma$: the multipliers are kept in $[\mu / (\kappa_\Sigma s),
 /// \kappa_\Sigma \mu / s]$.
@@ -104,26 +109,29 @@ impl Barrier {
     }
 
     /// The barrier of a primal-dual warm start from `duals` (which fit the layout `(count,
-    /// nodes, steps)`): their multipliers, their slacks raised to at least
-    /// [`WARM_SLACK_PUSH`] (IPOPT's `warm_start_bound_push`: a slack at the rounding of an
-    /// active constraint would cap every step that moves it at the fraction to the
-    /// boundary), and their barrier parameter, at least `floor`: a plan's is at its floor, so
-    /// the barrier is not restarted from $\mu_0$ (which would first undo the plan's
-    /// complementarity), and an unfinished plan's (a real-time iteration's) goes on from
-    /// where it was.
+    /// nodes, steps)`) at an iterate where the inequalities take `values`, pair by pair
+    /// ([`Self::warm_pair`]), and the plan's barrier parameter $\mu$ = `duals.barrier`, at
+    /// least `floor`: a plan's is at its floor, so the barrier is not restarted from $\mu_0$
+    /// (which would first undo the plan's complementarity), and an unfinished plan's (a
+    /// real-time iteration's) goes on from where it was.
     pub fn warm<const N: usize>(
         duals: &super::plan::duals::Duals<N>,
         (count, nodes, steps): (usize, usize, usize),
-        floor: f64,
+        (floor, values): (f64, &[f64]),
         [mut s, mut z, mut y]: [Vec<f64>; 3],
     ) -> Self {
-        s.extend(
-            (duals.step_slacks.iter().chain(&duals.node_slacks)).map(|s| s.max(WARM_SLACK_PUSH)),
-        );
-        z.extend(duals.step_multipliers.iter().chain(&duals.node_multipliers));
+        let mu = duals.barrier.max(floor);
+        let slacks = duals.step_slacks.iter().chain(&duals.node_slacks);
+        let multipliers = duals.step_multipliers.iter().chain(&duals.node_multipliers);
+        let pairs = || {
+            (slacks.clone().zip(multipliers.clone()).zip(values))
+                .map(|((s, z), g)| Self::warm_pair((*s, *z), *g, mu))
+        };
+        s.extend(pairs().map(|(s, _)| s));
+        z.extend(pairs().map(|(_, z)| z));
         y.extend_from_slice(&z);
         Self {
-            mu: duals.barrier.max(floor),
+            mu,
             s,
             y,
             z,
@@ -131,6 +139,30 @@ impl Barrier {
             nodes,
             steps,
         }
+    }
+
+    /// A plan's slack and multiplier $(s, z)$ for a warm start at an iterate where their
+    /// inequality takes the value `g`, under the barrier parameter `mu`:
+    /// - where the iterate is the plan's point for this inequality, $|g - s| \le p$ =
+    ///   [`WARM_SLACK_PUSH`] (the plan of a nearby problem, or the plan itself), the pair as
+    ///   it is, complementary at the plan's $\mu$, except that a slack below [`SLACK_RESET`]
+    ///   times $g > 0$ is $s = g$ (as [`Self::reset_slacks`]) and a multiplier whose product
+    ///   $z s$ is more than $c$ = [`WARM_CENTRE`] from $\mu$ either way is moved to that
+    ///   bound, $z \in [\mu / (c s), c \mu / s]$ (IPOPT's recentring towards its
+    ///   `warm_start_target_mu`). An active slack is not pushed away from 0: pushed to $p$,
+    ///   its pair starts at $z p \gg \mu$, the first steps collapse the slack again, $z / s$
+    ///   reaches $10^{12}$ and more, and the residuals stall at the rounding of the barrier
+    ///   Hessian above a tight tolerance;
+    /// - where the iterate has moved the inequality by more than $p$ (a plan stretched to
+    ///   another horizon), the plan's slack says little of it: $(\max(s, p), z)$ (IPOPT's
+    ///   `warm_start_bound_push`), so that a step that moves it is not capped at the
+    ///   fraction to the boundary of a slack at the rounding of an active constraint.
+    fn warm_pair((s, z): (f64, f64), g: f64, mu: f64) -> (f64, f64) {
+        if (g - s).abs() > WARM_SLACK_PUSH {
+            return (s.max(WARM_SLACK_PUSH), z);
+        }
+        let s = if s < SLACK_RESET * g { g } else { s };
+        (s, z.clamp(mu / (WARM_CENTRE * s), WARM_CENTRE * mu / s))
     }
 
     /// The barrier of a plan as it ended, for its sensitivities: the plan's `duals` (which

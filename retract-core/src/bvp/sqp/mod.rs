@@ -100,7 +100,7 @@ where
             None
         } else if let Some(duals) = warm.filter(fits) {
             let floor = barrier_floor(self.options.tolerance);
-            Some(Barrier::warm(duals, layout, floor, vectors))
+            Some(Barrier::warm(duals, layout, (floor, &values), vectors))
         } else {
             Some(self.cold_barrier(&values, layout, vectors))
         };
