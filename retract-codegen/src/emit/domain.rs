@@ -63,6 +63,7 @@ pub(crate) fn check_domain(e: &Emission<'_>) -> Option<TokenStream> {
     Some(quote! {
         #guards_quadratic
         #[doc = #doc]
+        #[inline(always)]
         fn check_domain(
             &self,
             z0: &#vec_s,

@@ -52,8 +52,8 @@
 //! momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
 //! A step returns a finite state or an error: $w$ is finite when
-//! $\sum_j |z_{0,j}| + \sum_q |n_q|$ is below [`ReducedFactors::finite_below`], and is checked
-//! entry by entry otherwise.
+//! $\sum_j |z_{0,j}| + \sum_q |n_q|$ is below [`ReducedFactors::finite_below`], and the state
+//! (its first $S$ entries) is checked entry by entry otherwise.
 
 mod blocks;
 
@@ -739,7 +739,12 @@ where
         } else {
             system.recover_plain(factors, z0, &forcing)
         };
-        if !(state_size + forcing_size < factors.finite_below || all_finite(&w)) {
+        // the state: the first S unknowns (an array built in place; nalgebra's `into_owned`
+        // of a slice copies through an iterator, out of line). Only it is returned, so only it
+        // is checked: the other unknowns (the top derivative) are left to the domain check,
+        // and where it does not read them they are not computed at all
+        let z1: SVector<f64, S> = SVector::from(core::array::from_fn(|i| w[i]));
+        if !(state_size + forcing_size < factors.finite_below || all_finite(&z1)) {
             return Err(if all_finite(z0) {
                 Error::NonFinite {
                     iteration: solution.iterations,
@@ -754,7 +759,7 @@ where
                 .map_err(Error::Domain)?;
         }
         Ok((
-            w.fixed_rows::<S>(0).into_owned(),
+            z1,
             StepReport {
                 iterations: solution.iterations,
                 residual_norm: solution.residual_norm,

@@ -257,7 +257,7 @@ pub const MAX_CHORD_PIECES: u32 = 1024;
 ///
 /// # Errors
 /// The first violated condition.
-#[inline]
+#[inline(always)]
 pub fn check_step_domain<Sys, const S: usize, const M: usize>(
     system: &Sys,
     z0: &SVector<f64, S>,
