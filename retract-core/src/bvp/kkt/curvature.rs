@@ -35,7 +35,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     // a start vector in the null space: the operator applied to a fixed pseudo-random vector
     let mut seed = pool.lanczos().take(dim);
-    seed.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
+    seed.extend(start_vector(dim));
     let mut q = pool.lanczos().take(dim);
     apply_inverse(riccati, dynamics, &packing, &seed, &mut q, pool);
     let (mut q_prev, mut w) = (seed, pool.lanczos().take(dim));
@@ -100,7 +100,7 @@ pub(crate) fn most_negative_direction<const N: usize, const X: usize>(
     let packing = Packing::new(steps, end);
     let dim = packing.dim::<N>();
     let mut v = pool.lanczos().take(dim);
-    v.extend((0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5));
+    v.extend(start_vector(dim));
     let mut w = pool.lanczos().take(dim);
     let mut found = true;
     for _ in 0..POWER_STEPS {
@@ -129,6 +129,13 @@ pub(crate) fn most_negative_direction<const N: usize, const X: usize>(
     pool.lanczos().give(v);
     pool.lanczos().give(w);
     found
+}
+
+/// The fixed pseudo-random start vector of the iterations here: entry $j$ is
+/// $\mathrm{frac}((j + 1)\varphi) - \tfrac12$, $\varphi$ the golden ratio's fractional part
+/// (equidistributed, so no direction of the operator is missed in practice).
+fn start_vector(dim: usize) -> impl Iterator<Item = f64> {
+    (0..dim).map(|j| ((j as f64 + 1.0) * 0.618_033_988_749_895).fract() - 0.5)
 }
 
 /// The most Lanczos steps of [`min_reduced_eigenvalue`].
