@@ -154,3 +154,21 @@ impl Noise {
         (self.0 % 2_000_001) as f64 / 1e6 - 1.0
     }
 }
+
+/// Asserts that `plan` is certified as a strict local minimum at the default tolerance: no
+/// negative direction, a positive smallest reduced-Hessian eigenvalue, stationarity and
+/// feasibility at most $10^{-9}$.
+pub fn assert_strict_minimum<const N: usize, const X: usize>(
+    plan: &retract::bvp::Plan<N, X>,
+    case: &str,
+) {
+    let c = &plan.certificate;
+    assert!(
+        c.negative_directions == 0 && c.min_reduced_hessian_eig > 0.0,
+        "{case}: {c:?}"
+    );
+    assert!(
+        c.stationarity <= 1e-9 && c.feasibility <= 1e-9,
+        "{case}: {c:?}"
+    );
+}

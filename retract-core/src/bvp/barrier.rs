@@ -123,12 +123,11 @@ impl Barrier {
         let mu = duals.barrier.max(floor);
         let slacks = duals.step_slacks.iter().chain(&duals.node_slacks);
         let multipliers = duals.step_multipliers.iter().chain(&duals.node_multipliers);
-        let pairs = || {
-            (slacks.clone().zip(multipliers.clone()).zip(values))
-                .map(|((s, z), g)| Self::warm_pair((*s, *z), *g, mu))
-        };
-        s.extend(pairs().map(|(s, _)| s));
-        z.extend(pairs().map(|(_, z)| z));
+        for ((sk, zk), g) in slacks.zip(multipliers).zip(values) {
+            let (sk, zk) = Self::warm_pair((*sk, *zk), *g, mu);
+            s.push(sk);
+            z.push(zk);
+        }
         y.extend_from_slice(&z);
         Self {
             mu,

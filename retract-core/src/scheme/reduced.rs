@@ -48,9 +48,9 @@
 //! enter the one rounding of the entry (added after it, a correction below the last bit would
 //! be lost). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
 //! stays within $2.1 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$); the
-//! corrections cost 18 to 20 ns a step on the obstacle system (with fat LTO). Each entry summed fully
-//! compensated (Dot2 of Ogita, Rump and Oishi: every product and addition error-free) kept the
-//! momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
+//! corrections cost 18 to 20 ns a step on the obstacle system (with fat LTO). Each entry
+//! summed fully compensated (Dot2 of Ogita, Rump and Oishi: every product and addition
+//! error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
 //! A step returns a finite state or an error: $w$ is finite when
 //! $\sum_j |z_{0,j}| + \sum_q |n_q|$ is below [`ReducedFactors::finite_below`], and the state
