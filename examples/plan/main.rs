@@ -24,8 +24,9 @@
 //!
 //! The first guess is the cubic Hermite path between the boundary data, pushed around every
 //! disc it would cross: away from the centre, or, for a disc centred on the path, to the left
-//! of the direction of travel (a deterministic choice). The solver never returns a path
-//! through a disc.
+//! of the direction of travel (a deterministic choice). The optimizer solves the barrier
+//! weights in turn, each warm-started from the plan of the last, and returns only certified
+//! local minima; its line search never steps into a disc, where the barrier has its pole.
 //!
 //! Run: `cargo run --release --example plan [scene.toml] [figure.svg]`
 //! (defaults: `examples/scenes/slalom.toml`, `docs/plan.svg`).
@@ -38,9 +39,9 @@ use std::error::Error;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use retract::bvp::{BvpOptions, ClearanceFn, Curve, Guess, continuation};
+use retract::bvp::{Curve, OptimalControlProblem, Plan, PlanGuess};
 use retract::higher_order_lagrangian;
-use retract::nalgebra::{SVector, Vector2};
+use retract::nalgebra::Vector2;
 use retract::plot;
 use scene::Scene;
 
@@ -131,22 +132,8 @@ fn run() -> Result<(), Box<dyn Error>> {
         .iter()
         .map(|o| [o.centre[0], o.centre[1], o.radius])
         .collect();
-    let clearance = |z: &SVector<f64, 12>, out: &mut [f64]| {
-        for (d, c) in discs.iter().zip(out.iter_mut()) {
-            *c = (z[0] - d[0]).hypot(z[1] - d[1]) - d[2];
-        }
-    };
-    let clearance: ClearanceFn<'_, 12> = &clearance;
     let (start, goal) = (scene.start.jet(), scene.goal.jet());
-    // z_i = Leg(q, q', q'', q''')(t_i) of the guessed path, derivatives by central differences
-    let guess = Curve::from_fn(guess_path(&scene)).states(
-        &PlanarBody {
-            tau: scene.barrier,
-            obstacles: &discs,
-        },
-        scene.horizon,
-        scene.steps,
-    )?;
+    let guess = Curve::from_fn(guess_path(&scene));
     let weights: Vec<f64> = scene
         .continuation
         .iter()
@@ -154,22 +141,23 @@ fn run() -> Result<(), Box<dyn Error>> {
         .chain([scene.barrier])
         .collect();
 
+    // each barrier weight warm-started from the plan of the last, the first from the guess
     let started = Instant::now();
-    let solution = continuation(
-        |tau| PlanarBody {
+    let mut plan: Option<Plan<3, 6>> = None;
+    for &tau in &weights {
+        let system = PlanarBody {
             tau,
             obstacles: &discs,
-        },
-        &weights,
-        &start,
-        &goal,
-        scene.horizon,
-        scene.steps,
-        BvpOptions::default(),
-        Some((discs.len(), clearance)),
-        Guess::States(&guess),
-    )?;
+        };
+        let problem =
+            OptimalControlProblem::new(&system, &start, &goal, scene.horizon, scene.steps);
+        let guess = plan
+            .as_ref()
+            .map_or(PlanGuess::Curve(&guess), PlanGuess::Plan);
+        plan = Some(problem.solve(guess).map_err(|e| e.to_string())?);
+    }
     let elapsed = started.elapsed();
+    let plan = plan.ok_or("no barrier weight")?;
 
     println!("scene: {}", scene_path.display());
     println!(
@@ -179,19 +167,34 @@ fn run() -> Result<(), Box<dyn Error>> {
         weights,
         discs.len()
     );
-    println!("cost J = {:.6}", solution.cost);
-    for (j, c) in solution.clearance.iter().enumerate() {
-        println!("min clearance to obstacle {j}: {c:.4}");
+    println!("cost J = {:.6}", plan.cost);
+    for (j, d) in discs.iter().enumerate() {
+        let clearance = plan
+            .x
+            .iter()
+            .map(|x| (x[0] - d[0]).hypot(x[1] - d[1]) - d[2])
+            .fold(f64::INFINITY, f64::min);
+        println!("min clearance to obstacle {j} (at the nodes): {clearance:.4}");
     }
+    let certificate = &plan.certificate;
     println!(
-        "Newton iterations (last solve): {}, final residual {:.1e}, total solve time {elapsed:.1?}",
-        solution.iterations, solution.residual_norm
+        "iterations (last solve): {}, stationarity {:.1e}, smallest reduced-Hessian eigenvalue \
+         {:.2e}, total solve time {elapsed:.1?}",
+        plan.iterations, certificate.stationarity, certificate.min_reduced_hessian_eig
     );
     let path = plot::Curve::new(
         "optimal path",
-        solution.states.iter().map(|z| (z[0], z[1])).collect(),
+        plan.x.iter().map(|x| (x[0], x[1])).collect(),
     );
-    let first = plot::Curve::new("first guess", guess.iter().map(|z| (z[0], z[1])).collect());
+    let times = plan.times();
+    let path_of_guess = guess_path(&scene);
+    let first = plot::Curve::new(
+        "first guess",
+        times
+            .iter()
+            .map(|&t| (path_of_guess(t)[0], path_of_guess(t)[1]))
+            .collect(),
+    );
     let circles: Vec<(f64, f64, f64)> = discs.iter().map(|d| (d[0], d[1], d[2])).collect();
     plot::plane(
         &figure,

@@ -241,7 +241,7 @@ pub enum Error {
         requirement: &'static str,
     },
     /// The Newton iteration of a boundary-value problem
-    /// ([`BoundaryValueProblem`](crate::bvp::BoundaryValueProblem)) reached its iteration
+    /// ([`BoundaryValueProblem`](crate::bvp::root_finder::BoundaryValueProblem)) reached its iteration
     /// cap; `residual_norm` is max|R| at the last iterate.
     BoundaryValueNoConvergence {
         /// Newton iterations performed.
@@ -250,7 +250,7 @@ pub enum Error {
         residual_norm: f64,
     },
     /// Backtracking could not decrease |R|^2 along the Newton direction of a boundary-value
-    /// problem ([`BoundaryValueProblem`](crate::bvp::BoundaryValueProblem)).
+    /// problem ([`BoundaryValueProblem`](crate::bvp::root_finder::BoundaryValueProblem)).
     BoundaryValueLineSearchFailed {
         /// Newton iteration whose line search failed.
         iteration: usize,
@@ -533,7 +533,7 @@ impl Error {
                  iterations (last residual max-norm {residual_norm:e}): raise \
                  BvpOptions::max_iterations, or start from a better guess (Guess::States along \
                  the expected path, or a warm start from an easier problem with \
-                 bvp::continuation)"
+                 bvp::root_finder::continuation)"
             ),
             Error::BoundaryValueLineSearchFailed {
                 iteration,
@@ -544,7 +544,7 @@ impl Error {
                  (residual max-norm {residual_norm:e}): no step along the Newton direction \
                  decreases the residual of the whole discrete trajectory; start from a better \
                  guess (Guess::States along the expected path, or a warm start from an easier \
-                 problem with bvp::continuation, e.g. a larger barrier weight), or use the \
+                 problem with bvp::root_finder::continuation, e.g. a larger barrier weight), or use the \
                  optimizer (OptimalControlProblem), whose line search follows the cost"
             ),
             Error::BoundariesSeparated {

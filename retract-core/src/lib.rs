@@ -55,7 +55,7 @@
 //! diagnostics and everything generated code needs; math goes through `libm`.
 //!
 //! `serde` (off by default): `Serialize` and `Deserialize` for the results and options
-//! ([`Trajectory`], [`StepReport`], [`bvp::Plan`], [`bvp::Certificate`], [`BvpSolution`],
+//! ([`Trajectory`], [`StepReport`], [`bvp::Plan`], [`bvp::Certificate`], [`bvp::root_finder::BvpSolution`],
 //! [`State`], [`Jet`], [`manifold::sphere::SphereState`], the option structs), `Serialize` for the
 //! errors ([`Error`], [`bvp::PlanError`], [`Interrupted`]). Vectors are lists of numbers
 //! (nalgebra's `serde-serialize-no-std`); it builds without std too.
@@ -120,9 +120,7 @@ pub mod __private {
     pub use crate::{DomainKind, DomainViolation, Error, Float, nalgebra};
 }
 
-// the optimizer at the root, beside the legacy root finder (both live in `bvp`)
-#[cfg(feature = "std")]
-pub use bvp::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
+// the optimizer at the root (the legacy root finder stays in `bvp::root_finder`)
 #[cfg(feature = "std")]
 pub use bvp::{
     OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, PlanOptions, Variable,

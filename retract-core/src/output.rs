@@ -38,8 +38,9 @@ use std::io::{self, Write};
 
 use nalgebra::SVector;
 
+use crate::Trajectory;
 use crate::bvp::Plan;
-use crate::{BvpSolution, Trajectory};
+use crate::bvp::root_finder::BvpSolution;
 
 /// The names of the $2nk$ state columns $z = (x, p)$ of a system on $\mathbb{R}^n$ of order
 /// $k$: `q_c`, then `d{j}q_c` for $j = 1, \dots, k-1$, then `p{j}_c` for $j = 0, \dots, k-1$,

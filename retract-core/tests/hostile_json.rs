@@ -8,10 +8,8 @@
 use serde_json::{Value, json};
 
 use retract_core::Error;
-use retract_core::bvp::{
-    BoundaryValueProblem, BvpOptions, BvpSolution, Failure, Guess, OptimalControlProblem,
-    PlanGuess, PlanOptions, Variable,
-};
+use retract_core::bvp::root_finder::{BoundaryValueProblem, BvpOptions, BvpSolution, Guess};
+use retract_core::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Variable};
 use retract_core::models::PlanarBarrier;
 
 type Edit = fn(&mut Value);

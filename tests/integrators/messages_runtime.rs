@@ -5,10 +5,8 @@
 use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
-use retract::bvp::{
-    BoundaryValueProblem, BvpOptions, ClearanceFn, Failure, Guess, OptimalControlProblem,
-    PlanGuess, PlanOptions,
-};
+use retract::bvp::root_finder::{BoundaryValueProblem, BvpOptions, ClearanceFn, Guess};
+use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions};
 use retract::higher_order_lagrangian;
 use retract::nalgebra::SVector;
 use retract::{DomainKind, Error, LiftedSystem, ReducedStepper, StepOptions, trajectory};

@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::models::RigidBody;
-use retract::bvp::{BoundaryValueProblem, BvpOptions, Guess};
+use retract::bvp::root_finder::{BoundaryValueProblem, BvpOptions, Guess};
 use retract::nalgebra::SVector;
 use retract::reduced::CACHE_SIZE;
 use retract::{Error, LiftedSystem, ReducedStepper, StepOptions, step, trajectory};

@@ -6,7 +6,7 @@ use crate::common;
 
 use common::largest_gap;
 use common::models::Scene;
-use retract::bvp::{
+use retract::bvp::root_finder::{
     BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver, continuation,
 };
 use retract::higher_order_lagrangian;

@@ -8,9 +8,8 @@ use common::models::{DISC_GOAL, DISC_START, DoublePendulum, OneDisc, disc_bump_g
 
 use std::f64::consts::PI;
 
-use retract::bvp::{
-    BoundaryValueProblem, Failure, OptimalControlProblem, Plan, PlanGuess, PlanOptions,
-};
+use retract::bvp::root_finder::BoundaryValueProblem;
+use retract::bvp::{Failure, OptimalControlProblem, Plan, PlanGuess, PlanOptions};
 use retract::nalgebra::{DMatrix, SVector};
 use retract::{JetFunction, Lagrangian, LiftedSystem, higher_order_lagrangian, jet_function};
 
@@ -61,7 +60,7 @@ fn plan_satisfies_the_lifted_scheme() {
     // the root finder, started from these states, stays at this point
     let states: Vec<_> = (0..=400).map(|i| plan_state(&plan, i)).collect();
     let root = BoundaryValueProblem::new(&system, &DISC_START, &DISC_GOAL, 4.0, 400)
-        .solve(retract::bvp::Guess::States(&states))
+        .solve(retract::bvp::root_finder::Guess::States(&states))
         .unwrap();
     for i in 0..=400 {
         assert!(
@@ -254,7 +253,7 @@ fn the_optimizer_descends_where_the_root_finder_stops_at_a_saddle() {
     let system = DoublePendulum { g: 9.81 };
     let goal = [PI, 0.0, 0.0, 0.0];
     let root = BoundaryValueProblem::new(&system, &[0.0; 4], &goal, 2.0, 200)
-        .solve(retract::bvp::Guess::Spline)
+        .solve(retract::bvp::root_finder::Guess::Spline)
         .unwrap();
     let plan = pendulum_problem(&system, 2.0, 200)
         .solve(PlanGuess::Spline)
@@ -629,7 +628,7 @@ fn public_problem_and_solution_types_are_send_and_sync() {
     send_sync::<Plan<2, 4>>();
     send_sync::<retract::bvp::PlanError<2, 4>>();
     send_sync::<BoundaryValueProblem<'_, OneDisc, 8, 10>>();
-    send_sync::<retract::BvpSolution<8, 10>>();
+    send_sync::<retract::bvp::root_finder::BvpSolution<8, 10>>();
     send_sync::<retract::Trajectory<8>>();
     send_sync::<retract::Interrupted<8>>();
     // a Lagrangian without parameters is a unit struct, a value by its name alone

@@ -6,9 +6,8 @@ use crate::common;
 
 use common::models::{DISC_GOAL, DISC_START, OneDisc, disc_bump_guess};
 
-use retract::bvp::{
-    BoundaryValueProblem, Certificate, Curve, Guess, OptimalControlProblem, Plan, PlanGuess,
-};
+use retract::bvp::root_finder::{BoundaryValueProblem, Guess};
+use retract::bvp::{Certificate, Curve, OptimalControlProblem, Plan, PlanGuess};
 use retract::nalgebra::SVector;
 use retract::{Error, Jet, State, StepOptions, higher_order_lagrangian, trajectory};
 

@@ -22,10 +22,10 @@ use std::hint::black_box;
 use std::io::Write;
 use std::time::Instant;
 
-use retract::bvp::{
-    BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver, OptimalControlProblem,
-    Plan, PlanError, PlanGuess, PlanOptions,
+use retract::bvp::root_finder::{
+    BoundaryValueProblem, BvpOptions, BvpSolution, Guess, LinearSolver,
 };
+use retract::bvp::{OptimalControlProblem, Plan, PlanError, PlanGuess, PlanOptions};
 use retract::nalgebra::SVector;
 use retract::{Lagrangian, LiftedSystem, ReducedScheme};
 

@@ -10,7 +10,7 @@ use crate::{Error, Lagrangian, LiftedSystem};
 /// library forms the jets $(q, \dots, q^{(2k-1)})(t_i)$ at the nodes $t_i = i h$, the top
 /// derivatives $u_i = q^{(k)}((i + \theta) h)$ for the optimizer ([`super::PlanGuess::Curve`])
 /// and the momenta by the Legendre map for the root finder ([`Self::states`], for
-/// [`super::Guess::States`]).
+/// [`super::root_finder::Guess::States`]).
 ///
 /// Three ways to give it:
 /// - [`Self::from_fn`]: $q(t)$ alone; derivatives by central differences,
@@ -163,7 +163,7 @@ impl<'a, const N: usize> Curve<'a, N> {
 
     /// The states $z_i = \mathrm{Leg}((q, \dots, q^{(2k-1)})(t_i))$ at $t_i = i T / N$,
     /// $i = 0, \dots, N$ (`t_end` $= T$, `steps` $= N$): the first guess
-    /// [`super::Guess::States`] of the root finder.
+    /// [`super::root_finder::Guess::States`] of the root finder.
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] for `t_end` not finite and positive, no steps, more states

@@ -13,8 +13,11 @@
 //!   correction, IPOPT's filter line search, stage equalities and interior-point
 //!   inequalities) and returns only certified local minima ([`Plan`], [`Certificate`]); every
 //!   failure carries the last iterate ([`PlanError`]).
-//! - [`BoundaryValueProblem`] solves the same conditions by Newton's method on their residual
-//!   (`root_finder`): fast where the answer is known to be a minimum, but blind to the cost.
+//! - [`root_finder`], the legacy root finder, kept as a cross-check of the optimizer and
+//!   behind it: [`root_finder::BoundaryValueProblem`] solves the same conditions by Newton's
+//!   method on their residual, blind to the cost (it can stop at a saddle). Everything a plan
+//!   needs (guesses, options, results, warm starts, continuation in a parameter by warm
+//!   starts) is the optimizer's; the root finder's types live in its module only.
 //!
 //! # Modules
 //! In dependency order: a module imports only modules listed before it, so there is no
@@ -147,8 +150,4 @@ pub use realtime::{Feedback, Preparation, RealTimeIteration};
 pub use sensitivity::{Parameter, ParameterSensitivity, Sensitivity};
 pub use workspace::Workspace;
 
-mod root_finder;
-
-pub use root_finder::{
-    BoundaryValueProblem, BvpOptions, BvpSolution, ClearanceFn, Guess, LinearSolver, continuation,
-};
+pub mod root_finder;

@@ -1,4 +1,7 @@
-//! The root finder: Newton's method on the discrete necessary conditions.
+//! The legacy root finder: Newton's method on the discrete necessary conditions, kept as a
+//! cross-check of the optimizer ([`super::OptimalControlProblem`], the planner's one front:
+//! its [`super::PlanGuess`], [`super::PlanOptions`] and [`super::Plan`] are the vocabulary of
+//! planning; the types here are the root finder's own and are not re-exported).
 //!
 //! Given the jet $x = (q, \dots, q^{(k-1)})$ at both ends, $x(0) = a$ and $x(T) = b$, and
 //! $N$ steps of $h = T/N$, the unknowns are the whole discrete trajectory

@@ -1308,12 +1308,12 @@ mod hostile_json {
             "{json}"
         );
         assert_eq!((read.theta, read.tolerance), (plan.theta, plan.tolerance));
-        let bvp = crate::bvp::BvpOptions {
+        let bvp = crate::bvp::root_finder::BvpOptions {
             residual_tolerance: f64::NEG_INFINITY,
             ..Default::default()
         };
         let json = serde_json::to_string(&bvp).unwrap();
-        let read: crate::bvp::BvpOptions = serde_json::from_str(&json).unwrap();
+        let read: crate::bvp::root_finder::BvpOptions = serde_json::from_str(&json).unwrap();
         assert_eq!(read, bvp, "{json}");
     }
 
