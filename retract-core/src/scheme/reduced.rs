@@ -133,6 +133,20 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         forcing: &SVector<f64, M>,
     ) -> SVector<f64, R>;
 
+    /// $K n$ for the forcing $n$ given: the fixed-point step from the force-free guess
+    /// $y_0 = G z_0$ is $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
+    /// $y = \text{offset} = 0$; the macro emits the products alone (no $y - \text{offset}$
+    /// term, whose $y_0 - y_0$ the compiler cannot drop: an addition on the step's critical
+    /// path).
+    fn core_forcing(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
+        forcing: &SVector<f64, M>,
+    ) -> SVector<f64, R> {
+        let zero = SVector::zeros();
+        self.core_residual(factors, &zero, &zero, forcing)
+    }
+
     /// $n(y)$ (zero outside the rows [`Self::FORCED`]).
     fn forcing(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SVector<f64, M>;
 
@@ -713,11 +727,12 @@ where
             iteration: 0,
             location: "state",
         };
-        // the fixed-point step y1 = y0 - r(y0) from the force-free guess y0 = G z0: exact up
-        // to O(|K dn/dy| |r(y0)|), so for small steps it meets the residual test and no
-        // Jacobian is evaluated (Newton would return it with 0 iterations)
+        // the fixed-point step y1 = y0 - r(y0) = y0 - K n(y0) from the force-free guess
+        // y0 = G z0: exact up to O(|K dn/dy| |r(y0)|), so for small steps it meets the
+        // residual test and no Jacobian is evaluated (Newton would return it with 0
+        // iterations)
         let n0 = system.forcing(&offset, h, theta);
-        let fixed_point = offset - system.core_residual(factors, &offset, &offset, &n0);
+        let fixed_point = offset - system.core_forcing(factors, &n0);
         let n1 = system.forcing(&fixed_point, h, theta);
         let r1 = system.core_residual(factors, &offset, &fixed_point, &n1);
         let norm1 = max_abs(&r1);
@@ -735,11 +750,7 @@ where
         let forcing_size = Sys::FORCED
             .iter()
             .fold(0.0, |sum, &q| sum + forcing[q].abs());
-        let w = if options.compensated {
-            system.recover(factors, z0, &forcing)
-        } else {
-            system.recover_plain(factors, z0, &forcing)
-        };
+        let w = recover(system, factors, z0, &forcing, options.compensated);
         // the state: the first S unknowns (an array built in place; nalgebra's `into_owned`
         // of a slice copies through an iterator, out of line). Only it is returned, so only it
         // is checked: the other unknowns (the top derivative) are left to the domain check,
@@ -756,7 +767,10 @@ where
             });
         }
         if options.check_domain {
-            crate::scheme::step::check_step_domain(system, z0, &w, options)
+            // the chord's pieces (the cold path) recover w again: only the entries the
+            // guards read are computed here
+            let again = || recover_again(system, factors, z0, &forcing, options.compensated);
+            crate::scheme::step::check_step_domain_with(system, z0, &w, options, again)
                 .map_err(Error::Domain)?;
         }
         Ok((
@@ -768,6 +782,44 @@ where
             },
         ))
     }
+}
+
+/// The unknowns $w$ from the solved core's forcing: [`ReducedScheme::recover`], or
+/// [`ReducedScheme::recover_plain`] without `compensated` (inlined, so that the step
+/// computes only the entries it reads).
+#[inline(always)]
+fn recover<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    factors: &ReducedFactors<S, M, R>,
+    z0: &SVector<f64, S>,
+    forcing: &SVector<f64, M>,
+    compensated: bool,
+) -> SVector<f64, M>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    if compensated {
+        system.recover(factors, z0, forcing)
+    } else {
+        system.recover_plain(factors, z0, forcing)
+    }
+}
+
+/// [`recover`] out of line, for the cold path that needs every entry of $w$ (the chord's
+/// pieces).
+#[cold]
+#[inline(never)]
+fn recover_again<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    factors: &ReducedFactors<S, M, R>,
+    z0: &SVector<f64, S>,
+    forcing: &SVector<f64, M>,
+    compensated: bool,
+) -> SVector<f64, M>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    recover(system, factors, z0, forcing, compensated)
 }
 
 #[cfg(feature = "std")]
