@@ -735,7 +735,7 @@ where
         let fixed_point = offset - system.core_forcing(factors, &n0);
         let n1 = system.forcing(&fixed_point, h, theta);
         let r1 = system.core_residual(factors, &offset, &fixed_point, &n1);
-        let norm1 = max_abs(&r1);
+        let norm1 = finite_max_abs(&r1);
         let (solution, forcing) = if all_finite(&r1) && options.newton.converged(norm1, norm1) {
             let solution = newton::Solution {
                 w: fixed_point,
@@ -782,6 +782,18 @@ where
             },
         ))
     }
+}
+
+/// $\max_i |r_i|$ for a finite `r` (with NaN entries it is not [`max_abs`]: a NaN is kept or
+/// skipped by its place), by plain comparisons: on the step's critical path, where the
+/// zero-initialised lanes of [`max_abs`] and its NaN-skipping maxima cost several dependent
+/// operations more.
+#[inline(always)]
+fn finite_max_abs<const R: usize>(r: &SVector<f64, R>) -> f64 {
+    r.iter()
+        .map(|v| v.abs())
+        .reduce(|m, a| if a > m { a } else { m })
+        .unwrap_or(0.0)
 }
 
 /// The unknowns $w$ from the solved core's forcing: [`ReducedScheme::recover`], or
