@@ -25,9 +25,9 @@
 //! cached factors as straight-line code over their nonzeros, with the factors' constant
 //! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
 //! obstacle system, built with fat LTO, a step with the domain check and without the
-//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.37x to 1.38x the time
+//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.24x to 1.29x the time
 //! of the fastest guarded step written by hand for $h$ and $\theta$ fixed at compile time,
-//! 2.10x to 2.13x with the corrections (`cargo build --profile release-lto -p
+//! 1.86x to 1.90x with the corrections (`cargo build --profile release-lto -p
 //! retract-validation --example report && ./target/release-lto/examples/report --steps`).
 //!
 //! Cached, $T$ and $A^{-1}$ are rounded once, so every step would apply the same slightly
@@ -48,7 +48,7 @@
 //! enter the one rounding of the entry (added after it, a correction below the last bit would
 //! be lost). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
 //! stays within $2.1 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$); the
-//! corrections cost 18 to 20 ns a step on the obstacle system (with fat LTO). Each entry
+//! corrections cost 14 to 16 ns a step on the obstacle system (with fat LTO). Each entry
 //! summed fully compensated (Dot2 of Ogita, Rump and Oishi: every product and addition
 //! error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
