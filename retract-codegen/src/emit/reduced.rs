@@ -150,7 +150,8 @@ impl<'a> Reduction<'a> {
              {:?} of the residual.",
             red.core, red.rows
         );
-        let residual_entries = self.residual_entries();
+        let forced_entries = self.forced_entries();
+        let residual_entries = Self::residual_entries(&forced_entries);
         let forcing_lets = self.forcing_lets();
         let header = self
             .e
@@ -161,6 +162,7 @@ impl<'a> Reduction<'a> {
         let closed_form = self.closed_form();
         let forcing_jacobian = self.forcing_jacobian();
         let core_residual = self.core_residual(&forcing_lets, &residual_entries);
+        let core_forcing = self.core_forcing(&forcing_lets, &forced_entries);
         let forcing = self.forcing();
         let recover = self.recover(&forcing_lets);
         quote! {
@@ -181,6 +183,8 @@ impl<'a> Reduction<'a> {
                 #forcing_jacobian
 
                 #core_residual
+
+                #core_forcing
 
                 #forcing
 
@@ -234,8 +238,8 @@ impl<'a> Reduction<'a> {
         }
     }
 
-    /// The rows of r(y) = y - offset + K n(y), with n_q(y) under the names `__n<q>`.
-    fn residual_entries(&self) -> Vec<TokenStream> {
+    /// The rows of K n over the structural nonzeros of K, with n_q under the names `__n<q>`.
+    fn forced_entries(&self) -> Vec<TokenStream> {
         self.k_pattern
             .iter()
             .enumerate()
@@ -250,7 +254,17 @@ impl<'a> Reduction<'a> {
                         (q, quote!(#name))
                     })
                     .collect();
-                let sum = dot(quote!(factors.k), mi, &cols);
+                dot(quote!(factors.k), mi, &cols)
+            })
+            .collect()
+    }
+
+    /// The rows of r(y) = y - offset + K n(y), from the rows of K n ([`Self::forced_entries`]).
+    fn residual_entries(forced_entries: &[TokenStream]) -> Vec<TokenStream> {
+        forced_entries
+            .iter()
+            .enumerate()
+            .map(|(mi, sum)| {
                 let mi_lit = index(mi);
                 quote!(y[#mi_lit] - offset[#mi_lit] + #sum)
             })
@@ -444,6 +458,25 @@ impl<'a> Reduction<'a> {
         }
     }
 
+    /// The method `core_forcing`: K n for a given forcing n, the products alone (the
+    /// fixed-point step y0 - K n(y0) without the y0 - y0 of `core_residual`).
+    fn core_forcing(
+        &self,
+        forcing_lets: &[TokenStream],
+        forced_entries: &[TokenStream],
+    ) -> TokenStream {
+        let Emission { na, vec_m, .. } = self.e;
+        let (r_lit, vec_r, factors_ty) = (&self.r_lit, &self.vec_r, &self.factors_ty);
+        quote! {
+            /// K n for the given forcing n, over the structural nonzeros of K.
+            #[inline]
+            fn core_forcing(&self, factors: &#factors_ty, forcing: &#vec_m) -> #vec_r {
+                #(#forcing_lets)*
+                #na::SVector::<f64, #r_lit>::from([#(#forced_entries),*])
+            }
+        }
+    }
+
     /// The method `forcing`: n(y), nonzero in the forced rows only.
     fn forcing(&self) -> TokenStream {
         let Emission {
@@ -592,7 +625,7 @@ impl<'a> Reduction<'a> {
             let sets = (0..*m).map(|row| self.recover_row(row, compensated));
             quote! {
                 #[doc = #doc]
-                #[inline]
+                #[inline(always)]
                 fn #name(
                     &self,
                     factors: &#factors_ty,

@@ -233,10 +233,13 @@ pub(crate) fn sum_abs<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) ->
 }
 
 /// $\sum_i f(v_i)$, summed in four lanes so that it vectorises (a single running sum is a
-/// chain of dependent additions that the compiler may not reorder).
+/// chain of dependent additions that the compiler may not reorder). The lanes start at
+/// $-0$, the identity of the addition ($-0 + x = x$ for every $x$, where $+0 + (-0) = +0$),
+/// so the compiler drops the first addition of each lane and, for fewer than four entries,
+/// the empty lanes.
 #[inline]
 pub(crate) fn lane_sum(entries: &[f64], f: impl Fn(f64) -> f64) -> f64 {
-    let mut lanes = [0.0f64; 4];
+    let mut lanes = [-0.0f64; 4];
     let mut chunks = entries.chunks_exact(4);
     for chunk in &mut chunks {
         for (lane, &v) in lanes.iter_mut().zip(chunk) {

@@ -25,9 +25,9 @@
 //! cached factors as straight-line code over their nonzeros, with the factors' constant
 //! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
 //! obstacle system, built with fat LTO, a step with the domain check and without the
-//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.37x to 1.38x the time
+//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.24x to 1.29x the time
 //! of the fastest guarded step written by hand for $h$ and $\theta$ fixed at compile time,
-//! 2.10x to 2.13x with the corrections (`cargo build --profile release-lto -p
+//! 1.86x to 1.90x with the corrections (`cargo build --profile release-lto -p
 //! retract-validation --example report && ./target/release-lto/examples/report --steps`).
 //!
 //! Cached, $T$ and $A^{-1}$ are rounded once, so every step would apply the same slightly
@@ -48,7 +48,7 @@
 //! enter the one rounding of the entry (added after it, a correction below the last bit would
 //! be lost). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
 //! stays within $2.1 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$); the
-//! corrections cost 18 to 20 ns a step on the obstacle system (with fat LTO). Each entry
+//! corrections cost 14 to 16 ns a step on the obstacle system (with fat LTO). Each entry
 //! summed fully compensated (Dot2 of Ogita, Rump and Oishi: every product and addition
 //! error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
@@ -132,6 +132,20 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         y: &SVector<f64, R>,
         forcing: &SVector<f64, M>,
     ) -> SVector<f64, R>;
+
+    /// $K n$ for the forcing $n$ given: the fixed-point step from the force-free guess
+    /// $y_0 = G z_0$ is $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
+    /// $y = \text{offset} = 0$; the macro emits the products alone (no $y - \text{offset}$
+    /// term, whose $y_0 - y_0$ the compiler cannot drop: an addition on the step's critical
+    /// path).
+    fn core_forcing(
+        &self,
+        factors: &ReducedFactors<S, M, R>,
+        forcing: &SVector<f64, M>,
+    ) -> SVector<f64, R> {
+        let zero = SVector::zeros();
+        self.core_residual(factors, &zero, &zero, forcing)
+    }
 
     /// $n(y)$ (zero outside the rows [`Self::FORCED`]).
     fn forcing(&self, y: &SVector<f64, R>, h: f64, theta: f64) -> SVector<f64, M>;
@@ -713,14 +727,15 @@ where
             iteration: 0,
             location: "state",
         };
-        // the fixed-point step y1 = y0 - r(y0) from the force-free guess y0 = G z0: exact up
-        // to O(|K dn/dy| |r(y0)|), so for small steps it meets the residual test and no
-        // Jacobian is evaluated (Newton would return it with 0 iterations)
+        // the fixed-point step y1 = y0 - r(y0) = y0 - K n(y0) from the force-free guess
+        // y0 = G z0: exact up to O(|K dn/dy| |r(y0)|), so for small steps it meets the
+        // residual test and no Jacobian is evaluated (Newton would return it with 0
+        // iterations)
         let n0 = system.forcing(&offset, h, theta);
-        let fixed_point = offset - system.core_residual(factors, &offset, &offset, &n0);
+        let fixed_point = offset - system.core_forcing(factors, &n0);
         let n1 = system.forcing(&fixed_point, h, theta);
         let r1 = system.core_residual(factors, &offset, &fixed_point, &n1);
-        let norm1 = max_abs(&r1);
+        let norm1 = finite_max_abs(&r1);
         let (solution, forcing) = if all_finite(&r1) && options.newton.converged(norm1, norm1) {
             let solution = newton::Solution {
                 w: fixed_point,
@@ -735,11 +750,7 @@ where
         let forcing_size = Sys::FORCED
             .iter()
             .fold(0.0, |sum, &q| sum + forcing[q].abs());
-        let w = if options.compensated {
-            system.recover(factors, z0, &forcing)
-        } else {
-            system.recover_plain(factors, z0, &forcing)
-        };
+        let w = recover(system, factors, z0, &forcing, options.compensated);
         // the state: the first S unknowns (an array built in place; nalgebra's `into_owned`
         // of a slice copies through an iterator, out of line). Only it is returned, so only it
         // is checked: the other unknowns (the top derivative) are left to the domain check,
@@ -756,7 +767,10 @@ where
             });
         }
         if options.check_domain {
-            crate::scheme::step::check_step_domain(system, z0, &w, options)
+            // the chord's pieces (the cold path) recover w again: only the entries the
+            // guards read are computed here
+            let again = || recover_again(system, factors, z0, &forcing, options.compensated);
+            crate::scheme::step::check_step_domain_with(system, z0, &w, options, again)
                 .map_err(Error::Domain)?;
         }
         Ok((
@@ -768,6 +782,56 @@ where
             },
         ))
     }
+}
+
+/// $\max_i |r_i|$ for a finite `r` (with NaN entries it is not [`max_abs`]: a NaN is kept or
+/// skipped by its place), by plain comparisons: on the step's critical path, where the
+/// zero-initialised lanes of [`max_abs`] and its NaN-skipping maxima cost several dependent
+/// operations more.
+#[inline(always)]
+fn finite_max_abs<const R: usize>(r: &SVector<f64, R>) -> f64 {
+    r.iter()
+        .map(|v| v.abs())
+        .reduce(|m, a| if a > m { a } else { m })
+        .unwrap_or(0.0)
+}
+
+/// The unknowns $w$ from the solved core's forcing: [`ReducedScheme::recover`], or
+/// [`ReducedScheme::recover_plain`] without `compensated` (inlined, so that the step
+/// computes only the entries it reads).
+#[inline(always)]
+fn recover<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    factors: &ReducedFactors<S, M, R>,
+    z0: &SVector<f64, S>,
+    forcing: &SVector<f64, M>,
+    compensated: bool,
+) -> SVector<f64, M>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    if compensated {
+        system.recover(factors, z0, forcing)
+    } else {
+        system.recover_plain(factors, z0, forcing)
+    }
+}
+
+/// [`recover`] out of line, for the cold path that needs every entry of $w$ (the chord's
+/// pieces).
+#[cold]
+#[inline(never)]
+fn recover_again<Sys, const S: usize, const M: usize, const R: usize>(
+    system: &Sys,
+    factors: &ReducedFactors<S, M, R>,
+    z0: &SVector<f64, S>,
+    forcing: &SVector<f64, M>,
+    compensated: bool,
+) -> SVector<f64, M>
+where
+    Sys: ReducedScheme<S, M, R> + ?Sized,
+{
+    recover(system, factors, z0, forcing, compensated)
 }
 
 #[cfg(feature = "std")]

@@ -267,6 +267,25 @@ pub fn check_step_domain<Sys, const S: usize, const M: usize>(
 where
     Sys: LiftedSystem<S, M> + ?Sized,
 {
+    check_step_domain_with(system, z0, w, options, || *w)
+}
+
+/// [`check_step_domain`] with the unknowns of the chord's pieces from `unknowns` (called
+/// only on the cold path, where the chord is cut; it must return `w`): the hot path reads
+/// only the entries of `w` that [`LiftedSystem::check_domain`] and the chord's length read,
+/// so a caller that builds `w` in place computes no other entry (the reduced step's top
+/// derivative, where the guards do not read it).
+#[inline(always)]
+pub(crate) fn check_step_domain_with<Sys, const S: usize, const M: usize>(
+    system: &Sys,
+    z0: &SVector<f64, S>,
+    w: &SVector<f64, M>,
+    options: &StepOptions,
+    unknowns: impl FnOnce() -> SVector<f64, M>,
+) -> Result<(), crate::DomainViolation>
+where
+    Sys: LiftedSystem<S, M> + ?Sized,
+{
     system.check_domain(z0, w, options.theta)?;
     // quadratic guards: the three points decide the chord (`guards_quadratic`)
     if system.guards_quadratic() && options.theta > 1e-3 && options.theta < 1.0 - 1e-3 {
@@ -281,7 +300,7 @@ where
         .take(half)
         .fold(0.0f64, |m, (a, b)| m.max((b - a).abs()));
     if length > options.chord_spacing {
-        check_chord(system, z0, w, length, options)
+        check_chord(system, z0, &unknowns(), length, options)
     } else {
         Ok(())
     }

@@ -42,6 +42,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "closed_form_factors",
     "core_offset",
     "core_residual",
+    "core_forcing",
     "core_system",
     "forcing",
     "forcing_jacobian",
