@@ -4,7 +4,9 @@
 //! where it is active (the parking car's turning radius near rest).
 
 use crate::parking::{CarEffort, SideSlip, Turning, WAYPOINTS};
-use retract::bvp::{Curve, Failure, OptimalControlProblem, Plan, PlanError, PlanGuess, Variable};
+use retract::bvp::{
+    Curve, Failure, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, Variable,
+};
 use retract::{higher_order_lagrangian, jet_function};
 
 #[higher_order_lagrangian(order = 2)]
@@ -113,6 +115,39 @@ fn parking_from_twelve_guesses_never_fails_the_inertia_correction() {
             let last = e.last.as_ref().expect("the last iterate");
             assert!(last.certificate.stationarity.is_finite(), "{case}");
         }
+    }
+}
+
+/// Parking (C3, |x| <= 0.8, T = 6, N = 30) from guesses that keep the heading at 0: the car
+/// standing at the start throughout, and the smoothstep sideways to the goal. There the side
+/// slip's linearisation fixes v_y and leaves the heading out of it (its gradient in psi is
+/// v_x cos psi + v_y sin psi = 0), so no first-order step moves y toward the goal 0.5 away
+/// (IPOPT on the same transcription and guesses stops with a point of local infeasibility).
+/// The failure names the goal's y (component 1) as out of reach with its miss, within a few
+/// iterations: not a line-search failure, nor a side slip of 1e-7 as the constraint violated.
+#[test]
+fn a_guess_whose_linearisation_cannot_reach_the_goal_is_named_unreachable() {
+    let standing = Curve::from_fn(|_| [0.0; 3]);
+    for (name, guess) in [
+        ("standing", PlanGuess::Curve(&standing)),
+        ("sideways", PlanGuess::Spline),
+    ] {
+        let goal = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0];
+        let err = OptimalControlProblem::new(&CarEffort::new(), &[0.0; 6], &goal, 6.0, 30)
+            .with_equality(&SideSlip::new())
+            .with_inequality_at(&Turning::new(), Placement::Midpoints)
+            .with_bounds(Variable::Jet(0), -0.8, 0.8)
+            .solve(guess)
+            .expect_err("no step leaves the heading at 0");
+        match err.failure {
+            Failure::UnreachableGoal { component, miss } => {
+                assert_eq!(component, 1, "{name}");
+                assert!((miss - 0.5).abs() < 1e-3, "{name}: miss {miss}");
+            }
+            other => panic!("{name}: {other}"),
+        }
+        let last = err.last.expect("the last iterate");
+        assert!(last.iterations < 10, "{name}: {}", last.iterations);
     }
 }
 

@@ -74,7 +74,9 @@ type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanErr
 const CHORD_ERROR: f64 = 1e-3;
 
 /// Consecutive iterations at which the goal stays out of the subproblems' reach
-/// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`].
+/// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`]; where
+/// the line search finds no step at such an iterate, it ends so at once (the goal is what
+/// stops it, not the merit function: a sideways guess for a car that cannot slip).
 const UNREACHABLE_ITERATIONS: usize = 5;
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
@@ -339,7 +341,8 @@ where
                 }
             };
             rho_last = sub.rho;
-            match self.unreachable_goal(&models, &sub) {
+            let goal = self.unreachable_goal(&models, &sub);
+            match goal {
                 Some((component, miss)) if unreachable + 1 >= UNREACHABLE_ITERATIONS => {
                     let failure = Failure::UnreachableGoal { component, miss };
                     let (cost, certificate, momenta) = self.hand_back(models, sub);
@@ -413,7 +416,13 @@ where
                     continue;
                 }
                 Err(failure) => {
-                    let failure = self.name_infeasibility(failure, &st.iterate);
+                    // (no step where the goal is out of the subproblem's reach: that is named)
+                    let failure = match (failure, goal) {
+                        (Failure::LineSearch, Some((component, miss))) => {
+                            Failure::UnreachableGoal { component, miss }
+                        }
+                        (failure, _) => self.name_infeasibility(failure, &st.iterate),
+                    };
                     self.pool.borrow_mut().reals.give(ds);
                     let (cost, certificate, momenta) = self.hand_back(models, sub);
                     return Err(fail(failure, cost, certificate, momenta));
