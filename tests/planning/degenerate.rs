@@ -146,6 +146,8 @@ fn a_guess_whose_linearisation_cannot_reach_the_goal_is_named_unreachable() {
             }
             other => panic!("{name}: {other}"),
         }
+        let message = err.to_string();
+        assert!(message.contains("start from a guess"), "{name}: {message}");
         let last = err.last.expect("the last iterate");
         assert!(last.iterations < 10, "{name}: {}", last.iterations);
     }

@@ -39,11 +39,14 @@ pub enum Failure {
     /// preferred.
     StalledInfeasible(Infeasibility),
     /// The goal cannot be reached: its fixed component `component` depends on the stage
-    /// equalities and the dynamics alone (they leave it no control), and at the last iterate
-    /// no step reduces its miss `miss` $= |x_N - \text{goal}|$ to first order, for several
-    /// iterations (a point of local infeasibility). The goal contradicts the equalities:
-    /// free that component ([`crate::bvp::OptimalControlProblem::with_free_end`]) or change
-    /// the goal or the equalities.
+    /// equalities (linearised at the last iterate) and the dynamics alone (they leave it no
+    /// control), and at the last iterate no step reduces its miss `miss` $= |x_N -
+    /// \text{goal}|$ to first order, for several iterations or where the line search finds
+    /// no step (a point of local infeasibility). Either the goal contradicts the equalities
+    /// (free that component, [`crate::bvp::OptimalControlProblem::with_free_end`], or change
+    /// the goal or the equalities), or only their linearisation at the iterate does (a car
+    /// that cannot slip, started standing or sideways to a goal beside it): start from a
+    /// guess along which the equalities allow motion towards the goal.
     UnreachableGoal {
         /// The component of $x_N$.
         component: usize,
@@ -117,9 +120,11 @@ impl core::fmt::Display for Failure {
             ),
             Failure::UnreachableGoal { component, miss } => write!(
                 f,
-                "the goal cannot be reached: its component {component} is left without control \
-                 by the stage equalities and the dynamics, and no step reduces its miss \
-                 {miss:e}; free that component (with_free_end) or make the goal consistent \
+                "the goal cannot be reached from the last iterate: its component {component} \
+                 is left without control by the stage equalities (linearised there) and the \
+                 dynamics, and no step reduces its miss {miss:e}; start from a guess along \
+                 which the equalities allow motion towards the goal (a path already heading \
+                 there), free that component (with_free_end), or make the goal consistent \
                  with the equalities"
             ),
             Failure::NotAMinimum {
