@@ -160,19 +160,27 @@ fn assert_converged_as_cold(
 /// 1e-12, re-solved from its own plan and from the plan of the start x0 = 0 at nearby starts,
 /// ends below the tolerance at the cold start's plan (to 1e-8 and 1e-10), in no more
 /// iterations.
-#[test]
-fn warm_starts_with_active_bounds_converge_to_the_tolerance() {
+/// At the default tolerance and at 1e-12: the plan `solve(base, Spline)` has an active bound
+/// (a multiplier above 1e-3), and for each parameter of `nearby` the solve warm-started from
+/// it converges as the cold one ([`assert_converged_as_cold`], to 1e3 times the tolerance).
+fn assert_warm_starts_converge(
+    what: &str,
+    (base, nearby): (f64, &[f64]),
+    solve: impl Fn(f64, PlanGuess<'_, 2, 4>, PlanOptions) -> Plan<2, 4>,
+) {
     let default = PlanOptions::default().tolerance;
     for tolerance in [default, 1e-12] {
         let options = PlanOptions::default().with_tolerance(tolerance);
-        let solve = |x0: f64, guess| solve_under(x0, guess, options);
-        let first = solve(0.0, PlanGuess::Spline);
+        let first = solve(base, PlanGuess::Spline, options);
         let bound = first.duals.step_multipliers.iter().filter(|z| **z > 1e-3);
-        assert!(bound.count() > 0, "the force bound is active at some steps");
-        for x0 in [0.0, 0.02, 0.1, -0.1] {
-            let cold = solve(x0, PlanGuess::Spline);
-            let warm = solve(x0, PlanGuess::Plan(&first));
-            let case = format!("cart-pole, tolerance {tolerance:e}, x0 = {x0}");
+        assert!(
+            bound.count() > 0,
+            "{what}: the bound is active at some steps"
+        );
+        for &p in nearby {
+            let cold = solve(p, PlanGuess::Spline, options);
+            let warm = solve(p, PlanGuess::Plan(&first), options);
+            let case = format!("{what}, tolerance {tolerance:e}, parameter {p}");
             assert_converged_as_cold(
                 (&warm, &cold),
                 (tolerance, 1e3 * tolerance.max(1e-11)),
@@ -182,35 +190,25 @@ fn warm_starts_with_active_bounds_converge_to_the_tolerance() {
     }
 }
 
+#[test]
+fn warm_starts_with_active_bounds_converge_to_the_tolerance() {
+    let nearby = [0.0, 0.02, 0.1, -0.1];
+    assert_warm_starts_converge("cart-pole x0", (0.0, &nearby), solve_under);
+}
+
 /// The swing-up (T = 2, N = 40) with |q''| <= 22 on both joints (active on some steps), at
 /// the default tolerance and at 1e-12: re-solved with gravity moved by 1e-4 and 1e-2 from the
 /// plan at g = 9.81, it ends below the tolerance at the cold start's plan (to 1e-8 and
 /// 1e-10), in no more iterations.
 #[test]
 fn a_bounded_swing_up_warm_starts_to_the_tolerance() {
-    let default = PlanOptions::default().tolerance;
-    for tolerance in [default, 1e-12] {
-        let options = PlanOptions::default().with_tolerance(tolerance);
-        let solve = |g: f64, guess| {
-            let system = DoublePendulum { g };
-            OptimalControlProblem::new(&system, &[0.0; 4], &UPRIGHT_PENDULUM, 2.0, 40)
-                .with_input_bounds([-22.0; 2], [22.0; 2])
-                .with_options(options)
-                .solve(guess)
-                .unwrap_or_else(|e| panic!("tolerance {tolerance:e}, g = {g}: {e}"))
-        };
-        let first = solve(9.81, PlanGuess::Spline);
-        let bound = first.duals.step_multipliers.iter().filter(|z| **z > 1e-3);
-        assert!(bound.count() > 0, "the input bound is active at some steps");
-        for g in [9.81, 9.81 + 1e-4, 9.81 - 1e-4, 9.81 + 1e-2] {
-            let cold = solve(g, PlanGuess::Spline);
-            let warm = solve(g, PlanGuess::Plan(&first));
-            let case = format!("swing-up, tolerance {tolerance:e}, g = {g}");
-            assert_converged_as_cold(
-                (&warm, &cold),
-                (tolerance, 1e3 * tolerance.max(1e-11)),
-                &case,
-            );
-        }
-    }
+    let nearby = [9.81, 9.81 + 1e-4, 9.81 - 1e-4, 9.81 + 1e-2];
+    assert_warm_starts_converge("swing-up g", (9.81, &nearby), |g, guess, options| {
+        let system = DoublePendulum { g };
+        OptimalControlProblem::new(&system, &[0.0; 4], &UPRIGHT_PENDULUM, 2.0, 40)
+            .with_input_bounds([-22.0; 2], [22.0; 2])
+            .with_options(options)
+            .solve(guess)
+            .unwrap_or_else(|e| panic!("g = {g}, tolerance {:e}: {e}", options.tolerance))
+    });
 }

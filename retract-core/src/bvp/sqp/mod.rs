@@ -75,8 +75,8 @@ const CHORD_ERROR: f64 = 1e-3;
 
 /// Consecutive iterations at which the goal stays out of the subproblems' reach
 /// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`]; where
-/// the line search finds no step at such an iterate, it ends so at once (the goal is what
-/// stops it, not the merit function: a sideways guess for a car that cannot slip).
+/// the line search finds no step at such an iterate, it ends so at once
+/// ([`Sqp::name_infeasibility`]).
 const UNREACHABLE_ITERATIONS: usize = 5;
 
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
@@ -334,7 +334,7 @@ where
                 }
                 Err(failure) => {
                     let partial = self.failure_certificate(&models, &st.barrier);
-                    let failure = self.name_infeasibility(failure, &st.iterate);
+                    let failure = self.name_infeasibility(failure, &st.iterate, None);
                     let cost = models.cost;
                     self.give_models(models);
                     return Err(fail(failure, cost, partial, vec![]));
@@ -416,13 +416,7 @@ where
                     continue;
                 }
                 Err(failure) => {
-                    // (no step where the goal is out of the subproblem's reach: that is named)
-                    let failure = match (failure, goal) {
-                        (Failure::LineSearch, Some((component, miss))) => {
-                            Failure::UnreachableGoal { component, miss }
-                        }
-                        (failure, _) => self.name_infeasibility(failure, &st.iterate),
-                    };
+                    let failure = self.name_infeasibility(failure, &st.iterate, goal);
                     self.pool.borrow_mut().reals.give(ds);
                     let (cost, certificate, momenta) = self.hand_back(models, sub);
                     return Err(fail(failure, cost, certificate, momenta));

@@ -295,10 +295,22 @@ where
         None
     }
 
-    /// A failure of the inertia correction or the line search at an iterate that violates a
-    /// constraint beyond the tolerance, as [`Failure::StalledInfeasible`] naming the
-    /// constraint violated most (and where); any other failure as it is.
-    pub(super) fn name_infeasibility(&self, failure: Failure, iterate: &Iterate<N, X>) -> Failure {
+    /// A failure at `iterate` named for what stopped it: a line search that finds no step
+    /// where the subproblem cannot reach the goal (`goal`: the component and its miss,
+    /// [`Self::unreachable_goal`]) as [`Failure::UnreachableGoal`] (the goal stops it, not the
+    /// merit function: a sideways guess for a car that cannot slip); a failure of the inertia
+    /// correction or the line search at an iterate that violates a constraint beyond the
+    /// tolerance as [`Failure::StalledInfeasible`] naming the constraint violated most (and
+    /// where); any other failure as it is.
+    pub(super) fn name_infeasibility(
+        &self,
+        failure: Failure,
+        iterate: &Iterate<N, X>,
+        goal: Option<(usize, f64)>,
+    ) -> Failure {
+        if let (Failure::LineSearch, Some((component, miss))) = (&failure, goal) {
+            return Failure::UnreachableGoal { component, miss };
+        }
         if !matches!(failure, Failure::Regularization | Failure::LineSearch) {
             return failure;
         }
