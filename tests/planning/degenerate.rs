@@ -5,7 +5,8 @@
 
 use crate::parking::{CarEffort, SideSlip, Turning, WAYPOINTS};
 use retract::bvp::{
-    Curve, Failure, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, Variable,
+    Curve, Failure, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, PlanOptions,
+    Variable,
 };
 use retract::{higher_order_lagrangian, jet_function};
 
@@ -115,6 +116,53 @@ fn parking_from_twelve_guesses_never_fails_the_inertia_correction() {
             let last = e.last.as_ref().expect("the last iterate");
             assert!(last.certificate.stationarity.is_finite(), "{case}");
         }
+    }
+}
+
+/// Parking (C3, |x| <= 0.8) in T = 4 with N = 30 steps, the turning constraint at the
+/// midpoints, from the suite's waypoints (times scaled to T) with x scaled by `x_scale`, at
+/// `tolerance`.
+fn park_quickly(x_scale: f64, tolerance: f64) -> Result<Plan<3, 6>, PlanError<3, 6>> {
+    let times = [0.0, 1.0, 2.0, 3.0, 4.0];
+    let knots = WAYPOINTS.map(|[x, y, psi]| [x * x_scale, y, psi * x_scale]);
+    let guess = Curve::through_waypoints(&times, &knots).expect("waypoints in time order");
+    let goal = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0];
+    OptimalControlProblem::new(&CarEffort::new(), &[0.0; 6], &goal, 4.0, 30)
+        .with_equality(&SideSlip::new())
+        .with_inequality_at(&Turning::new(), Placement::Midpoints)
+        .with_bounds(Variable::Jet(0), -0.8, 0.8)
+        .with_options(PlanOptions::default().with_tolerance(tolerance))
+        .solve(PlanGuess::Curve(&guess))
+}
+
+/// Parking in T = 4 from the waypoints (and their mirror image): the turning constraint is
+/// active where speed and turn rate vanish, and at the barrier's floor its slacks of 1e-13
+/// against multipliers of 1e3 left the subproblem's multipliers without digits; the
+/// stationarity wandered between 1e-4 and 3e-1 for 2950 iterations at a primal point fixed to
+/// 15 digits, and the solve ended at the iteration limit. The barrier problem solved just
+/// before the floor met the tolerance (complementarity about 2e-8): that point is certified
+/// at the acceptable level, within a few dozen iterations. Its cost is that of the same
+/// problem solved at the tolerance 1e-8 (whose floor the iteration reaches) to 1e-6, and
+/// the mirror image's.
+#[test]
+fn a_converged_point_before_the_barriers_floor_ends_the_solve() {
+    let reference = park_quickly(1.0, 1e-8).unwrap_or_else(|e| panic!("tolerance 1e-8: {e}"));
+    for x_scale in [1.0, -1.0] {
+        let plan = park_quickly(x_scale, 1e-9).unwrap_or_else(|e| panic!("x * {x_scale}: {e}"));
+        let c = &plan.certificate;
+        assert_eq!(c.negative_directions, 0);
+        assert!(c.min_reduced_hessian_eig > 0.0, "{c:?}");
+        assert!(c.stationarity <= 1e-9 && c.feasibility <= 1e-9, "{c:?}");
+        assert!(c.complementarity <= 1e-6, "{c:?}");
+        assert!(plan.violations.imposed() <= 1e-9, "{:?}", plan.violations);
+        assert!(plan.iterations < 100, "{}", plan.iterations);
+        let gap = (plan.cost - reference.cost).abs();
+        assert!(
+            gap <= 1e-6 * reference.cost,
+            "{} against {}",
+            plan.cost,
+            reference.cost
+        );
     }
 }
 

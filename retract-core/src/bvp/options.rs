@@ -22,7 +22,12 @@ pub struct PlanOptions {
     pub tolerance: f64,
     /// Accepted instead of `tolerance` when the line search has made only rounding-level
     /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
-    /// acceptable level; the certificate reports the residuals reached.
+    /// acceptable level; and where, at the barrier's floor, the error stays above this level
+    /// for 15 iterations or the iteration limit is reached, the last point whose barrier
+    /// problem was solved with stationarity and feasibility below `tolerance` and
+    /// complementarity below this level is certified and returned instead (a degenerate
+    /// active inequality, whose slacks at the floor leave the multipliers without digits).
+    /// The certificate reports the residuals reached.
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub acceptable: f64,
     /// Iteration budget; 3000 by default (IPOPT's): the hard problems of the constrained

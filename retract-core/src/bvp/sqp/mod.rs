@@ -31,9 +31,10 @@
 //! iterate), `direction` (the subproblem: the inertia-corrected Riccati solve of
 //! [`super::kkt`]), `termination` (the KKT and barrier errors, which the loop tests against
 //! the tolerances; at a converged point the second-order check of `second_order` and the
-//! plan), `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
+//! plan; `acceptable`, the acceptable-level exit at a point kept before the barrier's floor),
+//! `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
 //! step. A phase calls only the phases before it in the order `models`, `second_order`,
-//! `termination`, `direction`, `line_search`; this module holds the loop ([`Sqp::run`]) and
+//! `termination`, `direction`, `acceptable`, `line_search`; this module holds the loop ([`Sqp::run`]) and
 //! the first barrier, and calls them all. The vectors come from the workspace's pool, kept
 //! from one solve to the next ([`super::Workspace`]).
 
@@ -46,6 +47,7 @@ use crate::bvp::plan::duals::Duals;
 use crate::bvp::plan::{Failure, Plan, PlanError};
 use crate::{Lagrangian, LiftedSystem};
 
+mod acceptable;
 mod at_solution;
 mod correction;
 mod direction;
@@ -59,6 +61,7 @@ mod second_order;
 mod state;
 mod termination;
 
+use acceptable::ACCEPTABLE_ITERATIONS;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
@@ -218,6 +221,7 @@ where
             filter: None,
             full_step: None,
             kept: None,
+            acceptable: None,
         };
         if cold {
             self.first_barrier_test(&mut state);
@@ -286,6 +290,10 @@ where
         if let Some((riccati, _)) = state.kept {
             riccati.recycle(&mut *pool);
         }
+        drop(pool);
+        if let Some(kept) = state.acceptable {
+            self.give_kept(kept);
+        }
     }
 
     /// The iteration of [`Self::run`] from `st`: the plan and whether it is certified (if
@@ -295,7 +303,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        let mut unreachable = 0;
+        let (mut unreachable, mut floor_misses) = (0, 0);
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
@@ -353,10 +361,7 @@ where
             }
             // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
             if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
-                st.barrier.decrease(floor, self.dynamics.h);
-                if let Some(filter) = &mut st.filter {
-                    filter.reset();
-                }
+                self.decrease_barrier(st, sub.error);
                 self.give_models(models);
                 self.give_subproblem(sub);
                 continue;
@@ -380,6 +385,17 @@ where
                 } else {
                     sub
                 };
+            // at the floor and above the acceptable level for long: the point kept before
+            let missed = st.barrier.mu <= floor && sub.error > options.acceptable;
+            floor_misses = if missed { floor_misses + 1 } else { 0 };
+            let ending = iterations == options.max_iterations && !self.real_time;
+            if (ending || floor_misses >= ACCEPTABLE_ITERATIONS)
+                && let Some(plan) = self.acceptable_exit(&mut st.acceptable, iterations)
+            {
+                self.give_models(models);
+                self.give_subproblem(sub);
+                return Ok((plan, true));
+            }
             let out_of_time = self.out_of_time();
             if iterations == options.max_iterations && self.real_time && !out_of_time {
                 let point = (&st.iterate, &st.y[..], &st.barrier);
@@ -429,6 +445,23 @@ where
             stalled = if at_rounding { stalled + 1 } else { 0 };
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
+        }
+    }
+
+    /// $\mu$ decreased at a point `st` where the barrier problem is solved (the filter reset
+    /// with it), the point first kept for the acceptable-level exit if its `error`
+    /// ($\max$(stationarity, feasibility)) is below the tolerance and its complementarity
+    /// below the acceptable level ([`acceptable`]).
+    fn decrease_barrier(&self, st: &mut State<N, X>, error: f64) {
+        let complementarity = st.barrier.complementarity().0;
+        if error <= self.options.tolerance && complementarity <= self.options.acceptable {
+            let point = (&st.iterate, &st.y[..], &st.barrier);
+            self.keep(point, &mut st.acceptable);
+        }
+        let floor = barrier_floor(self.options.tolerance);
+        st.barrier.decrease(floor, self.dynamics.h);
+        if let Some(filter) = &mut st.filter {
+            filter.reset();
         }
     }
 

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 
+use super::acceptable::Kept;
 use super::filter::Filter;
 use crate::bvp::barrier::Barrier;
 use crate::bvp::constraints::{Inequality, Linearized};
@@ -97,6 +98,10 @@ pub(super) struct State<const N: usize, const X: usize> {
     pub full_step: Option<Direction<N, X>>,
     /// A factorisation kept for a simplified Newton step, with the error where it was made.
     pub kept: Option<(Riccati<N, X>, f64)>,
+    /// The last point where the barrier problem was solved with the error below the
+    /// tolerance and the complementarity below the acceptable level, kept for the
+    /// acceptable-level exit ([`super::acceptable`]).
+    pub acceptable: Option<Kept<N, X>>,
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
