@@ -22,8 +22,9 @@ pub struct PlanOptions {
     pub tolerance: f64,
     /// Accepted instead of `tolerance` when the line search has made only rounding-level
     /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
-    /// acceptable level; and where, at the barrier's floor, the error stays above this level
-    /// for 15 iterations or the iteration limit is reached, the last point whose barrier
+    /// acceptable level; and where, at the barrier's floor, the iterate makes only
+    /// rounding-level progress for three iterations with the error above this level, or the
+    /// iteration limit is reached, the last point whose barrier
     /// problem was solved with stationarity and feasibility below `tolerance` and
     /// complementarity below this level is certified and returned instead (a degenerate
     /// active inequality, whose slacks at the floor leave the multipliers without digits).

@@ -8,10 +8,11 @@
 //! moves. The barrier problem solved just before (at $\mu$ a few times the floor) met the
 //! tolerance in stationarity and feasibility, with complementarity $\max z s \approx \mu$
 //! below the acceptable level. That point is kept when $\mu$ decreases from it; if the
-//! iteration at the floor then stays above the acceptable level for
-//! [`ACCEPTABLE_ITERATIONS`] iterations (IPOPT's `acceptable_iter`), or reaches the
-//! iteration limit, the kept point is certified instead (the second-order check as for any
-//! plan) and returned: its certificate reports the complementarity reached.
+//! iteration at the floor then makes only rounding-level progress for three iterations
+//! (the primal iterate has converged) with the error above the acceptable level, or
+//! reaches the iteration limit, the kept point is certified instead (the second-order
+//! check as for any plan) and returned: its certificate reports the complementarity
+//! reached (IPOPT's acceptable level, at the point that met it).
 
 use nalgebra::SVector;
 
@@ -21,10 +22,6 @@ use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::Iterate;
 use crate::bvp::plan::Plan;
 use crate::{Lagrangian, LiftedSystem};
-
-/// Consecutive iterations at the barrier's floor above the acceptable level after which a
-/// kept point is returned (IPOPT's `acceptable_iter`).
-pub(super) const ACCEPTABLE_ITERATIONS: usize = 15;
 
 /// A point kept for the acceptable-level exit: the iterate, the stage equalities'
 /// multipliers and the barrier (its $\mu$, slacks and multipliers).

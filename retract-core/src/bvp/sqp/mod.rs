@@ -61,7 +61,6 @@ mod second_order;
 mod state;
 mod termination;
 
-use acceptable::ACCEPTABLE_ITERATIONS;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
@@ -303,7 +302,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        let (mut unreachable, mut floor_misses) = (0, 0);
+        let mut unreachable = 0;
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
             let done = iterations;
@@ -385,11 +384,11 @@ where
                 } else {
                     sub
                 };
-            // at the floor and above the acceptable level for long: the point kept before
-            let missed = st.barrier.mu <= floor && sub.error > options.acceptable;
-            floor_misses = if missed { floor_misses + 1 } else { 0 };
+            // at the floor with only rounding-level progress left, the error above the
+            // acceptable level: the point kept before the floor
+            let stuck = st.barrier.mu <= floor && stalled >= 3 && sub.error > options.acceptable;
             let ending = iterations == options.max_iterations && !self.real_time;
-            if (ending || floor_misses >= ACCEPTABLE_ITERATIONS)
+            if (ending || stuck)
                 && let Some(plan) = self.acceptable_exit(&mut st.acceptable, iterations)
             {
                 self.give_models(models);
