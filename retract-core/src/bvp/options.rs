@@ -23,7 +23,7 @@ pub struct PlanOptions {
     /// Accepted instead of `tolerance` when the line search has made only rounding-level
     /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
     /// acceptable level; and where, at the barrier's floor, the iterate makes only
-    /// rounding-level progress for three iterations with the error above this level, or the
+    /// rounding-level progress for ten iterations with the error above this level, or the
     /// iteration limit is reached, the last point whose barrier
     /// problem was solved with stationarity and feasibility below `tolerance` and
     /// complementarity below this level is certified and returned instead (a degenerate

@@ -8,7 +8,7 @@
 //! moves. The barrier problem solved just before (at $\mu$ a few times the floor) met the
 //! tolerance in stationarity and feasibility, with complementarity $\max z s \approx \mu$
 //! below the acceptable level. That point is kept when $\mu$ decreases from it; if the
-//! iteration at the floor then makes only rounding-level progress for three iterations
+//! iteration at the floor then makes only rounding-level progress for ten iterations
 //! (the primal iterate has converged) with the error above the acceptable level, or
 //! reaches the iteration limit, the kept point is certified instead (the second-order
 //! check as for any plan) and returned: its certificate reports the complementarity

@@ -75,6 +75,13 @@ type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanErr
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
 
+/// Consecutive iterations of only rounding-level progress at the barrier's floor, with the
+/// error above the acceptable level, after which the point kept before the floor is
+/// returned ([`acceptable`]). (Three end solves that would reach the tolerance a few dozen
+/// iterations later; ten leave them, and end the stalls of a degenerate inequality within
+/// about 35 iterations of the floor.)
+const STALLED_AT_FLOOR: usize = 10;
+
 /// Consecutive iterations at which the goal stays out of the subproblems' reach
 /// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`]; where
 /// the line search finds no step at such an iterate, it ends so at once
@@ -386,7 +393,9 @@ where
                 };
             // at the floor with only rounding-level progress left, the error above the
             // acceptable level: the point kept before the floor
-            let stuck = st.barrier.mu <= floor && stalled >= 3 && sub.error > options.acceptable;
+            let stuck = st.barrier.mu <= floor
+                && stalled >= STALLED_AT_FLOOR
+                && sub.error > options.acceptable;
             let ending = iterations == options.max_iterations && !self.real_time;
             if (ending || stuck)
                 && let Some(plan) = self.acceptable_exit(&mut st.acceptable, iterations)
