@@ -8,7 +8,8 @@
 //! Run: `cargo run --release -p retract-validation --example report` (about a minute), or
 //! with `-- --quick` for the same lines at reduced size in a few seconds; `-- --batch` prints
 //! only the plans across cores (`batch <name> threads=<t> plans_per_s=<p> scaling=<s>`),
-//! `-- --steps` only the one-step table (`step ratio generated/hand-written: ...`);
+//! `-- --steps` only the one-step table (`step ratio generated/hand-written: ...`), `-- --mpc`
+//! only the receding horizon (the lines of `--example mpc` of `retract`);
 //! `-- --write docs/benchmarks.md` also writes the report into that file, between its lines
 //! `<!-- report:begin ... -->` and `<!-- report:end -->`.
 
@@ -39,7 +40,7 @@ impl<W: Write> Write for Tee<W> {
 
 fn run() -> Result<(), Error> {
     let mut size = Size::full();
-    let (mut only_batches, mut only_steps) = (false, false);
+    let (mut only_batches, mut only_steps, mut only_mpc) = (false, false, false);
     let mut target = None;
     let mut arguments = std::env::args().skip(1);
     while let Some(argument) = arguments.next() {
@@ -47,13 +48,14 @@ fn run() -> Result<(), Error> {
             "--quick" => size = Size::quick(),
             "--batch" => only_batches = true,
             "--steps" => only_steps = true,
+            "--mpc" => only_mpc = true,
             "--write" => match arguments.next() {
                 Some(path) => target = Some(PathBuf::from(path)),
                 None => return Err(invalid("`--write` needs the path of the file to write")),
             },
             other => {
                 return Err(invalid(&format!(
-                    "unknown argument `{other}`; supported: --quick, --batch, --steps, --write PATH"
+                    "unknown argument `{other}`; supported: --quick, --batch, --steps, --mpc, --write PATH"
                 )));
             }
         }
@@ -63,13 +65,16 @@ fn run() -> Result<(), Error> {
         stdout: stdout.lock(),
         text: Vec::new(),
     };
-    if only_batches || only_steps {
+    if only_batches || only_steps || only_mpc {
         writeln!(out, "{}", report::header(&size))?;
         if only_steps {
             report::steps(&size, &mut out)?;
         }
         if only_batches {
             report::batches(&size, &mut out)?;
+        }
+        if only_mpc {
+            retract_validation::receding_horizon::write(&mut out)?;
         }
     } else {
         report::run(&size, &mut out)?;

@@ -8,7 +8,7 @@
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
 //! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
 //! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
-//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`], [`sphere_cubic`]), which [`report`]
+//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`], [`sphere_cubic`], [`receding_horizon`]), which [`report`]
 //! runs and prints in one go.
 
 pub mod batch_speed;
@@ -20,12 +20,19 @@ pub mod long_run;
 #[path = "../../tests/common/models.rs"]
 pub mod models;
 pub mod peers;
+/// The double pendulum of `retract`'s examples (`examples/common/pendulum.rs`).
+#[path = "../../examples/common/pendulum.rs"]
+mod pendulum;
 pub mod planner_speed;
+pub mod receding_horizon;
 pub mod report;
 pub mod sphere_cubic;
 pub mod step_speed;
 pub mod systems;
 pub mod timing;
+/// The receding-horizon loop of `retract`'s examples (`examples/common/upright.rs`).
+#[path = "../../examples/common/upright.rs"]
+mod upright;
 pub mod work_precision;
 
 pub use error::Error;

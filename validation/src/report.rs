@@ -14,7 +14,8 @@
 //! and Richardson extrapolation; and the compile-time cost of the expansion
 //! ([`crate::expansion_cost`]), with the lines `chain n=<n> expand_ms=<t> lines=<l>` of the
 //! n-link chain written as T - V; the plans across cores ([`crate::batch_speed`], lines
-//! `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`) and the Riemannian cubic on
+//! `batch <name> threads=<t> plans_per_s=<p> scaling=<s>`), the receding horizon
+//! ([`crate::receding_horizon`], the lines of `--example mpc`) and the Riemannian cubic on
 //! $S^2$ against de Casteljau ([`crate::sphere_cubic`], lines
 //! `sphere cubic error=<e> time_us=<t> method=<retract|decasteljau>`).
 
@@ -22,11 +23,11 @@ use std::io::Write;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use crate::Error;
-use crate::sphere_cubic;
 use crate::systems::{closest_approach, paper_system};
 use crate::{
     batch_speed, expansion_cost, guard_cost, long_run, planner_speed, step_speed, work_precision,
 };
+use crate::{receding_horizon, sphere_cubic};
 
 /// How much the report measures: rounds and calls per sample of each part.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,6 +139,7 @@ pub fn run(size: &Size, out: &mut dyn Write) -> Result<Summary, Error> {
     let planner = planner_speed::measure_all(size.planner_rounds, size.race_rounds)?;
     planner_speed::write_all(out, &planner)?;
     batches(size, out)?;
+    receding_horizon::write(out)?;
     sphere_cubic::run(out, size.planner_rounds)?;
     let expansions = expansion_cost::expansions(size.expansion_rounds)?;
     expansion_cost::write_expansions(out, &expansions, size.expansion_rounds)?;

@@ -2,7 +2,8 @@
 //! `work-precision 1e-8: best=<method> <t> us, DOP853 <t> us, ratio <r>` line parses with
 //! r = best / DOP853 within the rounding of the printed figures; the planner's tables and its
 //! `ratios: ...` line are there, with one ratio per race; the compile-time table is there. No
-//! timing is asserted; the `sphere cubic ...` lines are there, one pair per resolution.
+//! timing is asserted; the `sphere cubic ...` lines are there, one pair per resolution; the
+//! receding horizon's `kick=... mode=...` lines are there, every re-plan certified.
 
 use retract_validation::planner_speed::PlannerSpeed;
 use retract_validation::report::{self, Size, utc_date};
@@ -73,6 +74,38 @@ fn quick_report_prints_the_work_precision_line() {
     step_ratio_line(&text);
     batch_lines(&text);
     sphere_lines(&text);
+    receding_horizon_lines(&text);
+}
+
+/// The receding horizon's lines: one `kick=<k> mode=<m> ...` line per kick (2, 8) and mode
+/// (rti1, rti2, full), each held upright without a failed re-plan and settled (a finite
+/// settling time), positive times with the median below the 99th percentile; one `feedback`
+/// line per kick and real-time mode.
+fn receding_horizon_lines(text: &str) {
+    let field = |line: &str, key: &str| -> f64 {
+        let value = (line.split(' '))
+            .find_map(|w| w.strip_prefix(key))
+            .unwrap_or_else(|| panic!("no `{key}` in `{line}`"));
+        value
+            .parse()
+            .unwrap_or_else(|_| panic!("`{key}{value}` in `{line}`"))
+    };
+    for kick in ["2", "8"] {
+        for mode in ["rti1", "rti2", "full"] {
+            let prefix = format!("kick={kick} mode={mode} ");
+            let lines: Vec<&str> = text.lines().filter(|l| l.starts_with(&prefix)).collect();
+            assert_eq!(lines.len(), 1, "one `{prefix}` line in:\n{text}");
+            let line = lines[0];
+            assert_eq!(field(line, "failures="), 0.0, "{line}");
+            assert!(field(line, "settle_s=").is_finite(), "{line}");
+            let (median, p99) = (field(line, "median_us="), field(line, "p99_us="));
+            assert!(median > 0.0 && median <= p99, "{line}");
+            if mode != "full" {
+                let feedback = format!("feedback kick={kick} mode={mode} median_us=");
+                assert!(text.lines().any(|l| l.starts_with(&feedback)), "{feedback}");
+            }
+        }
+    }
 }
 
 /// The lines `sphere cubic error=<e> time_us=<t> method=<retract|decasteljau>`: one pair per

@@ -1,0 +1,61 @@
+//! The receding-horizon benchmark in the report (`docs/benchmarks.md`, "Receding horizon"):
+//! the loop of `examples/common/upright.rs` (the double pendulum held upright by re-plans over
+//! T = 1 s, N = 50, one every 0.02 s, its velocity kicked at t = 0.5 s), shared with
+//! `examples/mpc.rs` by path, run for each kick (2, 8) and each mode (one or two real-time
+//! iterations a period, full solves from the shifted plan). It writes the lines of
+//! `--example mpc`, exactly:
+//!
+//! `kick=<k> mode=<rti1|rti2|full> max_dev=<d> settle_s=<s> median_us=<m> p99_us=<p> failures=<f>`
+//!
+//! then for the real-time modes `feedback kick=<k> mode=<rti1|rti2> median_us=<m> p99_us=<p>
+//! max_us=<x>` (the feedback phase alone).
+
+use std::io::Write;
+
+use crate::Error;
+use crate::upright::{Mode, quantile, run};
+
+/// Runs the loop for every kick and mode and writes its lines to `out` under a heading.
+///
+/// # Errors
+/// A re-plan that fails to set up (a plan that fails inside the loop is counted in
+/// `failures=`, not an error) as [`Error::Plan`], or [`Error::Io`].
+pub fn write(out: &mut dyn Write) -> Result<(), Error> {
+    writeln!(
+        out,
+        "\n### Receding horizon\n\nThe double pendulum held upright (`examples/common/upright.rs`; \
+         a period's re-plan, then the feedback phase alone):\n\n```text"
+    )?;
+    let modes = [Mode::Rti(1), Mode::Rti(2), Mode::Full];
+    let mut feedback = Vec::new();
+    for kick in [2.0, 8.0] {
+        for mode in modes {
+            let outcome = run(kick, mode).map_err(|e| Error::Plan(e.to_string()))?;
+            writeln!(
+                out,
+                "kick={kick} mode={} max_dev={:.4} settle_s={:.2} median_us={:.1} p99_us={:.1} \
+                 failures={}",
+                mode.name(),
+                outcome.max_dev,
+                outcome.settle_s,
+                quantile(&outcome.replan_us, 0.5),
+                quantile(&outcome.replan_us, 0.99),
+                outcome.failures,
+            )?;
+            if mode != Mode::Full {
+                feedback.push(format!(
+                    "feedback kick={kick} mode={} median_us={:.1} p99_us={:.1} max_us={:.1}",
+                    mode.name(),
+                    quantile(&outcome.feedback_us, 0.5),
+                    quantile(&outcome.feedback_us, 0.99),
+                    quantile(&outcome.feedback_us, 1.0),
+                ));
+            }
+        }
+    }
+    for line in feedback {
+        writeln!(out, "{line}")?;
+    }
+    writeln!(out, "```")?;
+    Ok(())
+}
