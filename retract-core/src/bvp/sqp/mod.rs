@@ -31,11 +31,11 @@
 //! iterate), `direction` (the subproblem: the inertia-corrected Riccati solve of
 //! [`super::kkt`]), `termination` (the KKT and barrier errors, which the loop tests against
 //! the tolerances; at a converged point the second-order check of `second_order` and the
-//! plan; `acceptable`, the acceptable-level exit at a point kept before the barrier's floor),
-//! `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
+//! plan; `acceptable`, the acceptable-level exit at a point kept before the barrier's
+//! floor), `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
 //! step. A phase calls only the phases before it in the order `models`, `second_order`,
-//! `termination`, `direction`, `acceptable`, `line_search`; this module holds the loop ([`Sqp::run`]) and
-//! the first barrier, and calls them all. The vectors come from the workspace's pool, kept
+//! `termination`, `direction`, `acceptable`, `line_search`; this module holds the loop
+//! ([`Sqp::run`]) and the first barrier, and calls them all. The vectors come from the workspace's pool, kept
 //! from one solve to the next ([`super::Workspace`]).
 
 use nalgebra::SVector;
