@@ -348,6 +348,20 @@ pub fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, (a - (s - b_virtual)) + (b - b_virtual))
 }
 
+/// $\mathrm{fl}(s + (e + c))$ with $(s, e)$ = [`two_sum`]$(a, b)$: the sum $a + b$ with the
+/// small correction $c$ added inside its one rounding (the last addition of a row of
+/// [`ReducedScheme::recover`], generated, whose corrections $c$ would be lost below the last
+/// bit of $a + b$). Where $b$ is known last, the correction joins $b$'s half of the error
+/// first, $e + c = (a - (s - b_v)) + ((b - b_v) + c)$ with $b_v = s - a$: one addition fewer
+/// after $b$ than $(e + c)$, and the same value up to the rounding of the error terms
+/// ($u^2 |s|$, $u$ the unit roundoff).
+#[inline(always)]
+pub fn sum_corrected(a: f64, b: f64, c: f64) -> f64 {
+    let s = a + b;
+    let b_virtual = s - a;
+    s + ((a - (s - b_virtual)) + ((b - b_virtual) + c))
+}
+
 /// $p = \mathrm{fl}(a b)$ and its rounding error $a b - p$: a fused multiply-add where `std`
 /// and the target's `fma` feature make it one instruction, else Dekker's product by Veltkamp
 /// splitting (17 flops, branch-free). The error is exact unless it underflows; where Dekker's
@@ -868,7 +882,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{Dot2, Split, two_product, two_sum};
+    use super::{Dot2, Split, sum_corrected, two_product, two_sum};
 
     #[test]
     fn the_error_free_transformations_are_exact() {
@@ -901,5 +915,32 @@ mod tests {
         sum.add_split_product(a, b);
         sum.add_split_product(c, d);
         assert_eq!(sum.value(), -f64::EPSILON * f64::EPSILON);
+    }
+
+    #[test]
+    fn a_corrected_sum_keeps_a_correction_below_the_last_bit() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut kept = 0;
+        for _ in 0..10_000 {
+            // a correction of the size of the rounding error of a + b, either order of size
+            let (a, b) = (next(), next() * 1e-3);
+            let (a, b) = if next() < 0.0 { (a, b) } else { (b, a) };
+            let c = next() * f64::EPSILON;
+            // the sum a + b + c rounded once (Dot2: exact here, then one rounding)
+            let mut exact = Dot2::exact(a);
+            exact.add_exact(b);
+            exact.add_exact(c);
+            let (exact, sum) = (exact.value(), sum_corrected(a, b, c));
+            assert_eq!(sum, exact, "{a} + {b} + {c}");
+            kept += usize::from(sum == exact && a + b != exact);
+        }
+        // the correction changed the rounded sum in many of the draws, and was kept
+        assert!(kept > 1000, "{kept}");
     }
 }
