@@ -162,7 +162,7 @@ impl<'a> Reduction<'a> {
         let closed_form = self.closed_form();
         let forcing_jacobian = self.forcing_jacobian();
         let core_residual = self.core_residual(&forcing_lets, &residual_entries);
-        let core_forcing = self.core_forcing(&forcing_lets, &forced_entries);
+        let core_forcing = self.core_forcing();
         let forcing = self.forcing();
         let recover = self.recover(&forcing_lets);
         quote! {
@@ -458,21 +458,35 @@ impl<'a> Reduction<'a> {
         }
     }
 
-    /// The method `core_forcing`: K n for a given forcing n, the products alone (the
-    /// fixed-point step y0 - K n(y0) without the y0 - y0 of `core_residual`).
-    fn core_forcing(
-        &self,
-        forcing_lets: &[TokenStream],
-        forced_entries: &[TokenStream],
-    ) -> TokenStream {
-        let Emission { na, vec_m, .. } = self.e;
-        let (r_lit, vec_r, factors_ty) = (&self.r_lit, &self.vec_r, &self.factors_ty);
+    /// The method `core_forcing`: K n(y) at y, each entry of K a leaf of the product chains of
+    /// n (bound first as `__h`), so that it is multiplied in with their early operands: the
+    /// fixed-point step y0 - K n(y0) waits on no multiplication by K after n.
+    fn core_forcing(&self) -> TokenStream {
+        let Emission { na, float, .. } = self.e;
+        let (red, r_lit, vec_r, factors_ty) =
+            (self.red, &self.r_lit, &self.vec_r, &self.factors_ty);
+        let code = emit(self.e.g, &red.scaled, &self.e.scheme());
+        let (stmts, exprs) = (&code.stmts, &code.exprs);
+        let count = index(red.scale_entries.len());
+        let entries = red.scale_entries.iter().map(|&(m, q)| {
+            let (m, q) = (index(m), index(q));
+            quote!(factors.k[(#m, #q)])
+        });
         quote! {
-            /// K n for the given forcing n, over the structural nonzeros of K.
+            /// K n(y) over the structural nonzeros of K, the entries of K inside the products
+            /// of n.
             #[inline]
-            fn core_forcing(&self, factors: &#factors_ty, forcing: &#vec_m) -> #vec_r {
-                #(#forcing_lets)*
-                #na::SVector::<f64, #r_lit>::from([#(#forced_entries),*])
+            fn core_forcing(
+                &self,
+                factors: &#factors_ty,
+                y: &#vec_r,
+                h: f64,
+                theta: f64,
+            ) -> #vec_r {
+                #float
+                let __h: [f64; #count] = [#(#entries),*];
+                #stmts
+                #na::SVector::<f64, #r_lit>::from([#(#exprs),*])
             }
         }
     }

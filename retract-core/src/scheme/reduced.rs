@@ -133,18 +133,21 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         forcing: &SVector<f64, M>,
     ) -> SVector<f64, R>;
 
-    /// $K n$ for the forcing $n$ given: the fixed-point step from the force-free guess
-    /// $y_0 = G z_0$ is $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
-    /// $y = \text{offset} = 0$; the macro emits the products alone (no $y - \text{offset}$
-    /// term, whose $y_0 - y_0$ the compiler cannot drop: an addition on the step's critical
-    /// path).
+    /// $K n(y)$: the fixed-point step from the force-free guess $y_0 = G z_0$ is
+    /// $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
+    /// $y = \text{offset} = 0$ with the forcing [`Self::forcing`]; the macro emits the products
+    /// with the entries of $K$ multiplied into those of $n$ with their operands known first
+    /// (no multiplication by $K$ after $n$, and no $y - \text{offset}$ term, whose
+    /// $y_0 - y_0$ the compiler cannot drop: operations on the step's critical path).
     fn core_forcing(
         &self,
         factors: &ReducedFactors<S, M, R>,
-        forcing: &SVector<f64, M>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
     ) -> SVector<f64, R> {
         let zero = SVector::zeros();
-        self.core_residual(factors, &zero, &zero, forcing)
+        self.core_residual(factors, &zero, &zero, &self.forcing(y, h, theta))
     }
 
     /// $n(y)$ (zero outside the rows [`Self::FORCED`]).
@@ -745,8 +748,7 @@ where
         // y0 = G z0: exact up to O(|K dn/dy| |r(y0)|), so for small steps it meets the
         // residual test and no Jacobian is evaluated (Newton would return it with 0
         // iterations)
-        let n0 = system.forcing(&offset, h, theta);
-        let fixed_point = offset - system.core_forcing(factors, &n0);
+        let fixed_point = offset - system.core_forcing(factors, &offset, h, theta);
         let n1 = system.forcing(&fixed_point, h, theta);
         let r1 = system.core_residual(factors, &offset, &fixed_point, &n1);
         let norm1 = finite_max_abs(&r1);
