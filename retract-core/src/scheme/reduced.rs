@@ -25,9 +25,9 @@
 //! cached factors as straight-line code over their nonzeros, with the factors' constant
 //! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
 //! obstacle system, built with fat LTO, a step with the domain check and without the
-//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.24x to 1.29x the time
+//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.17x to 1.19x the time
 //! of the fastest guarded step written by hand for $h$ and $\theta$ fixed at compile time,
-//! 1.86x to 1.90x with the corrections (`cargo build --profile release-lto -p
+//! 1.72x to 1.77x with the corrections (`cargo build --profile release-lto -p
 //! retract-validation --example report && ./target/release-lto/examples/report --steps`).
 //!
 //! Cached, $T$ and $A^{-1}$ are rounded once, so every step would apply the same slightly
@@ -44,11 +44,12 @@
 //! $$w = (T + T_{lo})\thinspace z_0 - (A^{-1} + A^{-1}_{lo})\thinspace n(y),$$
 //!
 //! each entry a balanced sum of the terms of $T$ and $A^{-1}$ whose last addition is made exact
-//! ([`two_sum`]), with the corrections $T_{lo} z_0 - A^{-1}_{lo} n$ added to its error: they
-//! enter the one rounding of the entry (added after it, a correction below the last bit would
-//! be lost). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
+//! ([`sum_corrected`]), with the corrections $T_{lo} z_0 - A^{-1}_{lo} n$ added to its error:
+//! they enter the one rounding of the entry (added after it, a correction below the last bit
+//! would be lost). The terms of $n$, known last, are summed apart and enter that last
+//! addition, so that one addition follows $n$ (in the plain sums too). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
 //! stays within $2.1 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$); the
-//! corrections cost 14 to 16 ns a step on the obstacle system (with fat LTO). Each entry
+//! corrections cost 14 to 15 ns a step on the obstacle system (with fat LTO). Each entry
 //! summed fully compensated (Dot2 of Ogita, Rump and Oishi: every product and addition
 //! error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
