@@ -887,15 +887,19 @@ where
 mod tests {
     use super::{Dot2, Split, sum_corrected, two_product, two_sum};
 
-    #[test]
-    fn the_error_free_transformations_are_exact() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
+    /// Uniform draws in [-0.5, 0.5) (xorshift from `state`).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        }
+    }
+
+    #[test]
+    fn the_error_free_transformations_are_exact() {
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15);
         for _ in 0..10_000 {
             let (a, b) = (next() * 1e3, next() * 1e-3);
             let (p, e) = two_product(a, b);
@@ -922,13 +926,7 @@ mod tests {
 
     #[test]
     fn a_corrected_sum_keeps_a_correction_below_the_last_bit() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = uniform(0x2545_f491_4f6c_dd1d);
         let mut kept = 0;
         for _ in 0..10_000 {
             // a correction of the size of the rounding error of a + b, either order of size
