@@ -162,7 +162,7 @@ impl<'a> Reduction<'a> {
         let closed_form = self.closed_form();
         let forcing_jacobian = self.forcing_jacobian();
         let core_residual = self.core_residual(&forcing_lets, &residual_entries);
-        let core_forcing = self.core_forcing(&forcing_lets, &forced_entries);
+        let core_forcing = self.core_forcing();
         let forcing = self.forcing();
         let recover = self.recover(&forcing_lets);
         quote! {
@@ -458,21 +458,35 @@ impl<'a> Reduction<'a> {
         }
     }
 
-    /// The method `core_forcing`: K n for a given forcing n, the products alone (the
-    /// fixed-point step y0 - K n(y0) without the y0 - y0 of `core_residual`).
-    fn core_forcing(
-        &self,
-        forcing_lets: &[TokenStream],
-        forced_entries: &[TokenStream],
-    ) -> TokenStream {
-        let Emission { na, vec_m, .. } = self.e;
-        let (r_lit, vec_r, factors_ty) = (&self.r_lit, &self.vec_r, &self.factors_ty);
+    /// The method `core_forcing`: K n(y) at y, each entry of K a leaf of the product chains of
+    /// n (bound first as `__h`), so that it is multiplied in with their early operands: the
+    /// fixed-point step y0 - K n(y0) waits on no multiplication by K after n.
+    fn core_forcing(&self) -> TokenStream {
+        let Emission { na, float, .. } = self.e;
+        let (red, r_lit, vec_r, factors_ty) =
+            (self.red, &self.r_lit, &self.vec_r, &self.factors_ty);
+        let code = emit(self.e.g, &red.scaled, &self.e.scheme());
+        let (stmts, exprs) = (&code.stmts, &code.exprs);
+        let count = index(red.scale_entries.len());
+        let entries = red.scale_entries.iter().map(|&(m, q)| {
+            let (m, q) = (index(m), index(q));
+            quote!(factors.k[(#m, #q)])
+        });
         quote! {
-            /// K n for the given forcing n, over the structural nonzeros of K.
+            /// K n(y) over the structural nonzeros of K, the entries of K inside the products
+            /// of n.
             #[inline]
-            fn core_forcing(&self, factors: &#factors_ty, forcing: &#vec_m) -> #vec_r {
-                #(#forcing_lets)*
-                #na::SVector::<f64, #r_lit>::from([#(#forced_entries),*])
+            fn core_forcing(
+                &self,
+                factors: &#factors_ty,
+                y: &#vec_r,
+                h: f64,
+                theta: f64,
+            ) -> #vec_r {
+                #float
+                let __h: [f64; #count] = [#(#entries),*];
+                #stmts
+                #na::SVector::<f64, #r_lit>::from([#(#exprs),*])
             }
         }
     }
@@ -536,12 +550,15 @@ impl<'a> Reduction<'a> {
     }
 
     /// Row `row` of w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y): the terms of T and A^{-1}
-    /// summed as a balanced tree, the last addition exact (`two_sum`), and the corrections
-    /// (T_lo z0 and A^{-1}_lo n, of the size of the rounding errors) added to its error, so
-    /// that they enter the one rounding of the result instead of being lost below the last
-    /// bit. A row of exact terms (factors +-1) has no correction and is a plain sum. With
-    /// `compensated` false, the row is the plain sum of the terms of T and A^{-1} (no
-    /// corrections, no exact addition).
+    /// summed as a balanced tree, the last addition exact (`sum_corrected`: `two_sum` with the
+    /// error), and the corrections (T_lo z0 and A^{-1}_lo n, of the size of the rounding
+    /// errors) added to its error, so that they enter the one rounding of the result instead
+    /// of being lost below the last bit. The terms of n, known last, are summed apart and
+    /// enter the last addition (and their corrections the last addition of the corrections):
+    /// one addition after n, not the depth of the tree. A row of exact terms (factors +-1) has
+    /// no correction and is a plain sum. With `compensated` false, the row is the plain sum of
+    /// the terms of T and A^{-1} (no corrections, no exact addition), the terms of n again
+    /// added last.
     fn recover_row(&self, row: usize, compensated: bool) -> TokenStream {
         let (core, s, red) = (&self.e.core, self.e.s, self.red);
         let rl = index(row);
@@ -563,7 +580,7 @@ impl<'a> Reduction<'a> {
             terms.push(term);
         }
         // the forcing is known last: its terms join the sum of the others at the end
-        let forced_start = terms.len();
+        let (forced_start, early_corrections) = (terms.len(), corrections.len());
         for &q in red.rows.iter().filter(|&&q| self.inverse_pattern[row][q]) {
             let (ql, name) = (index(q), n_name(q));
             let term = self.term(
@@ -584,10 +601,27 @@ impl<'a> Reduction<'a> {
                 Term::Product(a, b) => (false, quote!(#a * #b)),
             })
             .collect();
+        // the forcing's terms, known last, are summed apart and join the sum of the others in
+        // its last addition: one addition after them, not the depth of a balanced tree
+        let mixed = forced_start > 0 && forced_start < terms.len();
         if corrections.is_empty() || !compensated {
+            if mixed {
+                let (left, right) = signed.split_at(forced_start);
+                let (left, right) = (signed_sum(left), signed_sum(right));
+                return quote!((#left + #right));
+            }
             return signed_sum(&signed);
         }
-        let small = signed_sum(&corrections);
+        // the corrections of the forcing's terms (known last) are summed apart, as theirs
+        let (early, late) = corrections.split_at(early_corrections);
+        let small = match (early.is_empty(), late.is_empty()) {
+            (false, false) => {
+                let (early, late) = (signed_sum(early), signed_sum(late));
+                quote!((#early + #late))
+            }
+            (true, _) => signed_sum(late),
+            (false, true) => signed_sum(early),
+        };
         if let [Term::Product(a, b)] = terms.as_slice() {
             // one product: its own rounding error, exact, carries the correction
             return quote!({
@@ -595,17 +629,10 @@ impl<'a> Reduction<'a> {
                 __p + (__e + #small)
             });
         }
-        let split = if forced_start > 0 && forced_start < terms.len() {
-            forced_start
-        } else {
-            terms.len() / 2
-        };
+        let split = if mixed { forced_start } else { terms.len() / 2 };
         let (left, right) = signed.split_at(split);
         let (left, right) = (signed_sum(left), signed_sum(right));
-        quote!({
-            let (__s, __e) = #core::two_sum(#left, #right);
-            __s + (__e + #small)
-        })
+        quote!(#core::sum_corrected(#left, #right, #small))
     }
 
     /// The methods `recover`, w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the

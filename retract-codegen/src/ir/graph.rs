@@ -54,8 +54,9 @@ pub enum Var {
     /// Component `index` (`j * n + i` for q^(j)_i) of a direction d in the jet (x, u), for a
     /// Hessian-vector product H d.
     Direction(u32),
-    /// Value `index` of the nodes evaluated once before a run-time loop (named `__h`), in
-    /// code that the loop repeats (the Hessian's columns).
+    /// Value `index` of the values computed before the emitted code (named `__h`): the nodes
+    /// evaluated once before a run-time loop, in code that the loop repeats (the Hessian's
+    /// columns), or the entries of the reduced step's cached factor K (`Reduced::scaled`).
     Hoisted(u32),
 }
 

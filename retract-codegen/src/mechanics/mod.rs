@@ -521,6 +521,14 @@ pub struct Reduced {
     pub nonlinear: Vec<Id>,
     /// dn_q/dy, row-major |rows| x R.
     pub nonlinear_jacobian: Vec<Id>,
+    /// K n(y), row m the sum of `k_mq n_q(y)` over the entries (m, q) of `scale_entries`,
+    /// `k_mq` the leaf `Var::Hoisted(i)` of the i-th entry: the factor enters the product
+    /// chain of n_q with its other early operands, not after its last one.
+    pub scaled: Vec<Id>,
+    /// The entries (m, q) of K that `scaled` multiplies, in the order of their leaves: the
+    /// structural nonzeros of the core rows of A^{-1} at the forced columns, less the zeros
+    /// of the closed form.
+    pub scale_entries: Vec<(usize, usize)>,
     /// The irreducible blocks of A: (rows, columns), ascending.
     pub blocks: Vec<(Vec<usize>, Vec<usize>)>,
     /// Structural nonzeros of A^{-1}, M x M (a superset: entries in one irreducible block).
@@ -712,6 +720,8 @@ pub fn reduce(
     let inverse_pattern = inverse_pattern(&linear_pattern);
     let initial_pattern = pattern(&initial, s);
     let closed_form = closed_form(g, &linear, &initial, &rows, &blocks, m, s);
+    let (scaled, scale_entries) =
+        scaled_forcing(g, &core, &rows, &nonlinear, &inverse_pattern, &closed_form);
     Some(Reduced {
         core,
         linear,
@@ -719,11 +729,48 @@ pub fn reduce(
         rows,
         nonlinear,
         nonlinear_jacobian,
+        scaled,
+        scale_entries,
         blocks,
         inverse_pattern,
         initial_pattern,
         closed_form,
     })
+}
+
+/// K n(y) over the structural nonzeros of K (the core rows of A^{-1} at the forced columns,
+/// less the closed form's zeros), each entry of K a leaf `Var::Hoisted(i)`; with the entries
+/// (m, q), in the order of i ([`Reduced::scaled`]).
+fn scaled_forcing(
+    g: &mut Graph,
+    core: &[usize],
+    rows: &[usize],
+    nonlinear: &[Id],
+    inverse_pattern: &[Vec<bool>],
+    closed_form: &Option<(Vec<Id>, Vec<Id>, bool)>,
+) -> (Vec<Id>, Vec<(usize, usize)>) {
+    let mut entries = Vec::new();
+    let mut scaled = Vec::with_capacity(core.len());
+    for (mi, &c) in core.iter().enumerate() {
+        let mut sum = None;
+        for (f, (&q, &n_q)) in rows.iter().zip(nonlinear).enumerate() {
+            let known_zero = closed_form
+                .as_ref()
+                .is_some_and(|(_, a_inv, _)| g.is_const(a_inv[c * rows.len() + f], 0.0));
+            if !inverse_pattern[c][q] || known_zero {
+                continue;
+            }
+            let k = g.var(Var::Hoisted(entries.len() as u32));
+            entries.push((mi, q));
+            let term = g.mul(k, n_q);
+            sum = Some(match sum {
+                Some(s) => g.add_op(s, term),
+                None => term,
+            });
+        }
+        scaled.push(sum.unwrap_or_else(|| g.constant(0.0)));
+    }
+    (scaled, entries)
 }
 
 /// The irreducible blocks of a square pattern: rows and columns (ascending) connected through

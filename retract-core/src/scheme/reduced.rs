@@ -25,9 +25,9 @@
 //! cached factors as straight-line code over their nonzeros, with the factors' constant
 //! entries written in. The result is the same $z_1$ as the general step, to rounding; on the
 //! obstacle system, built with fat LTO, a step with the domain check and without the
-//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.24x to 1.29x the time
+//! corrections below ([`crate::StepOptions::compensated`] off) takes 1.17x to 1.19x the time
 //! of the fastest guarded step written by hand for $h$ and $\theta$ fixed at compile time,
-//! 1.86x to 1.90x with the corrections (`cargo build --profile release-lto -p
+//! 1.72x to 1.77x with the corrections (`cargo build --profile release-lto -p
 //! retract-validation --example report && ./target/release-lto/examples/report --steps`).
 //!
 //! Cached, $T$ and $A^{-1}$ are rounded once, so every step would apply the same slightly
@@ -44,11 +44,12 @@
 //! $$w = (T + T_{lo})\thinspace z_0 - (A^{-1} + A^{-1}_{lo})\thinspace n(y),$$
 //!
 //! each entry a balanced sum of the terms of $T$ and $A^{-1}$ whose last addition is made exact
-//! ([`two_sum`]), with the corrections $T_{lo} z_0 - A^{-1}_{lo} n$ added to its error: they
-//! enter the one rounding of the entry (added after it, a correction below the last bit would
-//! be lost). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
+//! ([`sum_corrected`]), with the corrections $T_{lo} z_0 - A^{-1}_{lo} n$ added to its error:
+//! they enter the one rounding of the entry (added after it, a correction below the last bit
+//! would be lost). The terms of $n$, known last, are summed apart and enter that last
+//! addition, so that one addition follows $n$ (in the plain sums too). The angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then
 //! stays within $2.1 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$); the
-//! corrections cost 14 to 16 ns a step on the obstacle system (with fat LTO). Each entry
+//! corrections cost 14 to 15 ns a step on the obstacle system (with fat LTO). Each entry
 //! summed fully compensated (Dot2 of Ogita, Rump and Oishi: every product and addition
 //! error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made the step 3x slower.
 //!
@@ -133,18 +134,21 @@ pub trait ReducedScheme<const S: usize, const M: usize, const R: usize>:
         forcing: &SVector<f64, M>,
     ) -> SVector<f64, R>;
 
-    /// $K n$ for the forcing $n$ given: the fixed-point step from the force-free guess
-    /// $y_0 = G z_0$ is $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
-    /// $y = \text{offset} = 0$; the macro emits the products alone (no $y - \text{offset}$
-    /// term, whose $y_0 - y_0$ the compiler cannot drop: an addition on the step's critical
-    /// path).
+    /// $K n(y)$: the fixed-point step from the force-free guess $y_0 = G z_0$ is
+    /// $y_1 = y_0 - K n(y_0)$. By default [`Self::core_residual`] at
+    /// $y = \text{offset} = 0$ with the forcing [`Self::forcing`]; the macro emits the products
+    /// with the entries of $K$ multiplied into those of $n$ with their operands known first
+    /// (no multiplication by $K$ after $n$, and no $y - \text{offset}$ term, whose
+    /// $y_0 - y_0$ the compiler cannot drop: operations on the step's critical path).
     fn core_forcing(
         &self,
         factors: &ReducedFactors<S, M, R>,
-        forcing: &SVector<f64, M>,
+        y: &SVector<f64, R>,
+        h: f64,
+        theta: f64,
     ) -> SVector<f64, R> {
         let zero = SVector::zeros();
-        self.core_residual(factors, &zero, &zero, forcing)
+        self.core_residual(factors, &zero, &zero, &self.forcing(y, h, theta))
     }
 
     /// $n(y)$ (zero outside the rows [`Self::FORCED`]).
@@ -346,6 +350,20 @@ pub fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let b_virtual = s - a;
     (s, (a - (s - b_virtual)) + (b - b_virtual))
+}
+
+/// $\mathrm{fl}(s + (e + c))$ with $(s, e)$ = [`two_sum`]$(a, b)$: the sum $a + b$ with the
+/// small correction $c$ added inside its one rounding (the last addition of a row of
+/// [`ReducedScheme::recover`], generated, whose corrections $c$ would be lost below the last
+/// bit of $a + b$). Where $b$ is known last, the correction joins $b$'s half of the error
+/// first, $e + c = (a - (s - b_v)) + ((b - b_v) + c)$ with $b_v = s - a$: one addition fewer
+/// after $b$ than $(e + c)$, and the same value up to the rounding of the error terms
+/// ($u^2 |s|$, $u$ the unit roundoff).
+#[inline(always)]
+pub fn sum_corrected(a: f64, b: f64, c: f64) -> f64 {
+    let s = a + b;
+    let b_virtual = s - a;
+    s + ((a - (s - b_virtual)) + ((b - b_virtual) + c))
 }
 
 /// $p = \mathrm{fl}(a b)$ and its rounding error $a b - p$: a fused multiply-add where `std`
@@ -731,8 +749,7 @@ where
         // y0 = G z0: exact up to O(|K dn/dy| |r(y0)|), so for small steps it meets the
         // residual test and no Jacobian is evaluated (Newton would return it with 0
         // iterations)
-        let n0 = system.forcing(&offset, h, theta);
-        let fixed_point = offset - system.core_forcing(factors, &n0);
+        let fixed_point = offset - system.core_forcing(factors, &offset, h, theta);
         let n1 = system.forcing(&fixed_point, h, theta);
         let r1 = system.core_residual(factors, &offset, &fixed_point, &n1);
         let norm1 = finite_max_abs(&r1);
@@ -868,17 +885,21 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{Dot2, Split, two_product, two_sum};
+    use super::{Dot2, Split, sum_corrected, two_product, two_sum};
 
-    #[test]
-    fn the_error_free_transformations_are_exact() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
+    /// Uniform draws in [-0.5, 0.5) (xorshift from `state`).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        }
+    }
+
+    #[test]
+    fn the_error_free_transformations_are_exact() {
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15);
         for _ in 0..10_000 {
             let (a, b) = (next() * 1e3, next() * 1e-3);
             let (p, e) = two_product(a, b);
@@ -901,5 +922,26 @@ mod tests {
         sum.add_split_product(a, b);
         sum.add_split_product(c, d);
         assert_eq!(sum.value(), -f64::EPSILON * f64::EPSILON);
+    }
+
+    #[test]
+    fn a_corrected_sum_keeps_a_correction_below_the_last_bit() {
+        let mut next = uniform(0x2545_f491_4f6c_dd1d);
+        let mut kept = 0;
+        for _ in 0..10_000 {
+            // a correction of the size of the rounding error of a + b, either order of size
+            let (a, b) = (next(), next() * 1e-3);
+            let (a, b) = if next() < 0.0 { (a, b) } else { (b, a) };
+            let c = next() * f64::EPSILON;
+            // the sum a + b + c rounded once (Dot2: exact here, then one rounding)
+            let mut exact = Dot2::exact(a);
+            exact.add_exact(b);
+            exact.add_exact(c);
+            let (exact, sum) = (exact.value(), sum_corrected(a, b, c));
+            assert_eq!(sum, exact, "{a} + {b} + {c}");
+            kept += usize::from(sum == exact && a + b != exact);
+        }
+        // the correction changed the rounded sum in many of the draws, and was kept
+        assert!(kept > 1000, "{kept}");
     }
 }

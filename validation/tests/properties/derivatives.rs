@@ -457,8 +457,35 @@ fn reduced_agrees<Sys, const S: usize, const M: usize, const R: usize>(
                 "theta {theta}, step {i}: reduced and general differ by {err:e}"
             );
             assert!(report.iterations <= 6);
+            scaled_forcing_agrees(sys, &z, h, theta);
             z = general;
         }
+    }
+}
+
+/// The generated `core_forcing` (the entries of K multiplied into the products of n) is
+/// K n(y) as the product of the factors' K with the generated n(y), to rounding, at the
+/// force-free guess y = G z0 of a step from `z`.
+fn scaled_forcing_agrees<Sys, const S: usize, const M: usize, const R: usize>(
+    sys: &Sys,
+    z: &SVector<f64, S>,
+    h: f64,
+    theta: f64,
+) where
+    Sys: retract::ReducedScheme<S, M, R>,
+{
+    let factors = retract::ReducedFactors::new(sys, h, theta).expect("factors");
+    let y = sys.core_offset(&factors, z);
+    let n = sys.forcing(&y, h, theta);
+    let scaled = sys.core_forcing(&factors, &y, h, theta);
+    for m in 0..R {
+        let terms = (0..M).map(|q| factors.k[(m, q)] * n[q]);
+        let (expected, size) = terms.fold((0.0, 0.0), |(s, a), t| (s + t, a + t.abs()));
+        assert!(
+            (scaled[m] - expected).abs() <= 16.0 * f64::EPSILON * size,
+            "theta {theta}, row {m}: K n(y) = {expected:e}, core_forcing {:e}",
+            scaled[m]
+        );
     }
 }
 
