@@ -23,6 +23,7 @@ mod optimize;
 mod placement;
 mod plan_sensitivity;
 mod realtime;
+mod restoration;
 mod sensitivity;
 mod stage_systems;
 mod typed_data;
