@@ -17,7 +17,7 @@ use std::time::Instant;
 use retract::bvp::{
     Curve, FreeTime, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, Variable,
 };
-use retract::{higher_order_lagrangian, jet_function};
+use retract::higher_order_lagrangian;
 
 #[path = "common/cart_pole.rs"]
 mod cart_pole;
@@ -27,6 +27,10 @@ use cart_pole::{CartForce, CartPole, MinTimeCartPole, PoleTorque};
 mod parking;
 use parking::{CarEffort, SideSlip, Turning};
 
+#[path = "common/quadrotor.rs"]
+mod quadrotor;
+use quadrotor::{Clearance, Lateral, Quadrotor, Rotors};
+
 const G: f64 = 9.81;
 
 /// What a suite returns: an error for its first failure.
@@ -34,44 +38,6 @@ type Outcome = Result<(), Box<dyn std::error::Error>>;
 
 /// A suite of problems, run at full or reduced size.
 type Suite = fn(bool) -> Outcome;
-
-/// Planar quadrotor, q = (x, z, theta): cost 1/2 (f1^2 + f2^2) of the rotor thrusts
-/// f1,2 = Th/2 -+ tq/(2a), Th = -fx sin(theta) + fz cos(theta), fx = m x'', fz = m z'' + m g,
-/// tq = I theta''.
-#[higher_order_lagrangian(order = 2)]
-fn quadrotor(_q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> f64 {
-    let (s, c) = (_q[2].sin(), _q[2].cos());
-    let thrust = -m * ddq[0] * s + (m * ddq[1] + m * 9.81) * c;
-    let torque = inertia * ddq[2];
-    let f1 = 0.5 * thrust - torque / (2.0 * arm);
-    let f2 = 0.5 * thrust + torque / (2.0 * arm);
-    0.5 * (f1 * f1 + f2 * f2)
-}
-
-/// The quadrotor's lateral body force fx cos(theta) + fz sin(theta) (two rotors cannot push
-/// sideways: an equality).
-#[jet_function(order = 2)]
-fn lateral(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64) -> f64 {
-    m * ddq[0] * q[2].cos() + (m * ddq[1] + m * 9.81) * q[2].sin()
-}
-
-/// The rotor thrusts (f1, f2) = Th/2 -+ tq/(2a): one function with two components, each
-/// bounded to [0, fmax].
-#[jet_function(order = 2)]
-fn rotors(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> [f64; 2] {
-    let thrust = -m * ddq[0] * q[2].sin() + (m * ddq[1] + m * 9.81) * q[2].cos();
-    let torque = inertia * ddq[2];
-    [
-        0.5 * thrust - torque / (2.0 * arm),
-        0.5 * thrust + torque / (2.0 * arm),
-    ]
-}
-
-/// Clearance of the disc of radius 0.3 about (1, 0.5): (x - 1)^2 + (z - 0.5)^2 - 0.3^2.
-#[jet_function(order = 2)]
-fn clearance(q: [f64; 3], _dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
-    (q[0] - 1.0).powi(2) + (q[1] - 0.5).powi(2) - 0.09
-}
 
 /// The planar n-link chain's cost 1/2 |tau|^2, tau the Euler-Lagrange torques of T - V (unit
 /// lengths and masses at the link ends, joint angles relative, q_1 from the downward vertical):

@@ -22,35 +22,8 @@ mod pendulum;
 #[path = "common/upright.rs"]
 mod upright;
 
-use upright::{Mode, quantile, run};
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let modes = [Mode::Rti(1), Mode::Rti(2), Mode::Full];
-    let mut feedback = Vec::new();
-    for kick in [2.0, 8.0] {
-        for mode in modes {
-            let out = run(kick, mode)?;
-            println!(
-                "kick={kick} mode={} max_dev={:.4} settle_s={:.2} median_us={:.1} p99_us={:.1} failures={}",
-                mode.name(),
-                out.max_dev,
-                out.settle_s,
-                quantile(&out.replan_us, 0.5),
-                quantile(&out.replan_us, 0.99),
-                out.failures,
-            );
-            if mode != Mode::Full {
-                feedback.push(format!(
-                    "feedback kick={kick} mode={} median_us={:.1} p99_us={:.1} max_us={:.1}",
-                    mode.name(),
-                    quantile(&out.feedback_us, 0.5),
-                    quantile(&out.feedback_us, 0.99),
-                    quantile(&out.feedback_us, 1.0),
-                ));
-            }
-        }
-    }
-    for line in feedback {
+    for line in upright::lines()? {
         println!("{line}");
     }
     Ok(())

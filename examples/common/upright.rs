@@ -299,6 +299,45 @@ pub struct Outcome {
     pub max_torque: f64,
 }
 
+/// The benchmark's lines for every kick (2, 8) and mode (one and two real-time iterations a
+/// period, full solves): one
+/// `kick=<k> mode=<rti1|rti2|full> max_dev=<d> settle_s=<s> median_us=<m> p99_us=<p> failures=<f>`
+/// per run, then for the real-time modes
+/// `feedback kick=<k> mode=<rti1|rti2> median_us=<m> p99_us=<p> max_us=<x>`.
+///
+/// # Errors
+/// A run that fails ([`run`]).
+pub fn lines() -> Result<Vec<String>, Box<dyn std::error::Error>> {
+    let modes = [Mode::Rti(1), Mode::Rti(2), Mode::Full];
+    let (mut runs, mut feedback) = (Vec::new(), Vec::new());
+    for kick in [2.0, 8.0] {
+        for mode in modes {
+            let out = run(kick, mode)?;
+            runs.push(format!(
+                "kick={kick} mode={} max_dev={:.4} settle_s={:.2} median_us={:.1} p99_us={:.1} \
+                 failures={}",
+                mode.name(),
+                out.max_dev,
+                out.settle_s,
+                quantile(&out.replan_us, 0.5),
+                quantile(&out.replan_us, 0.99),
+                out.failures,
+            ));
+            if mode != Mode::Full {
+                feedback.push(format!(
+                    "feedback kick={kick} mode={} median_us={:.1} p99_us={:.1} max_us={:.1}",
+                    mode.name(),
+                    quantile(&out.feedback_us, 0.5),
+                    quantile(&out.feedback_us, 0.99),
+                    quantile(&out.feedback_us, 1.0),
+                ));
+            }
+        }
+    }
+    runs.extend(feedback);
+    Ok(runs)
+}
+
 /// The `p`-quantile (0..=1) of `times`, nearest rank.
 pub fn quantile(times: &[f64], p: f64) -> f64 {
     let mut sorted = times.to_vec();

@@ -2,43 +2,8 @@
 //! slacks of the thrust bounds and the disc at their bounds, the steps cut to nothing) is
 //! brought back to the feasible region and the plan certified.
 
+use crate::quadrotor::{Clearance, Lateral, Quadrotor, Rotors};
 use retract::bvp::{Curve, OptimalControlProblem, PlanGuess, PlanOptions};
-use retract::{higher_order_lagrangian, jet_function};
-
-/// Planar quadrotor, q = (x, z, theta): cost 1/2 (f1^2 + f2^2) of the rotor thrusts (the
-/// constrained suite's model, `examples/constrained.rs`).
-#[higher_order_lagrangian(order = 2)]
-fn quadrotor(_q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> f64 {
-    let (s, c) = (_q[2].sin(), _q[2].cos());
-    let thrust = -m * ddq[0] * s + (m * ddq[1] + m * 9.81) * c;
-    let torque = inertia * ddq[2];
-    let f1 = 0.5 * thrust - torque / (2.0 * arm);
-    let f2 = 0.5 * thrust + torque / (2.0 * arm);
-    0.5 * (f1 * f1 + f2 * f2)
-}
-
-/// The lateral body force, which two rotors cannot produce (an equality).
-#[jet_function(order = 2)]
-fn lateral(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64) -> f64 {
-    m * ddq[0] * q[2].cos() + (m * ddq[1] + m * 9.81) * q[2].sin()
-}
-
-/// The rotor thrusts (f1, f2), each bounded to [0, fmax].
-#[jet_function(order = 2)]
-fn rotors(q: [f64; 3], _dq: [f64; 3], ddq: [f64; 3], m: f64, inertia: f64, arm: f64) -> [f64; 2] {
-    let thrust = -m * ddq[0] * q[2].sin() + (m * ddq[1] + m * 9.81) * q[2].cos();
-    let torque = inertia * ddq[2];
-    [
-        0.5 * thrust - torque / (2.0 * arm),
-        0.5 * thrust + torque / (2.0 * arm),
-    ]
-}
-
-/// Clearance of the disc of radius 0.3 about (1, 0.5).
-#[jet_function(order = 2)]
-fn clearance(q: [f64; 3], _dq: [f64; 3], _ddq: [f64; 3]) -> f64 {
-    (q[0] - 1.0).powi(2) + (q[1] - 0.5).powi(2) - 0.09
-}
 
 /// The quadrotor of the constrained suite (thrusts in [0, 15], the disc, T = 2, N = 50) from
 /// the zero guess: every thrust starts at its lower bound, far from the hover thrust; the

@@ -13,9 +13,10 @@
 use std::io::Write;
 
 use crate::Error;
-use crate::upright::{Mode, quantile, run};
+use crate::upright;
 
-/// Runs the loop for every kick and mode and writes its lines to `out` under a heading.
+/// Runs the loop for every kick and mode ([`upright::lines`]) and writes its lines to `out`
+/// under a heading.
 ///
 /// # Errors
 /// A re-plan that fails to set up (a plan that fails inside the loop is counted in
@@ -26,34 +27,7 @@ pub fn write(out: &mut dyn Write) -> Result<(), Error> {
         "\n### Receding horizon\n\nThe double pendulum held upright (`examples/common/upright.rs`; \
          a period's re-plan, then the feedback phase alone):\n\n```text"
     )?;
-    let modes = [Mode::Rti(1), Mode::Rti(2), Mode::Full];
-    let mut feedback = Vec::new();
-    for kick in [2.0, 8.0] {
-        for mode in modes {
-            let outcome = run(kick, mode).map_err(|e| Error::Plan(e.to_string()))?;
-            writeln!(
-                out,
-                "kick={kick} mode={} max_dev={:.4} settle_s={:.2} median_us={:.1} p99_us={:.1} \
-                 failures={}",
-                mode.name(),
-                outcome.max_dev,
-                outcome.settle_s,
-                quantile(&outcome.replan_us, 0.5),
-                quantile(&outcome.replan_us, 0.99),
-                outcome.failures,
-            )?;
-            if mode != Mode::Full {
-                feedback.push(format!(
-                    "feedback kick={kick} mode={} median_us={:.1} p99_us={:.1} max_us={:.1}",
-                    mode.name(),
-                    quantile(&outcome.feedback_us, 0.5),
-                    quantile(&outcome.feedback_us, 0.99),
-                    quantile(&outcome.feedback_us, 1.0),
-                ));
-            }
-        }
-    }
-    for line in feedback {
+    for line in upright::lines().map_err(|e| Error::Plan(e.to_string()))? {
         writeln!(out, "{line}")?;
     }
     writeln!(out, "```")?;
