@@ -295,8 +295,6 @@ pub struct Outcome {
     pub feedback_us: Vec<f64>,
     /// Periods whose re-plan failed.
     pub failures: usize,
-    /// The largest |tau| applied.
-    pub max_torque: f64,
 }
 
 /// The benchmark's lines for every kick (2, 8) and mode (one and two real-time iterations a
@@ -368,7 +366,6 @@ pub fn run(kick: f64, mode: Mode) -> Result<Outcome, Box<dyn std::error::Error>>
         replan_us: Vec::with_capacity(PERIODS),
         feedback_us: Vec::with_capacity(PERIODS),
         failures: 0,
-        max_torque: 0.0,
     };
     let mut last_unsettled = None;
     for period in 0..PERIODS {
@@ -383,9 +380,7 @@ pub fn run(kick: f64, mode: Mode) -> Result<Outcome, Box<dyn std::error::Error>>
         out.replan_us.push(started.elapsed().as_secs_f64() * 1e6);
         out.feedback_us.push(applied.feedback_us);
         out.failures += usize::from(applied.failed() || prepare_failed);
-        let tau = applied.tau;
-        out.max_torque = out.max_torque.max(tau[0].abs()).max(tau[1].abs());
-        (z, jet) = plant_step(&plant, &z, &jet, tau)?;
+        (z, jet) = plant_step(&plant, &z, &jet, applied.tau)?;
         if period >= KICK_PERIOD {
             let dev = deviation(&jet);
             out.max_dev = out.max_dev.max(dev);

@@ -9,7 +9,8 @@
 //! with `-- --quick` for the same lines at reduced size in a few seconds; `-- --batch` prints
 //! only the plans across cores (`batch <name> threads=<t> plans_per_s=<p> scaling=<s>`),
 //! `-- --steps` only the one-step table (`step ratio generated/hand-written: ...`), `-- --mpc`
-//! only the receding horizon (the lines of `--example mpc` of `retract`);
+//! only the receding horizon (the lines of `--example mpc` of `retract`; at full size under
+//! `--quick` too, 0.1 s);
 //! `-- --write docs/benchmarks.md` also writes the report into that file, between its lines
 //! `<!-- report:begin ... -->` and `<!-- report:end -->`.
 

@@ -8,8 +8,8 @@
 //! systems ([`systems`]), the peers ([`peers`]: hand-written steps, dual-number and
 //! finite-difference Newton, RK4 and DOP853 on plain right-hand sides), the timing
 //! ([`timing`]: interleaved rounds) and the measurements ([`step_speed`], [`guard_cost`],
-//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`], [`sphere_cubic`], [`receding_horizon`]), which [`report`]
-//! runs and prints in one go.
+//! [`work_precision`], [`long_run`], [`planner_speed`], [`batch_speed`], [`expansion_cost`],
+//! [`sphere_cubic`], [`receding_horizon`]), which [`report`] runs and prints in one go.
 
 pub mod batch_speed;
 mod error;

@@ -15,8 +15,8 @@ use std::io::Write;
 use crate::Error;
 use crate::upright;
 
-/// Runs the loop for every kick and mode ([`upright::lines`]) and writes its lines to `out`
-/// under a heading.
+/// Runs the loop for every kick and mode (`upright::lines` of `examples/common/upright.rs`)
+/// and writes its lines to `out` under a heading.
 ///
 /// # Errors
 /// A re-plan that fails to set up (a plan that fails inside the loop is counted in

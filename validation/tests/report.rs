@@ -78,9 +78,9 @@ fn quick_report_prints_the_work_precision_line() {
 }
 
 /// The receding horizon's lines: one `kick=<k> mode=<m> ...` line per kick (2, 8) and mode
-/// (rti1, rti2, full), each held upright without a failed re-plan and settled (a finite
-/// settling time), positive times with the median below the 99th percentile; one `feedback`
-/// line per kick and real-time mode.
+/// (rti1, rti2, full), each held upright (its largest deviation below pi) without a failed
+/// re-plan and settled (a finite settling time), a positive median time; one `feedback` line
+/// per kick and real-time mode.
 fn receding_horizon_lines(text: &str) {
     let field = |line: &str, key: &str| -> f64 {
         let value = (line.split(' '))
@@ -98,8 +98,13 @@ fn receding_horizon_lines(text: &str) {
             let line = lines[0];
             assert_eq!(field(line, "failures="), 0.0, "{line}");
             assert!(field(line, "settle_s=").is_finite(), "{line}");
-            let (median, p99) = (field(line, "median_us="), field(line, "p99_us="));
-            assert!(median > 0.0 && median <= p99, "{line}");
+            assert!(field(line, "median_us=") > 0.0, "{line}");
+            // held: the pendulum never swings past the horizontal of the other side
+            let deviation = field(line, "max_dev=");
+            assert!(
+                deviation > 0.0 && deviation < std::f64::consts::PI,
+                "{line}"
+            );
             if mode != "full" {
                 let feedback = format!("feedback kick={kick} mode={mode} median_us=");
                 assert!(text.lines().any(|l| l.starts_with(&feedback)), "{feedback}");

@@ -115,7 +115,8 @@ impl Barrier {
     /// The barrier of a primal-dual warm start from `duals` (which fit the layout `(count,
     /// nodes, steps)`) at an iterate where the inequalities take `values`, pair by pair
     /// ([`Self::warm_pair`]), and the plan's barrier parameter $\mu$ = `duals.barrier`, at
-    /// least `floor`: a plan's is at its floor, so the barrier is not restarted from $\mu_0$
+    /// least `floor`: a plan's is at its floor (or, certified at the acceptable level, a few
+    /// times above it), so the barrier is not restarted from $\mu_0$
     /// (which would first undo the plan's complementarity), and an unfinished plan's (a
     /// real-time iteration's) goes on from where it was.
     pub fn warm<const N: usize>(

@@ -25,8 +25,9 @@
 //! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
 //! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
 //! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
-//! without correction; its [`Certificate`](super::Certificate) holds the residuals and the smallest eigenvalue of
-//! the reduced Hessian (Lanczos on the inverse, [`super::kkt::residuals`]).
+//! without correction; its [`Certificate`](super::Certificate) holds the residuals and the
+//! smallest eigenvalue of the reduced Hessian (Lanczos on the inverse,
+//! [`super::kkt::residuals`]).
 //!
 //! One iteration runs the phases in turn, each a module of methods of [`Sqp`] (`state.rs`
 //! holds it and what the phases pass each other): `models` (the stage models at the
@@ -65,6 +66,7 @@ mod second_order;
 mod state;
 mod termination;
 
+use acceptable::Kept;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
@@ -79,11 +81,11 @@ type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanErr
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
 
-/// Consecutive iterations of only rounding-level progress at the barrier's floor, with the
-/// error above the acceptable level, after which the point kept before the floor is
-/// returned ([`acceptable`]). (Three end solves that would reach the tolerance a few dozen
-/// iterations later; ten leave them, and end the stalls of a degenerate inequality within
-/// about 35 iterations of the floor.)
+/// Consecutive iterations at the barrier's floor of only rounding-level progress (counted
+/// from the floor on), with the error above the acceptable level, after which the point kept
+/// before the floor is returned ([`acceptable`]). (Three end solves that would reach the
+/// tolerance a few dozen iterations later; ten leave them, and end the stalls of a degenerate
+/// inequality within about 35 iterations of the floor.)
 const STALLED_AT_FLOOR: usize = 10;
 
 /// Consecutive iterations at which the goal stays out of the subproblems' reach
@@ -313,6 +315,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        let mut floor_stalled = 0;
         let mut unreachable = 0;
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
@@ -395,14 +398,8 @@ where
                 } else {
                     sub
                 };
-            // at the floor with only rounding-level progress left, the error above the
-            // acceptable level: the point kept before the floor
-            let stuck = st.barrier.mu <= floor
-                && stalled >= STALLED_AT_FLOOR
-                && sub.error > options.acceptable;
-            let ending = iterations == options.max_iterations && !self.real_time;
-            if (ending || stuck)
-                && let Some(plan) = self.acceptable_exit(&mut st.acceptable, iterations)
+            if let Some(plan) =
+                self.exit_at_kept(&mut st.acceptable, (floor_stalled, sub.error), iterations)
             {
                 self.give_models(models);
                 self.give_subproblem(sub);
@@ -458,9 +455,30 @@ where
             self.pool.borrow_mut().reals.give(ds);
             self.give_models(models);
             stalled = if at_rounding { stalled + 1 } else { 0 };
+            let at_floor = at_rounding && st.barrier.mu <= floor;
+            floor_stalled = if at_floor { floor_stalled + 1 } else { 0 };
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
         }
+    }
+
+    /// The plan at the point kept before the barrier's floor ([`acceptable`]), where the
+    /// iteration is stuck (the last `floor_stalled` iterations, at least
+    /// [`STALLED_AT_FLOOR`], made only rounding-level progress at the floor and `error`, the
+    /// current $\max$(stationarity, feasibility), is above the acceptable level) or at its
+    /// limit after `iterations` (not in a real-time iteration); `None` otherwise, or where the
+    /// kept point (`kept`, taken if tried) is not certified.
+    fn exit_at_kept(
+        &self,
+        kept: &mut Option<Kept<N, X>>,
+        (floor_stalled, error): (usize, f64),
+        iterations: usize,
+    ) -> Option<Plan<N, X>> {
+        let stuck = floor_stalled >= STALLED_AT_FLOOR && error > self.options.acceptable;
+        let ending = iterations == self.options.max_iterations && !self.real_time;
+        (stuck || ending)
+            .then(|| self.acceptable_exit(kept, iterations))
+            .flatten()
     }
 
     /// $\mu$ decreased at a point `st` where the barrier problem is solved (the filter reset

@@ -27,8 +27,8 @@
 //! The phase returns at the first iterate whose violation, with the slacks $s_k = g_k +
 //! n_k$, is at most $\kappa_R \theta_R$ ($\kappa_R = 0.9$) and which the filter, augmented
 //! by the point where it failed, accepts; the multipliers $z$ are reset as IPOPT's
-//! ([`Barrier::restart`]), those of the stage equalities kept as they were (IPOPT recomputes them by least squares). Where the
-//! barrier problem is solved at the smallest $\mu_R$ with the violation still above the
+//! ([`Barrier::restart`]), those of the stage equalities kept as they were (IPOPT recomputes
+//! them by least squares). Where the barrier problem is solved at the smallest $\mu_R$ with the violation still above the
 //! tolerance, the point is locally infeasible. The phase gives up (and the penalty search's
 //! step is taken) after [`MAX_RESTORATION`] steps, or [`STALL`] steps without progress.
 
