@@ -54,8 +54,15 @@ where
             value: SVector::zeros(),
             node: None,
         };
-        self.add_equalities(&mut stage, &xb, u);
         for (j, c) in self.problem.equalities.iter().enumerate() {
+            let grad = c.gradient(&xb, u);
+            stage.value[j] = c.value(&xb, u);
+            for r in 0..X {
+                stage.cx[(j, r)] = grad.x[r / N][r % N];
+            }
+            for a in 0..N {
+                stage.cu[(j, a)] = grad.u[a];
+            }
             if y[j] != 0.0 {
                 let (cxx, cux, cuu) = flat_hessian::<N, K, X>(&c.hessian(&xb, u), y[j]);
                 hxx += cxx;
@@ -79,27 +86,6 @@ where
             stage.node = self.node_curvature(iterate, i, barrier);
         }
         derivatives.value
-    }
-
-    /// Sets the stage equalities' rows of `stage` at the point `(xb, u)`: their number,
-    /// values $g$ and Jacobians $\partial g / \partial x_\theta$, $\partial g / \partial u$.
-    pub(super) fn add_equalities(
-        &self,
-        stage: &mut StageModel<N, X>,
-        xb: &[SVector<f64, N>; K],
-        u: &SVector<f64, N>,
-    ) {
-        stage.constraints = self.problem.equalities.len();
-        for (j, c) in self.problem.equalities.iter().enumerate() {
-            let grad = c.gradient(xb, u);
-            stage.value[j] = c.value(xb, u);
-            for r in 0..X {
-                stage.cx[(j, r)] = grad.x[r / N][r % N];
-            }
-            for a in 0..N {
-                stage.cu[(j, a)] = grad.u[a];
-            }
-        }
     }
 
     /// The curvature $-h y \nabla^2 g$ of the inequalities at node `i` (interior nodes
