@@ -23,6 +23,13 @@ use crate::bvp::iterate::Iterate;
 use crate::bvp::plan::Plan;
 use crate::{Lagrangian, LiftedSystem};
 
+/// Consecutive iterations at the barrier's floor of only rounding-level progress (counted
+/// from the floor on), with the error above the acceptable level, after which the point kept
+/// before the floor is returned ([`Sqp::exit_at_kept`]). (Three end solves that would reach the
+/// tolerance a few dozen iterations later; ten leave them, and end the stalls of a degenerate
+/// inequality within about 35 iterations of the floor.)
+const STALLED_AT_FLOOR: usize = 10;
+
 /// A point kept for the acceptable-level exit: the iterate, the stage equalities'
 /// multipliers and the barrier (its $\mu$, slacks and multipliers).
 pub(super) struct Kept<const N: usize, const X: usize> {
@@ -80,13 +87,23 @@ where
         }
     }
 
-    /// The plan at the point `kept` held (taken, its vectors given back to the pool) after
-    /// `iterations`: [`Self::finish_kept`]; `None` without a kept point.
-    pub(super) fn acceptable_exit(
+    /// The plan at the point kept before the barrier's floor, where the iteration is stuck
+    /// (the last `floor_stalled` iterations, at least [`STALLED_AT_FLOOR`], made only
+    /// rounding-level progress at the floor and `error`, the current $\max$(stationarity,
+    /// feasibility), is above the acceptable level) or at its limit after `iterations` (not
+    /// in a real-time iteration): [`Self::finish_kept`] at the point `kept` held, which is
+    /// taken (tried once) and its vectors given back to the pool; `None` otherwise.
+    pub(super) fn exit_at_kept(
         &self,
         kept: &mut Option<Kept<N, X>>,
+        (floor_stalled, error): (usize, f64),
         iterations: usize,
     ) -> Option<Plan<N, X>> {
+        let stuck = floor_stalled >= STALLED_AT_FLOOR && error > self.options.acceptable;
+        let ending = iterations == self.options.max_iterations && !self.real_time;
+        if !(stuck || ending) {
+            return None;
+        }
         let point = kept.take()?;
         let plan = self.finish_kept(&point, iterations);
         self.give_kept(point);

@@ -62,7 +62,6 @@ mod second_order;
 mod state;
 mod termination;
 
-use acceptable::Kept;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 pub(super) use state::Sqp;
@@ -76,13 +75,6 @@ type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanErr
 /// The error below which a full step's factorisation is kept for a simplified Newton step
 /// at the next iterate.
 const CHORD_ERROR: f64 = 1e-3;
-
-/// Consecutive iterations at the barrier's floor of only rounding-level progress (counted
-/// from the floor on), with the error above the acceptable level, after which the point kept
-/// before the floor is returned ([`acceptable`]). (Three end solves that would reach the
-/// tolerance a few dozen iterations later; ten leave them, and end the stalls of a degenerate
-/// inequality within about 35 iterations of the floor.)
-const STALLED_AT_FLOOR: usize = 10;
 
 /// Consecutive iterations at which the goal stays out of the subproblems' reach
 /// ([`Sqp::unreachable_goal`]) before the solve ends with [`Failure::UnreachableGoal`]; where
@@ -453,25 +445,6 @@ where
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
         }
-    }
-
-    /// The plan at the point kept before the barrier's floor ([`acceptable`]), where the
-    /// iteration is stuck (the last `floor_stalled` iterations, at least
-    /// [`STALLED_AT_FLOOR`], made only rounding-level progress at the floor and `error`, the
-    /// current $\max$(stationarity, feasibility), is above the acceptable level) or at its
-    /// limit after `iterations` (not in a real-time iteration); `None` otherwise, or where the
-    /// kept point (`kept`, taken if tried) is not certified.
-    fn exit_at_kept(
-        &self,
-        kept: &mut Option<Kept<N, X>>,
-        (floor_stalled, error): (usize, f64),
-        iterations: usize,
-    ) -> Option<Plan<N, X>> {
-        let stuck = floor_stalled >= STALLED_AT_FLOOR && error > self.options.acceptable;
-        let ending = iterations == self.options.max_iterations && !self.real_time;
-        (stuck || ending)
-            .then(|| self.acceptable_exit(kept, iterations))
-            .flatten()
     }
 
     /// $\mu$ decreased at a point `st` where the barrier problem is solved (the filter reset
