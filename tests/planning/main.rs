@@ -23,6 +23,7 @@ mod optimize;
 mod placement;
 mod plan_sensitivity;
 mod realtime;
+mod restoration;
 mod sensitivity;
 mod stage_systems;
 mod typed_data;
@@ -44,6 +45,9 @@ mod car_models;
 // the parking car of the constrained suite, shared with `examples/constrained.rs`
 #[path = "../../examples/common/parking.rs"]
 mod parking;
+// the quadrotor of the constrained suite, shared with `examples/constrained.rs`
+#[path = "../../examples/common/quadrotor.rs"]
+mod quadrotor;
 
 // the double pendulum's models and receding-horizon loop, shared with the examples
 #[path = "../../examples/common/pendulum.rs"]

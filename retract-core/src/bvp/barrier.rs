@@ -39,6 +39,10 @@ const WARM_CENTRE: f64 = 1e2;
 /// \kappa_\Sigma \mu / s]$.
 const KAPPA_SIGMA: f64 = 1e10;
 
+/// The largest multiplier $h z$ kept by [`Barrier::restart`] (IPOPT's
+/// `bound_mult_reset_threshold`).
+const MULTIPLIER_RESET: f64 = 1000.0;
+
 /// The ratio $s / g$ below which a slack is reset to its inequality's value $g > 0$
 /// ([`Barrier::reset_slacks`]).
 const SLACK_RESET: f64 = 1e-3;
@@ -513,6 +517,25 @@ impl Barrier {
             }
         }
         reset
+    }
+
+    /// Restarts at the slacks `s` (after the feasibility restoration phase), with IPOPT's
+    /// reset of the multipliers (its `bound_mult_reset_threshold`): where the largest
+    /// multiplier in the transcribed problem's units, $h z_k$, is above
+    /// [`MULTIPLIER_RESET`], every $z_k = \mu / s_k$ (centred); otherwise each is kept within
+    /// the safeguard of [`Self::update`], $z_k \in [\mu / (\kappa_\Sigma s_k), \kappa_\Sigma
+    /// \mu / s_k]$. The curvature multipliers follow, $y_k = z_k$.
+    pub fn restart(&mut self, s: &[f64], h: f64) {
+        self.s.copy_from_slice(s);
+        let reset = self.z.iter().any(|z| h * z > MULTIPLIER_RESET);
+        for ((z, y), s) in self.z.iter_mut().zip(&mut self.y).zip(s) {
+            *z = if reset {
+                self.mu / s
+            } else {
+                z.clamp(self.mu / (KAPPA_SIGMA * s), KAPPA_SIGMA * self.mu / s)
+            };
+            *y = *z;
+        }
     }
 
     /// Lowers $\mu$ towards `floor` by IPOPT's monotone rule on the transcribed problem's

@@ -92,6 +92,19 @@ pub struct PlanOptions {
     /// Not in [`OptimalControlProblem::solve_real_time`](crate::bvp::OptimalControlProblem::solve_real_time).
     #[cfg_attr(feature = "serde", serde(default = "default_escapes"))]
     pub saddle_escapes: usize,
+    /// Whether the feasibility restoration phase runs (Wächter and Biegler, sec. 3.3; off by
+    /// default): where neither the filter line search nor the exact-penalty search makes
+    /// progress (a step below $\gamma_\alpha \gamma_\theta = 5 \cdot 10^{-7}$), the
+    /// iteration minimises the constraint violation (elastic inequality rows, a proximity
+    /// term) until the filter accepts a point, or names the point locally infeasible. With
+    /// it, the constrained suite's quadrotor started from the zero guess is certified in
+    /// 46 of the 48 variants of thrust limit, goal, horizon and N (none without); the suite
+    /// itself is unchanged but for the minimum-time cart-pole (the same plan in 409
+    /// iterations instead of 389). Off by default: a keep-out disc centred on a node of the
+    /// straight guess, a stationary point of the violation, ends at the iteration limit
+    /// instead of being named a stalled infeasibility.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub restoration: bool,
 }
 
 /// [`PlanOptions::saddle_escapes`]'s default.
@@ -126,6 +139,7 @@ impl Default for PlanOptions {
             interior_samples: 0,
             second_order_corrections: 0,
             saddle_escapes: 2,
+            restoration: false,
         }
     }
 }
@@ -220,6 +234,11 @@ impl PlanOptions {
     /// ([`Self::second_order_corrections`]; 0 turns them off).
     pub fn with_second_order_corrections(mut self, corrections: usize) -> Self {
         self.second_order_corrections = corrections;
+        self
+    }
+    /// Turns the feasibility restoration phase on or off ([`Self::restoration`]).
+    pub fn with_restoration(mut self, restoration: bool) -> Self {
+        self.restoration = restoration;
         self
     }
     /// Sets the most escapes from saddles per solve ([`Self::saddle_escapes`]; 0 turns them

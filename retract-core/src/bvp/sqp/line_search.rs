@@ -9,12 +9,14 @@
 //! Armijo's condition on $\varphi$, or it reduces $\theta$ by a factor $1 - \gamma_\theta$ or
 //! $\varphi$ by $\gamma_\varphi \theta$; in the second case the filter is augmented by
 //! $((1 - \gamma_\theta) \theta, \varphi - \gamma_\varphi \theta)$. The filter is emptied when
-//! $\mu$ decreases.
+//! $\mu$ decreases. Where neither search makes progress, the feasibility restoration phase
+//! ([`super::restoration`]) looks for a point the filter accepts.
 
 use nalgebra::SVector;
 
 use super::correction::Corrected;
 use super::filter::Filter;
+use super::restoration::Restoration;
 use super::state::{Models, Sqp};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::{Iterate, blocks};
@@ -32,13 +34,15 @@ const DELTA: f64 = 1.0;
 const GAMMA_ALPHA: f64 = 0.05;
 
 /// An accepted trial point: the iterate, the step length, whether the decrease it was
-/// accepted on is at rounding level, and the corrected step it was taken along, if a
-/// second-order correction was accepted.
+/// accepted on is at rounding level, the corrected step it was taken along, if a
+/// second-order correction was accepted, and, if the point comes from the feasibility
+/// restoration phase, its slacks and the phase's steps.
 pub(super) struct Accepted<const N: usize, const X: usize> {
     pub trial: Iterate<N, X>,
     pub alpha: f64,
     pub at_rounding: bool,
     pub corrected: Option<Corrected<N, X>>,
+    pub restored: Option<(Vec<f64>, usize)>,
 }
 
 /// The subproblem a line search searches along: the iterate, its models, the direction and,
@@ -173,7 +177,9 @@ where
     }
 
     /// Moves to the `accepted` point along `direction` with slack steps `ds` (or along its
-    /// corrected step): the iterate; the slacks and the multipliers $z$ by its step length
+    /// corrected step; or, for a point of the restoration phase, to it with its slacks, the
+    /// multipliers restarted by [`Barrier::restart`] and the stage equalities' at 0): the
+    /// iterate; the slacks and the multipliers $z$ by its step length
     /// (then the slacks far below their inequality's value reset, [`Barrier::reset_slacks`],
     /// from the values the trial's merit evaluation kept);
     /// the stage equalities' multipliers `y` toward the direction's by the same primal step
@@ -185,6 +191,13 @@ where
         (direction, ds): (&Direction<N, X>, &[f64]),
         (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
     ) -> (f64, bool, bool) {
+        if let Some((slacks, _)) = accepted.restored.take() {
+            let left = core::mem::replace(iterate, accepted.trial);
+            self.give_iterate(left);
+            barrier.restart(&slacks, self.dynamics.h);
+            self.pool.borrow_mut().reals.give(slacks);
+            return (1.0, false, false);
+        }
         let alpha = accepted.alpha;
         let corrected = accepted.corrected.take();
         let (direction, ds) = match &corrected {
@@ -214,8 +227,13 @@ where
     }
 
     /// The line search: [`Self::filter_search`] with `filter` (made at the first call from
-    /// the violation there), and where it finds no step [`Self::penalty_search`] with
-    /// `penalty`.
+    /// the violation there); where it finds no step, [`Self::penalty_search`] with `penalty`;
+    /// where that fails too or its step is below $\gamma_\alpha \gamma_\theta$ (the largest
+    /// $\alpha_{\min}$ of the filter: a step that makes no progress), and
+    /// [`crate::bvp::PlanOptions::restoration`] is on, the feasibility restoration phase
+    /// ([`Self::restore`]): its point if it returns to one the filter accepts,
+    /// [`Failure::LineSearch`] if it ends at a point of local infeasibility, and otherwise
+    /// the penalty search's result.
     pub(super) fn line_search(
         &self,
         searched: Searched<'_, N, X>,
@@ -226,9 +244,37 @@ where
         let filter = filter.get_or_insert_with(|| {
             Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
         });
-        match self.filter_search(searched, slacks, filter)? {
-            Some(accepted) => Ok(accepted),
-            None => self.penalty_search(iterate, models, direction, slacks, penalty),
+        if let Some(accepted) = self.filter_search(searched, slacks, filter)? {
+            return Ok(accepted);
+        }
+        let fallback = self.penalty_search(iterate, models, direction, slacks, penalty);
+        match &fallback {
+            _ if !self.options.restoration => return fallback,
+            Ok(accepted) if accepted.alpha >= GAMMA_ALPHA * GAMMA_THETA => return fallback,
+            Err(Failure::TimeLimit) => return fallback,
+            _ => {}
+        }
+        let restored = self.restore((iterate, models), slacks.0, filter);
+        match restored {
+            Restoration::Restored(trial, s, steps) => {
+                if let Ok(accepted) = fallback {
+                    self.give_iterate(accepted.trial);
+                }
+                Ok(Accepted {
+                    trial,
+                    alpha: 1.0,
+                    at_rounding: false,
+                    corrected: None,
+                    restored: Some((s, steps)),
+                })
+            }
+            Restoration::Infeasible => {
+                if let Ok(accepted) = fallback {
+                    self.give_iterate(accepted.trial);
+                }
+                Err(Failure::LineSearch)
+            }
+            Restoration::Unfinished => fallback,
         }
     }
 
@@ -283,6 +329,7 @@ where
                     alpha,
                     at_rounding,
                     corrected: None,
+                    restored: None,
                 }));
             }
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
@@ -300,6 +347,7 @@ where
                         alpha: alpha_soc,
                         at_rounding,
                         corrected: Some(step),
+                        restored: None,
                     }));
                 }
             }
@@ -394,6 +442,7 @@ where
                     alpha,
                     at_rounding: -descent <= noise,
                     corrected: None,
+                    restored: None,
                 });
             }
             self.give_iterate(trial);

@@ -18,7 +18,9 @@
 //! so every direction descends and iterates are drawn to minima. The step length comes from
 //! IPOPT's filter line search on the barrier cost and the constraint violation, and where the
 //! filter finds no step, from backtracking on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$:
-//! all constraints), $\pi$ raised so that the direction descends; a trial point whose steps leave the domain of
+//! all constraints), $\pi$ raised so that the direction descends, and where neither makes
+//! progress from IPOPT's feasibility restoration phase (`restoration`); a trial point whose
+//! steps leave the domain of
 //! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
 //! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
 //! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
@@ -33,10 +35,11 @@
 //! [`super::kkt`]), `termination` (the KKT and barrier errors, which the loop tests against
 //! the tolerances; at a converged point the second-order check of `second_order` and the
 //! plan; `acceptable`, the acceptable-level exit at a point kept before the barrier's
-//! floor), `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback) and the
-//! step. A phase calls only the phases before it in the order `models`, `second_order`,
-//! `termination`, `direction`, `acceptable`, `line_search`; this module holds the loop
-//! ([`Sqp::run`]) and the first barrier, and calls them all. The vectors come from the workspace's pool, kept
+//! floor), `line_search` (IPOPT's filter, `filter`, with the exact-penalty fallback and the
+//! restoration phase, `restoration`) and the step. A phase calls only the phases before it
+//! in the order `models`, `second_order`, `termination`, `direction`, `acceptable`,
+//! `restoration`, `line_search`; this module holds the loop ([`Sqp::run`]) and the first
+//! barrier, and calls them all. The vectors come from the workspace's pool, kept
 //! from one solve to the next ([`super::Workspace`]).
 
 use nalgebra::SVector;
@@ -58,6 +61,7 @@ mod filter;
 mod first_multipliers;
 mod line_search;
 mod models;
+mod restoration;
 mod second_order;
 mod state;
 mod termination;
@@ -435,6 +439,9 @@ where
                     return Err(fail(failure, cost, certificate, momenta));
                 }
             };
+            // (the steps of a restoration phase count as iterations)
+            let restored = accepted.restored.as_ref().map_or(0, |r| r.1);
+            iterations = (iterations + restored).min(options.max_iterations);
             let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
             let (alpha, at_rounding, plain) = self.advance(accepted, (&sub.direction, &ds), state);
             self.pool.borrow_mut().reals.give(ds);
