@@ -206,6 +206,46 @@ fn a_guess_whose_linearisation_cannot_reach_the_goal_is_named_unreachable() {
     }
 }
 
+/// A goal already met is not named out of reach: the cart-pole swing-up (C1's model, |F| <=
+/// 6) on a coarse grid, N = 10, from the spline and from the straight line in (x, phi), ends
+/// where the subproblem cannot hold the goal (it and the pole's equality dependent) while the
+/// goal's miss is at rounding level. Whatever the outcome, an `UnreachableGoal` names a miss
+/// above the acceptable level (its advice, to start elsewhere or free the component, is
+/// about a goal that is missed).
+#[test]
+fn a_goal_already_met_is_not_named_unreachable() {
+    use crate::cart_pole::{CartForce, CartPole, PoleTorque};
+    use core::f64::consts::PI;
+    let (system, torque) = (
+        CartPole::new(1.0, 0.3, 0.5),
+        PoleTorque::new(0.3, 0.5, 9.81),
+    );
+    let force = CartForce::new(1.0, 0.3, 0.5);
+    for t_end in [3.0, 4.0] {
+        let line = Curve::from_derivatives(move |t, j| match j {
+            0 => [0.0, PI * t / t_end],
+            1 => [0.0, PI / t_end],
+            _ => [0.0; 2],
+        });
+        for (name, guess) in [
+            ("spline", PlanGuess::Spline),
+            ("line", PlanGuess::Curve(&line)),
+        ] {
+            let result =
+                OptimalControlProblem::new(&system, &[0.0; 4], &[0.0, PI, 0.0, 0.0], t_end, 10)
+                    .with_equality(&torque)
+                    .with_function_bounds(&force, -6.0, 6.0)
+                    .solve(guess);
+            if let Err(e) = result
+                && let Failure::UnreachableGoal { miss, .. } = e.failure
+            {
+                let acceptable = PlanOptions::default().acceptable;
+                assert!(miss > acceptable, "T = {t_end}, {name}: {e}");
+            }
+        }
+    }
+}
+
 /// A cost singular in a whole direction: the cart-pole's 1/2 F^2 with the pole left free (no
 /// equality), so the pole's motion is paid for only through the cart force. The discrete
 /// problem reaches F = 0 at every step (J ~ 1e-26), the global minimum since J >= 0; the

@@ -216,7 +216,9 @@ where
     /// terminal pivot needed the $\delta_c$ shift (the goal and the stage equalities are
     /// dependent) and the step's linearised miss $|r_N - \delta x_N|$ of a fixed component
     /// is above [`crate::bvp::PlanOptions::acceptable`] and at least half of its miss $|r_N|$
-    /// now (to first order no step reaches it: a point of local infeasibility of the goal).
+    /// now, and that miss is itself above the acceptable level (to first order no step
+    /// reaches it: a point of local infeasibility of the goal; a goal already met, whose
+    /// subproblem only cannot hold it, is not named).
     pub(super) fn unreachable_goal(
         &self,
         models: &Models<N, X>,
@@ -229,7 +231,8 @@ where
         let predicted = (models.r_end - last).component_mul(&self.problem.fixed_end);
         let component = predicted.iamax();
         let (after, now) = (predicted[component].abs(), models.r_end[component].abs());
-        (after > self.options.acceptable && after >= 0.5 * now).then_some((component, now))
+        let acceptable = self.options.acceptable;
+        (now > acceptable && after > acceptable && after >= 0.5 * now).then_some((component, now))
     }
 
     /// The end of the iteration at a point whose residuals are below the tolerance (or at the
