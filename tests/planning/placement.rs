@@ -231,8 +231,9 @@ fn contradictions_are_refused_naming_the_constraint() {
 
 /// A solve that stalls at an infeasible point names the constraint violated most there:
 /// contradictory equalities (u0 = 1 and u0 = 2) at the first iteration, and a keep-out disc
-/// centred on the straight path of the guess (its centre a node of it: violated by r^2 there),
-/// with the last iterate attached.
+/// centred on the straight path of the guess (its centre a node of it: violated by r^2 there;
+/// by symmetry no step leaves the line, and the restoration phase's steps stall inside the
+/// disc), with the last iterate attached.
 #[test]
 fn a_solve_stalled_at_an_infeasible_point_names_the_constraint() {
     /// u0 - v.
@@ -270,11 +271,17 @@ fn a_solve_stalled_at_an_infeasible_point_names_the_constraint() {
     assert!(contradiction.violation > 0.5, "{contradiction}");
     let (radius, disc) = (0.5, Clearance::new(0.0, 0.0, 0.5));
     for steps in [8, 40] {
-        let head_on = stalled(
-            OptimalControlProblem::new(&system, &START, &GOAL, 4.0, steps)
-                .with_inequality(&disc)
-                .solve(PlanGuess::Spline),
-        );
+        let problem =
+            OptimalControlProblem::new(&system, &START, &GOAL, 4.0, steps).with_inequality(&disc);
+        // with the restoration phase (the default) the iterate leaves the straight line
+        // before it stalls, still inside the disc
+        let restored = stalled(problem.solve(PlanGuess::Spline));
+        assert_eq!(restored.constraint.kind, ConstraintKind::Inequality);
+        assert_eq!(restored.constraint.index, 0);
+        assert!(restored.violation > 0.1, "N = {steps}: {restored}");
+        // without it, at the straight guess's centre node
+        let options = PlanOptions::default().with_restoration(false);
+        let head_on = stalled(problem.with_options(options).solve(PlanGuess::Spline));
         assert_eq!(head_on.constraint.kind, ConstraintKind::Inequality);
         assert_eq!(head_on.constraint.index, 0);
         assert_eq!(head_on.location, Location::Node(steps / 2), "N = {steps}");

@@ -92,18 +92,15 @@ pub struct PlanOptions {
     /// Not in [`OptimalControlProblem::solve_real_time`](crate::bvp::OptimalControlProblem::solve_real_time).
     #[cfg_attr(feature = "serde", serde(default = "default_escapes"))]
     pub saddle_escapes: usize,
-    /// Whether the feasibility restoration phase runs (Wächter and Biegler, sec. 3.3; off by
-    /// default): where neither the filter line search nor the exact-penalty search makes
-    /// progress (a step below $\gamma_\alpha \gamma_\theta = 5 \cdot 10^{-7}$), the
-    /// iteration minimises the constraint violation (elastic inequality rows, a proximity
-    /// term) until the filter accepts a point, or names the point locally infeasible. With
-    /// it, the constrained suite's quadrotor started from the zero guess is certified in
-    /// 46 of the 48 variants of thrust limit, goal, horizon and N (none without); the suite
-    /// itself is unchanged but for the minimum-time cart-pole (the same plan in 409
-    /// iterations instead of 389). Off by default: a keep-out disc centred on a node of the
-    /// straight guess, a stationary point of the violation, ends at the iteration limit
-    /// instead of being named a stalled infeasibility.
-    #[cfg_attr(feature = "serde", serde(default))]
+    /// Whether the feasibility restoration phase runs (Wächter and Biegler, sec. 3.3; on by
+    /// default): where the exact-penalty search finds no step, or where its steps stay below
+    /// $\gamma_\alpha \gamma_\theta = 5 \cdot 10^{-7}$ for five iterations in a row (the
+    /// filter having found none), the iteration minimises the constraint violation (elastic
+    /// inequality rows, a proximity term) until the filter accepts a point, or names the
+    /// point locally infeasible. With it, the constrained suite's quadrotor started from the
+    /// zero guess is certified at IPOPT's minimum, where without it the solve stalls
+    /// (`tests/planning/restoration.rs`).
+    #[cfg_attr(feature = "serde", serde(default = "default_restoration"))]
     pub restoration: bool,
 }
 
@@ -111,6 +108,12 @@ pub struct PlanOptions {
 #[cfg(feature = "serde")]
 fn default_escapes() -> usize {
     PlanOptions::default().saddle_escapes
+}
+
+/// [`PlanOptions::restoration`]'s default.
+#[cfg(feature = "serde")]
+fn default_restoration() -> bool {
+    PlanOptions::default().restoration
 }
 
 /// IPOPT's `max_soc`, [`PlanOptions::second_order_corrections`]'s default.
@@ -139,7 +142,7 @@ impl Default for PlanOptions {
             interior_samples: 0,
             second_order_corrections: 0,
             saddle_escapes: 2,
-            restoration: false,
+            restoration: true,
         }
     }
 }

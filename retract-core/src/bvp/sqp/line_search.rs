@@ -27,6 +27,10 @@ use crate::{Lagrangian, LiftedSystem};
 /// IPOPT's constants: $\gamma_\theta$, $\gamma_\varphi$, the switching exponents $s_\theta$,
 /// $s_\varphi$ and factor $\delta$, and $\gamma_\alpha$ of the smallest step length.
 const GAMMA_THETA: f64 = 1e-5;
+/// The feasibility restoration phase starts after this many successive steps shorter than
+/// $\gamma_\alpha \gamma_\theta$ (or where no step is found at all): an isolated short step
+/// is often followed by full ones.
+const TINY_STEPS: usize = 5;
 const GAMMA_PHI: f64 = 1e-8;
 const S_THETA: f64 = 1.1;
 const S_PHI: f64 = 2.3;
@@ -238,22 +242,34 @@ where
         &self,
         searched: Searched<'_, N, X>,
         slacks: (&Barrier, &[f64]),
-        (filter, penalty): (&mut Option<Filter>, &mut f64),
+        (filter, penalty, tiny): (&mut Option<Filter>, &mut f64, &mut usize),
     ) -> Result<Accepted<N, X>, Failure> {
-        let (iterate, models, direction, _) = searched;
+        let (iterate, models, direction, factor) = searched;
         let filter = filter.get_or_insert_with(|| {
             Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
         });
         if let Some(accepted) = self.filter_search(searched, slacks, filter)? {
+            *tiny = 0;
             return Ok(accepted);
         }
         let fallback = self.penalty_search(iterate, models, direction, slacks, penalty);
         match &fallback {
-            _ if !self.options.restoration => return fallback,
-            Ok(accepted) if accepted.alpha >= GAMMA_ALPHA * GAMMA_THETA => return fallback,
+            Ok(accepted) if accepted.alpha >= GAMMA_ALPHA * GAMMA_THETA => {
+                *tiny = 0;
+                return fallback;
+            }
+            Ok(_) => *tiny += 1,
+            _ => {}
+        }
+        match &fallback {
+            // (a simplified direction, of a factorisation kept from an earlier iterate, is
+            // retried with the iterate's own before restoration: see the loop)
+            _ if !self.options.restoration || factor.is_none() => return fallback,
+            Ok(_) if *tiny < TINY_STEPS => return fallback,
             Err(Failure::TimeLimit) => return fallback,
             _ => {}
         }
+        *tiny = 0;
         let restored = self.restore((iterate, models), slacks.0, filter);
         match restored {
             Restoration::Restored(trial, s, steps) => {

@@ -307,6 +307,8 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        // successive steps too short to make progress (the trigger of restoration)
+        let mut tiny = 0;
         let mut floor_stalled = 0;
         let mut unreachable = 0;
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
@@ -419,7 +421,10 @@ where
             let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
             let theta = self.dynamics.theta;
             let ds = (st.barrier).slack_steps(&models.inequalities, &sub.direction, theta, ds);
-            let (slacks, globals) = ((&st.barrier, &ds[..]), (&mut st.filter, &mut penalty));
+            let (slacks, globals) = (
+                (&st.barrier, &ds[..]),
+                (&mut st.filter, &mut penalty, &mut tiny),
+            );
             let factor = (!sub.stale).then_some((&sub.riccati, self.dynamics.h * sub.rho));
             let searched = (&st.iterate, &models, &sub.direction, factor);
             let accepted = match self.line_search(searched, slacks, globals) {
