@@ -232,9 +232,10 @@ where
 
     /// The line search: [`Self::filter_search`] with `filter` (made at the first call from
     /// the violation there); where it finds no step, [`Self::penalty_search`] with `penalty`;
-    /// where that fails too or its step is below $\gamma_\alpha \gamma_\theta$ (the largest
-    /// $\alpha_{\min}$ of the filter: a step that makes no progress), and
-    /// [`crate::bvp::PlanOptions::restoration`] is on, the feasibility restoration phase
+    /// where that fails too, or its step is below $\gamma_\alpha \gamma_\theta$ (the largest
+    /// $\alpha_{\min}$ of the filter: a step that makes no progress) for the [`TINY_STEPS`]th
+    /// time in a row (`tiny` counts them), with a direction of the iterate's own factorisation
+    /// and [`crate::bvp::PlanOptions::restoration`] on, the feasibility restoration phase
     /// ([`Self::restore`]): its point if it returns to one the filter accepts,
     /// [`Failure::LineSearch`] if it ends at a point of local infeasibility, and otherwise
     /// the penalty search's result.
