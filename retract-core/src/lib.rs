@@ -111,7 +111,7 @@ pub mod __private {
     };
     pub use crate::scheme::map::{CovectorHessian, DiscretizationMap, MapJacobians};
     pub use crate::scheme::reduced::{
-        ClosedForm, ReducedFactors, ReducedScheme, sum_corrected, two_product, two_sum,
+        ClosedForm, ReducedFactors, ReducedScheme, sum_corrected, sum_folded, two_product, two_sum,
     };
     pub use crate::scheme::split::Separable;
     pub use crate::system::{

@@ -135,14 +135,15 @@ fn the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
     // its cached propagator T = -A^{-1} B (and the forced columns of A^{-1}) are rounded once,
     // so every step applied the same slightly non-symplectic linear map. The factors now carry
     // their rounding errors, T_lo = -A^{-1}(A T + B) and A^{-1}(E - A a_inv) (residuals summed
-    // compensated), and the recovery adds T_lo z0 - a_inv_lo n to the exact error of its last
-    // addition, inside the one rounding of each entry of w (added after that rounding, a
-    // correction below the last bit is lost: the drift stayed 6.5e-11 at 1e6). Measured
-    // (h = 0.1, relative, worst over the run): 4.2e-13 at 1e6 steps and 2.1e-12 at 1e7;
-    // 3.5e-12 at 1e7 without the A^{-1} correction; 1.6e-13 and 6.3e-13 with each row summed
-    // fully compensated (Dot2), which made the step 3x slower. Bound: 1e-11, five times the
-    // measured 2.1e-12 and 65 times below the drift before; 1e7 reduced steps take about a
-    // second in the test profile.
+    // compensated), and the recovery adds T_lo z0 - a_inv_lo n to the terms of n first and
+    // those to the others (`sum_folded`), inside the one rounding of each entry of w (added
+    // after that rounding, a correction below the last bit is lost: the drift stayed 6.5e-11
+    // at 1e6). Measured (h = 0.1, relative, worst over the run): 3.8e-13 at 1e6 steps and
+    // 1.8e-12 at 1e7; with the exact last addition in every row (`sum_corrected`) 4.2e-13 and
+    // 2.1e-12; 3.5e-12 at 1e7 without the A^{-1} correction; 1.6e-13 and 6.3e-13 with each
+    // row summed fully compensated (Dot2), which made the step 3x slower. Bound: 1e-11, five
+    // times the measured 2.1e-12 and 65 times below the drift before; 1e7 reduced steps take
+    // about a second in the test profile.
     let (system, z0) = common::models::bounded_pais_uhlenbeck();
     let j0 = angular_momentum(&z0);
     let options = StepOptions::default();
@@ -170,7 +171,7 @@ fn the_uncompensated_reduced_step_is_the_same_map_but_lets_the_momentum_drift() 
     // StepOptions::compensated off: each entry of w one rounded sum of T z0 - A^{-1} n. Step
     // by step it agrees with the compensated step to rounding; over 1e6 steps its angular
     // momentum drifts linearly (6.5e-17 a step: about 6.5e-11), the compensated one stays at
-    // rounding (4.2e-13, measured in the test above). The bounds sit between the two; the
+    // rounding (3.8e-13, measured in the test above). The bounds sit between the two; the
     // lower one on the plain step's drift is what shows that the option really takes the
     // plain recovery.
     let (system, z0) = common::models::bounded_pais_uhlenbeck();

@@ -7,7 +7,7 @@
 //! forced columns of A^{-1}, K = theta E A^{-1} and G = (1 - theta) E + theta E T; the core
 //! system is r(y) = y - G z0 + K n(y) with Jacobian I + K dn/dy, and the unknowns are
 //! recovered as w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y), the corrections (the cached
-//! factors' rounding errors, `retract_core::reduced`) added inside the last rounding of each
+//! factors' rounding errors, `retract_core::reduced`) added inside the one rounding of each
 //! entry. Every product is emitted over the structural nonzeros of its factor; where T and
 //! A^{-1} are known in closed form (a symbolic elimination of the blocks of A at compile time,
 //! `closed_form_factors`), its zeros refine the patterns and its constants are written in
@@ -550,13 +550,15 @@ impl<'a> Reduction<'a> {
     }
 
     /// Row `row` of w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y): the terms of T and A^{-1}
-    /// summed as a balanced tree, the last addition exact (`sum_corrected`: `two_sum` with the
-    /// error), and the corrections (T_lo z0 and A^{-1}_lo n, of the size of the rounding
-    /// errors) added to its error, so that they enter the one rounding of the result instead
-    /// of being lost below the last bit. The terms of n, known last, are summed apart and
-    /// enter the last addition (and their corrections the last addition of the corrections):
-    /// one addition after n, not the depth of the tree. A row of exact terms (factors +-1) has
-    /// no correction and is a plain sum. With `compensated` false, the row is the plain sum of
+    /// summed as balanced trees in two halves, the terms of n (known last, summed apart: one
+    /// addition after n, not the depth of the tree) or the two halves of the terms, and the
+    /// corrections (T_lo z0 and A^{-1}_lo n, of the size of the rounding errors; those of n's
+    /// terms summed apart and added last) added to the half without a term of factor +-1
+    /// first, the late one where both qualify (`sum_folded`: that half is the small one, so
+    /// that they enter the one rounding of the result instead of being lost below the last
+    /// bit); with unit terms in both halves, the last addition exact (`sum_corrected`:
+    /// `two_sum` with the corrections added to its error). A row of exact terms (factors +-1)
+    /// has no correction and is a plain sum. With `compensated` false, the row is the plain sum of
     /// the terms of T and A^{-1} (no corrections, no exact addition), the terms of n again
     /// added last.
     fn recover_row(&self, row: usize, compensated: bool) -> TokenStream {
@@ -630,9 +632,18 @@ impl<'a> Reduction<'a> {
             });
         }
         let split = if mixed { forced_start } else { terms.len() / 2 };
+        let exact = |terms: &[Term]| terms.iter().any(|t| matches!(t, Term::Exact(_)));
+        let (exact_left, exact_right) = (exact(&terms[..split]), exact(&terms[split..]));
         let (left, right) = signed.split_at(split);
         let (left, right) = (signed_sum(left), signed_sum(right));
-        quote!(#core::sum_corrected(#left, #right, #small))
+        // the corrections join the half without a term of factor +-1 (a unit term carries the
+        // state: the other half, of the terms of n or of factors scaled by powers of h, is the
+        // small one), the late half where both qualify; with a unit term in each, the exact sum
+        match (exact_left, exact_right) {
+            (_, false) => quote!(#core::sum_folded(#left, #right, #small)),
+            (false, true) => quote!(#core::sum_folded(#right, #left, #small)),
+            (true, true) => quote!(#core::sum_corrected(#left, #right, #small)),
+        }
     }
 
     /// The methods `recover`, w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the
