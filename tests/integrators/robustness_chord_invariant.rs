@@ -142,7 +142,7 @@ fn the_reduced_step_conserves_angular_momentum_over_1e7_steps() {
     // 1.8e-12 at 1e7; with the exact last addition in every row (`sum_corrected`) 4.2e-13 and
     // 2.1e-12; 3.5e-12 at 1e7 without the A^{-1} correction; 1.6e-13 and 6.3e-13 with each
     // row summed fully compensated (Dot2), which made the step 3x slower. Bound: 1e-11, five
-    // times the measured 2.1e-12 and 65 times below the drift before; 1e7 reduced steps take
+    // times the measured 1.8e-12 and 65 times below the drift before; 1e7 reduced steps take
     // about a second in the test profile.
     let (system, z0) = common::models::bounded_pais_uhlenbeck();
     let j0 = angular_momentum(&z0);

@@ -647,7 +647,7 @@ impl<'a> Reduction<'a> {
     }
 
     /// The methods `recover`, w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the
-    /// structural nonzeros, each row with its corrections inside its last rounding
+    /// structural nonzeros, each row with its corrections inside its one rounding
     /// ([`Self::recover_row`]), and `recover_plain`, w = T z0 - A^{-1} n(y), each row one plain
     /// sum.
     fn recover(&self, forcing_lets: &[TokenStream]) -> TokenStream {
@@ -678,7 +678,7 @@ impl<'a> Reduction<'a> {
         let compensated = method(
             format_ident!("recover"),
             " w = (T + T_lo) z0 - (A^{-1} + A^{-1}_lo) n(y) over the structural nonzeros, the \
-             corrections inside each row's last rounding.",
+             corrections inside each row's one rounding.",
             true,
         );
         let plain = method(

@@ -519,14 +519,17 @@ impl Barrier {
         reset
     }
 
-    /// Restarts at the slacks `s` (after the feasibility restoration phase), with IPOPT's
-    /// reset of the multipliers (its `bound_mult_reset_threshold`): where the largest
+    /// Restarts at the slacks `s` (after the feasibility restoration phase), the multipliers
+    /// reset under IPOPT's threshold (its `bound_mult_reset_threshold`): where the largest
     /// multiplier in the transcribed problem's units, $h z_k$, is above
-    /// [`MULTIPLIER_RESET`], every $z_k = \mu / s_k$ (centred); otherwise each is kept within
-    /// the safeguard of [`Self::update`], $z_k \in [\mu / (\kappa_\Sigma s_k), \kappa_\Sigma
-    /// \mu / s_k]$. The curvature multipliers follow, $y_k = z_k$.
+    /// [`MULTIPLIER_RESET`], every $z_k = \mu / s_k$ (centred; IPOPT sets them to 1);
+    /// otherwise each is kept within the safeguard of [`Self::update`], $z_k \in [\mu /
+    /// (\kappa_\Sigma s_k), \kappa_\Sigma \mu / s_k]$ (IPOPT takes a step of them instead).
+    /// The curvature multipliers follow, $y_k = z_k$.
     pub fn restart(&mut self, s: &[f64], h: f64) {
-        self.s.copy_from_slice(s);
+        for (own, s) in self.s.iter_mut().zip(s) {
+            *own = *s;
+        }
         let reset = self.z.iter().any(|z| h * z > MULTIPLIER_RESET);
         for ((z, y), s) in self.z.iter_mut().zip(&mut self.y).zip(s) {
             *z = if reset {

@@ -43,9 +43,10 @@
 //!
 //! $$w = (T + T_{lo})\thinspace z_0 - (A^{-1} + A^{-1}_{lo})\thinspace n(y),$$
 //!
-//! each entry a sum of the terms of $T$ and $A^{-1}$ in two halves: $b$, the terms of $n$
-//! (known last, summed apart so that one addition follows $n$, in the plain sums too) or, in
-//! a row without them, the half without a term of factor $\pm 1$, and $a$, the others. The
+//! each entry a sum of the terms of $T$ and $A^{-1}$ in two halves (the terms of $n$, known
+//! last, summed apart so that one addition follows $n$, in the plain sums too; in a row
+//! without them, two halves of its terms): $b$, the half without a term of factor $\pm 1$
+//! (the late one, of $n$'s terms where there are, if both qualify), and $a$, the other. The
 //! corrections $c$ ($T_{lo} z_0 - A^{-1}_{lo} n$) are added to $b$ first,
 //! $\mathrm{fl}(a + \mathrm{fl}(b + c))$ ([`sum_folded`]): where $b$ is small against $a$
 //! (the terms of $n$ and the factors off the unit diagonal carry powers of $h$, the unit terms

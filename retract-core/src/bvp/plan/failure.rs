@@ -24,7 +24,9 @@ pub enum Failure {
     IterationLimit,
     /// The wall-time budget ran out.
     TimeLimit,
-    /// No step along the (descent) direction was accepted.
+    /// No step along the (descent) direction was accepted, and the feasibility restoration
+    /// phase, where it ran, found no point the filter accepts (an iterate that violates a
+    /// constraint beyond the tolerance there is named [`Failure::StalledInfeasible`]).
     LineSearch,
     /// The inertia correction reached its cap without making the reduced Hessian definite.
     Regularization,

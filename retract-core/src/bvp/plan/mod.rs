@@ -46,7 +46,7 @@ pub struct Plan<const N: usize, const X: usize> {
     /// $J = \sum_i h\thinspace L(x_{\theta,i}, u_i)$.
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub cost: f64,
-    /// SQP iterations.
+    /// SQP iterations (the Newton steps of feasibility restoration phases included).
     pub iterations: usize,
     /// Residuals and curvature at this point.
     pub certificate: Certificate,

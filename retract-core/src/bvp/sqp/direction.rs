@@ -3,12 +3,15 @@
 //! of the last iterate: a simplified Newton step), refined where the barrier makes it
 //! ill-conditioned, with the multipliers, residuals and errors that go with it.
 
+use nalgebra::SVector;
+
 use super::state::{Models, Sqp, Subproblem};
 use crate::bvp::barrier::Barrier;
+use crate::bvp::iterate::Iterate;
 use crate::bvp::kkt::model::StageModel;
 use crate::bvp::kkt::refine::refine;
 use crate::bvp::kkt::riccati::Riccati;
-use crate::bvp::plan::Failure;
+use crate::bvp::plan::{Certificate, Failure};
 use crate::{Lagrangian, LiftedSystem};
 
 /// The ratio $z / s$ of an inequality above which the subproblem's solution is refined
@@ -21,6 +24,42 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
+    /// The models at the point `(iterate, y, barrier)` and the subproblem solved there (from
+    /// the `kept` factorisation if any); on a failure, the failure and the point's cost and
+    /// certificate (`None` where the models could not be formed: nothing to report), an
+    /// inertia-correction or line-search failure named by [`Self::name_infeasibility`].
+    #[allow(clippy::type_complexity, clippy::result_large_err)] // (once an iteration)
+    pub(super) fn model_and_solve(
+        &self,
+        (iterate, y, barrier): (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
+        kept: Option<(Riccati<N, X>, f64)>,
+        rho_last: f64,
+    ) -> Result<(Models<N, X>, Subproblem<N, X>), (Failure, Option<(f64, Certificate)>)> {
+        let mut models = match self.models(iterate, y, barrier) {
+            Ok(models) => models,
+            Err(Failure::TimeLimit) => {
+                let (cost, certificate) = self.interrupted_certificate(iterate, barrier);
+                return Err((Failure::TimeLimit, Some((cost, certificate))));
+            }
+            Err(failure) => return Err((failure, None)),
+        };
+        match self.subproblem(&mut models, barrier, kept, rho_last) {
+            Ok(sub) => Ok((models, sub)),
+            Err(failure) => {
+                let (failure, certificate) = if matches!(failure, Failure::TimeLimit) {
+                    // (no least-squares multipliers: they would cost another factorisation)
+                    (failure, Self::unsolved_certificate(&models, barrier))
+                } else {
+                    let partial = self.failure_certificate(&models, barrier);
+                    (self.name_infeasibility(failure, iterate, None), partial)
+                };
+                let cost = models.cost;
+                self.give_models(models);
+                Err((failure, Some((cost, certificate))))
+            }
+        }
+    }
+
     /// The subproblem at `models`. With the factorisation `kept` of the previous iterate
     /// (whose error was $e_{\rm prev}$), a simplified Newton step: taken if its predicted error
     /// from here, about $e^2 / e_{\rm prev}$ (the kept factorisation is off by about the last

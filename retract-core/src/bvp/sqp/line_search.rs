@@ -27,26 +27,43 @@ use crate::{Lagrangian, LiftedSystem};
 /// IPOPT's constants: $\gamma_\theta$, $\gamma_\varphi$, the switching exponents $s_\theta$,
 /// $s_\varphi$ and factor $\delta$, and $\gamma_\alpha$ of the smallest step length.
 const GAMMA_THETA: f64 = 1e-5;
-/// The feasibility restoration phase starts after this many successive steps shorter than
-/// $\gamma_\alpha \gamma_\theta$ (or where no step is found at all): an isolated short step
-/// is often followed by full ones.
-const TINY_STEPS: usize = 5;
 const GAMMA_PHI: f64 = 1e-8;
 const S_THETA: f64 = 1.1;
 const S_PHI: f64 = 2.3;
 const DELTA: f64 = 1.0;
 const GAMMA_ALPHA: f64 = 0.05;
+/// The feasibility restoration phase starts after this many successive steps shorter than
+/// $\gamma_\alpha \gamma_\theta$ (or where no step is found at all): an isolated short step
+/// is often followed by full ones.
+const TINY_STEPS: usize = 5;
+
+/// What the line search carries from one iteration to the next besides the filter and the
+/// penalty: the successive steps shorter than $\gamma_\alpha \gamma_\theta$ (the trigger of
+/// restoration) and the Newton steps restoration phases took since the loop last read them
+/// ([`Progress::take_steps`]: they count as iterations, whatever the phase's outcome).
+#[derive(Default)]
+pub(super) struct Progress {
+    tiny: usize,
+    restoration_steps: usize,
+}
+
+impl Progress {
+    /// The restoration phases' Newton steps since the last call.
+    pub fn take_steps(&mut self) -> usize {
+        core::mem::take(&mut self.restoration_steps)
+    }
+}
 
 /// An accepted trial point: the iterate, the step length, whether the decrease it was
 /// accepted on is at rounding level, the corrected step it was taken along, if a
 /// second-order correction was accepted, and, if the point comes from the feasibility
-/// restoration phase, its slacks and the phase's steps.
+/// restoration phase, its slacks.
 pub(super) struct Accepted<const N: usize, const X: usize> {
     pub trial: Iterate<N, X>,
     pub alpha: f64,
     pub at_rounding: bool,
     pub corrected: Option<Corrected<N, X>>,
-    pub restored: Option<(Vec<f64>, usize)>,
+    pub restored: Option<Vec<f64>>,
 }
 
 /// The subproblem a line search searches along: the iterate, its models, the direction and,
@@ -182,7 +199,7 @@ where
 
     /// Moves to the `accepted` point along `direction` with slack steps `ds` (or along its
     /// corrected step; or, for a point of the restoration phase, to it with its slacks, the
-    /// multipliers restarted by [`Barrier::restart`] and the stage equalities' at 0): the
+    /// multipliers restarted by [`Barrier::restart`] and the stage equalities' kept): the
     /// iterate; the slacks and the multipliers $z$ by its step length
     /// (then the slacks far below their inequality's value reset, [`Barrier::reset_slacks`],
     /// from the values the trial's merit evaluation kept);
@@ -195,7 +212,7 @@ where
         (direction, ds): (&Direction<N, X>, &[f64]),
         (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
     ) -> (f64, bool, bool) {
-        if let Some((slacks, _)) = accepted.restored.take() {
+        if let Some(slacks) = accepted.restored.take() {
             let left = core::mem::replace(iterate, accepted.trial);
             self.give_iterate(left);
             barrier.restart(&slacks, self.dynamics.h);
@@ -234,61 +251,73 @@ where
     /// the violation there); where it finds no step, [`Self::penalty_search`] with `penalty`;
     /// where that fails too, or its step is below $\gamma_\alpha \gamma_\theta$ (the largest
     /// $\alpha_{\min}$ of the filter: a step that makes no progress) for the [`TINY_STEPS`]th
-    /// time in a row (`tiny` counts them), with a direction of the iterate's own factorisation
-    /// and [`crate::bvp::PlanOptions::restoration`] on, the feasibility restoration phase
-    /// ([`Self::restore`]): its point if it returns to one the filter accepts,
-    /// [`Failure::LineSearch`] if it ends at a point of local infeasibility, and otherwise
-    /// the penalty search's result.
+    /// time in a row or later (`progress` counts them), the feasibility restoration phase
+    /// ([`Self::restore`]), unless it is off ([`crate::bvp::PlanOptions::restoration`]), the
+    /// iteration is a real-time one, the direction is a kept factorisation's, or the iterate
+    /// is feasible to the tolerance (no elastic point can then reduce its violation): its point
+    /// if it returns to one the filter accepts, [`Failure::LineSearch`] if it ends at a point
+    /// of local infeasibility, [`Failure::TimeLimit`] if the budget ran out in it, and
+    /// otherwise the penalty search's result.
     pub(super) fn line_search(
         &self,
         searched: Searched<'_, N, X>,
         slacks: (&Barrier, &[f64]),
-        (filter, penalty, tiny): (&mut Option<Filter>, &mut f64, &mut usize),
+        (filter, penalty, progress): (&mut Option<Filter>, &mut f64, &mut Progress),
     ) -> Result<Accepted<N, X>, Failure> {
         let (iterate, models, direction, factor) = searched;
         let filter = filter.get_or_insert_with(|| {
             Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
         });
         if let Some(accepted) = self.filter_search(searched, slacks, filter)? {
-            *tiny = 0;
+            progress.tiny = 0;
             return Ok(accepted);
         }
         let fallback = self.penalty_search(iterate, models, direction, slacks, penalty);
         match &fallback {
             Ok(accepted) if accepted.alpha >= GAMMA_ALPHA * GAMMA_THETA => {
-                *tiny = 0;
+                progress.tiny = 0;
                 return fallback;
             }
-            Ok(_) => *tiny += 1,
+            Ok(_) => progress.tiny += 1,
             _ => {}
         }
-        match &fallback {
+        let skipped = !self.options.restoration
+            || self.real_time
             // (a simplified direction, of a factorisation kept from an earlier iterate, is
-            // retried with the iterate's own before restoration: see the loop)
-            _ if !self.options.restoration || factor.is_none() => return fallback,
-            Ok(_) if *tiny < TINY_STEPS => return fallback,
+            // retried with the iterate's own first: see the loop)
+            || factor.is_none()
+            || models.violation_max() <= self.options.tolerance;
+        match &fallback {
+            _ if skipped => return fallback,
+            Ok(_) if progress.tiny < TINY_STEPS => return fallback,
             Err(Failure::TimeLimit) => return fallback,
             _ => {}
         }
-        *tiny = 0;
+        progress.tiny = 0;
         let restored = self.restore((iterate, models), slacks.0, filter);
-        match restored {
-            Restoration::Restored(trial, s, steps) => {
-                if let Ok(accepted) = fallback {
-                    self.give_iterate(accepted.trial);
-                }
+        progress.restoration_steps += restored.1;
+        let give = |fallback: Result<Accepted<N, X>, Failure>| {
+            if let Ok(accepted) = fallback {
+                self.give_iterate(accepted.trial);
+            }
+        };
+        match restored.0 {
+            Restoration::Restored(trial, s) => {
+                give(fallback);
                 Ok(Accepted {
                     trial,
                     alpha: 1.0,
                     at_rounding: false,
                     corrected: None,
-                    restored: Some((s, steps)),
+                    restored: Some(s),
                 })
             }
+            _ if self.out_of_time() => {
+                give(fallback);
+                Err(Failure::TimeLimit)
+            }
             Restoration::Infeasible => {
-                if let Ok(accepted) = fallback {
-                    self.give_iterate(accepted.trial);
-                }
+                give(fallback);
                 Err(Failure::LineSearch)
             }
             Restoration::Unfinished => fallback,

@@ -20,12 +20,11 @@
 //! filter finds no step, from backtracking on the exact penalty $J + \pi \Vert c\Vert_1$ ($c$:
 //! all constraints), $\pi$ raised so that the direction descends, and where neither makes
 //! progress from IPOPT's feasibility restoration phase (`restoration`); a trial point whose
-//! steps leave the domain of
-//! $L$ (the generated singularity guard at both ends and the evaluation point of every step,
-//! and on pieces of its chord no longer than `chord_spacing` unless its guards are quadratic,
-//! as [`crate::step::check_step_domain`]) is rejected. A point is returned only
-//! when the KKT residuals are below the tolerance and the reduced Hessian is positive definite
-//! without correction; its [`Certificate`](super::Certificate) holds the residuals and the
+//! steps leave the domain of $L$ (the generated singularity guard at both ends and the
+//! evaluation point of every step, and on pieces of its chord no longer than `chord_spacing`
+//! unless its guards are quadratic, as [`crate::step::check_step_domain`]) is rejected. A
+//! point is returned only when the KKT residuals are below the tolerance and the reduced
+//! Hessian is positive definite without correction; its [`Certificate`](super::Certificate) holds the residuals and the
 //! smallest eigenvalue of the reduced Hessian (Lanczos on the inverse,
 //! [`super::kkt::residuals`]).
 //!
@@ -68,6 +67,7 @@ mod termination;
 
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
+use line_search::Progress;
 pub(super) use state::Sqp;
 use state::{State, Subproblem};
 use termination::{Finished, barrier_floor};
@@ -307,8 +307,7 @@ where
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
-        // successive steps too short to make progress (the trigger of restoration)
-        let mut tiny = 0;
+        let mut progress = Progress::default();
         let mut floor_stalled = 0;
         let mut unreachable = 0;
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
@@ -330,30 +329,13 @@ where
                     return Ok((plan, true));
                 }
             }
-            let mut models = match self.models(&st.iterate, &st.y, &st.barrier) {
-                Ok(models) => models,
-                Err(Failure::TimeLimit) => {
-                    let (cost, certificate) = self.interrupted_certificate(point.0, point.2);
-                    return Err(fail(Failure::TimeLimit, cost, certificate, vec![]));
+            let at = (&st.iterate, &st.y[..], &st.barrier);
+            let (models, sub) = match self.model_and_solve(at, st.kept.take(), rho_last) {
+                Ok(pair) => pair,
+                Err((failure, Some((cost, certificate)))) => {
+                    return Err(fail(failure, cost, certificate, vec![]));
                 }
-                Err(failure) => return Err(PlanError::without_iterate(failure)),
-            };
-            let sub = match self.subproblem(&mut models, &st.barrier, st.kept.take(), rho_last) {
-                Ok(sub) => sub,
-                Err(Failure::TimeLimit) => {
-                    // (no least-squares multipliers: they would cost another factorisation)
-                    let certificate = Self::unsolved_certificate(&models, &st.barrier);
-                    let cost = models.cost;
-                    self.give_models(models);
-                    return Err(fail(Failure::TimeLimit, cost, certificate, vec![]));
-                }
-                Err(failure) => {
-                    let partial = self.failure_certificate(&models, &st.barrier);
-                    let failure = self.name_infeasibility(failure, &st.iterate, None);
-                    let cost = models.cost;
-                    self.give_models(models);
-                    return Err(fail(failure, cost, partial, vec![]));
-                }
+                Err((failure, None)) => return Err(PlanError::without_iterate(failure)),
             };
             rho_last = sub.rho;
             let goal = self.unreachable_goal(&models, &sub);
@@ -423,11 +405,14 @@ where
             let ds = (st.barrier).slack_steps(&models.inequalities, &sub.direction, theta, ds);
             let (slacks, globals) = (
                 (&st.barrier, &ds[..]),
-                (&mut st.filter, &mut penalty, &mut tiny),
+                (&mut st.filter, &mut penalty, &mut progress),
             );
             let factor = (!sub.stale).then_some((&sub.riccati, self.dynamics.h * sub.rho));
             let searched = (&st.iterate, &models, &sub.direction, factor);
-            let accepted = match self.line_search(searched, slacks, globals) {
+            let searched = self.line_search(searched, slacks, globals);
+            // (the restoration phases' Newton steps count as iterations)
+            iterations = (iterations + progress.take_steps()).min(options.max_iterations);
+            let accepted = match searched {
                 Ok(accepted) => accepted,
                 Err(Failure::LineSearch) if sub.stale => {
                     // the simplified direction failed: solve this iterate's own subproblem
@@ -444,9 +429,6 @@ where
                     return Err(fail(failure, cost, certificate, momenta));
                 }
             };
-            // (the steps of a restoration phase count as iterations)
-            let restored = accepted.restored.as_ref().map_or(0, |r| r.1);
-            iterations = (iterations + restored).min(options.max_iterations);
             let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
             let (alpha, at_rounding, plain) = self.advance(accepted, (&sub.direction, &ds), state);
             self.pool.borrow_mut().reals.give(ds);

@@ -26,11 +26,13 @@
 //!
 //! The phase returns at the first iterate whose violation, with the slacks $s_k = g_k +
 //! n_k$, is at most $\kappa_R \theta_R$ ($\kappa_R = 0.9$) and which the filter, augmented
-//! by the point where it failed, accepts; the multipliers $z$ are reset as IPOPT's
-//! ([`Barrier::restart`]), those of the stage equalities kept as they were (IPOPT recomputes them by least squares). Where the
-//! barrier problem is solved at the smallest $\mu_R$ with the violation still above the
-//! tolerance, the point is locally infeasible. The phase gives up (and the penalty search's
-//! step is taken) after [`MAX_RESTORATION`] steps, or [`STALL`] steps without progress.
+//! by the point where it failed, accepts; the multipliers $z$ are reset under IPOPT's
+//! threshold ([`Barrier::restart`]), those of the stage equalities kept as they were (IPOPT
+//! recomputes them by least squares). Where the barrier problem is solved at the smallest
+//! $\mu_R$ with the violation still above the tolerance, the point is locally infeasible.
+//! The phase gives up (and the penalty search's step is taken) after [`MAX_RESTORATION`]
+//! passes, or [`STALL`] passes without progress. Its Newton steps count as iterations of the
+//! solve, whatever its outcome.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -128,8 +130,8 @@ struct Evaluation {
 
 /// How a restoration phase ended.
 pub(super) enum Restoration<const N: usize, const X: usize> {
-    /// At an iterate the filter accepts: it, its slacks and the phase's steps.
-    Restored(Iterate<N, X>, Vec<f64>, usize),
+    /// At an iterate the filter accepts: it and its slacks.
+    Restored(Iterate<N, X>, Vec<f64>),
     /// At a point of local infeasibility.
     Infeasible,
     /// Without either (its budget or a factorisation ran out).
@@ -142,13 +144,14 @@ where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
     /// The restoration phase from `iterate` (its `models` and `barrier`), the `filter`
-    /// augmented by the point first (IPOPT's rule: the iteration cannot come back to it).
+    /// augmented by the point first (IPOPT's rule: the iteration cannot come back to it):
+    /// how it ended and the Newton steps it took.
     pub(super) fn restore(
         &self,
         (iterate, models): (&Iterate<N, X>, &Models<N, X>),
         barrier: &Barrier,
         filter: &mut Filter,
-    ) -> Restoration<N, X> {
+    ) -> (Restoration<N, X>, usize) {
         let (theta_r, phi_r) = (models.violation_l1(), models.barrier_cost);
         filter.augment((1.0 - 1e-5) * theta_r, phi_r - 1e-8 * theta_r);
         let h = self.dynamics.h;
@@ -164,6 +167,8 @@ where
         // the least violation so far and the step where it was reached
         let mut best = (theta_r, 0);
         let mut slacks = self.pool.borrow_mut().reals.take(barrier.s.len());
+        // the Newton steps taken (the passes that only lower mu_R take none)
+        let mut newton = 0;
         for step in 1..=MAX_RESTORATION {
             if self.out_of_time() {
                 break;
@@ -188,11 +193,12 @@ where
                 if reference.mu <= floor {
                     let theta = at.constraints + at.elastic;
                     self.finish_restoration(w, slacks);
-                    return if theta > self.options.tolerance {
+                    let end = if theta > self.options.tolerance {
                         Restoration::Infeasible
                     } else {
                         Restoration::Unfinished
                     };
+                    return (end, newton);
                 }
                 reference.mu = (reference.mu / 5.0).min(reference.mu.powf(1.5)).max(floor);
                 reference.zeta = reference.mu.sqrt();
@@ -204,11 +210,12 @@ where
             let Some((next, evaluation)) = next else {
                 break;
             };
+            newton += 1;
             self.give_iterate(core::mem::replace(&mut w, next));
             let theta = evaluation.constraints + evaluation.elastic;
             let phi = evaluation.cost - h * barrier.mu * evaluation.log;
             if theta <= KAPPA_R * theta_r && !filter.rejects(theta, phi) {
-                return Restoration::Restored(w, slacks, step);
+                return (Restoration::Restored(w, slacks), newton);
             }
             if theta < (1.0 - PROGRESS) * best.0 {
                 best = (theta, step);
@@ -217,7 +224,7 @@ where
             }
         }
         self.finish_restoration(w, slacks);
-        Restoration::Unfinished
+        (Restoration::Unfinished, newton)
     }
 
     /// Gives the phase's iterate and slacks back to the pool.
@@ -332,17 +339,11 @@ where
                     node.0 += cxx;
                 }
             }
-            finite &= stage
-                .hxx
-                .iter()
-                .chain(stage.huu.iter())
-                .all(|v| v.is_finite())
-                && stage
-                    .gx
-                    .iter()
-                    .chain(stage.gu.iter())
-                    .all(|v| v.is_finite())
-                && node.0.iter().chain(node.1.iter()).all(|v| v.is_finite());
+            finite &= (stage.hxx.iter().chain(&stage.hux).chain(&stage.huu))
+                .chain(stage.gx.iter().chain(&stage.gu).chain(&stage.defect))
+                .chain(stage.cx.iter().chain(&stage.cu).chain(&stage.value))
+                .chain(node.0.iter().chain(&node.1))
+                .all(|v| v.is_finite());
             stage.node = Some(node);
             stages.push(stage);
         }
