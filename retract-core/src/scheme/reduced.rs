@@ -58,9 +58,7 @@
 //! angular momentum of the rotation-invariant Pais-Uhlenbeck oscillator then stays within
 //! $1.8 \cdot 10^{-12}$ over $10^7$ steps (it drifted $6.5 \cdot 10^{-10}$; with the exact
 //! last addition in every row $2.1 \cdot 10^{-12}$, the step 1.26 to 1.28 times slower on the
-//! obstacle system); at $h = 0.5$, where the terms of $n$ reach the size of the others,
-//! within $1.65 \cdot 10^{-11}$ over $2 \cdot 10^6$ steps, $1.59 \cdot 10^{-11}$ with the
-//! exact addition. Each entry summed fully compensated (Dot2 of Ogita, Rump and Oishi: every
+//! obstacle system). Each entry summed fully compensated (Dot2 of Ogita, Rump and Oishi: every
 //! product and addition error-free) kept the momentum within $6.3 \cdot 10^{-13}$ but made
 //! the step 3x slower.
 //!
