@@ -4,6 +4,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::newton::all_finite;
+
 /// One stage's quadratic model: the Hessian blocks and gradient of $h\thinspace L$ in
 /// $y = (x_\theta, u)$ (the Hessian of the Lagrangian, with the constraints' curvature), the
 /// defect $c_i$, and the stage's equality constraints $g(y) = 0$: `constraints` rows of
@@ -24,6 +26,26 @@ pub(crate) struct StageModel<const N: usize, const X: usize> {
     /// Terms of the node $x_i$ itself (the barrier of the inequalities placed at the node):
     /// their Hessian and gradient in $\delta x_i$, added to $Q_{xx}$ and $q_x$.
     pub node: Option<NodeTerms<X>>,
+}
+
+impl<const N: usize, const X: usize> StageModel<N, X> {
+    /// Whether every entry of the Hessian blocks, the gradient, the equality rows and the node
+    /// terms is finite (each a vectorised sum of 0 * entry: nalgebra's `sum` is one chain of
+    /// dependent additions, a fifth of an SQP iteration on the SE(2) scene).
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        let node =
+            (self.node.as_ref()).is_none_or(|node| all_finite(&node.0) & all_finite(&node.1));
+        all_finite(&self.hxx)
+            & all_finite(&self.hux)
+            & all_finite(&self.huu)
+            & all_finite(&self.gx)
+            & all_finite(&self.gu)
+            & all_finite(&self.cx)
+            & all_finite(&self.cu)
+            & all_finite(&self.value)
+            & node
+    }
 }
 
 /// The Hessian and gradient in $\delta x_i$ of terms of a node $x_i$ itself.

@@ -273,25 +273,27 @@ where
             return Ok(accepted);
         }
         let fallback = self.penalty_search(iterate, models, direction, slacks, penalty);
-        match &fallback {
+        let too_early = match &fallback {
             Ok(accepted) if accepted.alpha >= GAMMA_ALPHA * GAMMA_THETA => {
                 progress.tiny = 0;
                 return fallback;
             }
-            Ok(_) => progress.tiny += 1,
-            _ => {}
-        }
-        let skipped = !self.options.restoration
+            Ok(_) => {
+                progress.tiny += 1;
+                progress.tiny < TINY_STEPS
+            }
+            Err(Failure::TimeLimit) => return fallback,
+            Err(_) => false,
+        };
+        let skipped = too_early
+            || !self.options.restoration
             || self.real_time
             // (a simplified direction, of a factorisation kept from an earlier iterate, is
             // retried with the iterate's own first: see the loop)
             || factor.is_none()
             || models.violation_max() <= self.options.tolerance;
-        match &fallback {
-            _ if skipped => return fallback,
-            Ok(_) if progress.tiny < TINY_STEPS => return fallback,
-            Err(Failure::TimeLimit) => return fallback,
-            _ => {}
+        if skipped {
+            return fallback;
         }
         progress.tiny = 0;
         let restored = self.restore((iterate, models), slacks.0, filter);

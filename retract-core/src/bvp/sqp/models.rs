@@ -250,22 +250,7 @@ where
                 let from = barrier.node_index(i, 0);
                 barrier.add_to_node(stage, i, &inequalities[from..from + barrier.nodes], h);
             }
-            let node_finite = stage
-                .node
-                .as_ref()
-                .is_none_or(|node| all_finite(&node.0) & all_finite(&node.1));
-            // each a vectorised sum of 0 * entry (nalgebra's `sum` is one chain of dependent
-            // additions: a fifth of an SQP iteration on the SE(2) scene)
-            let finite = all_finite(&stage.hxx)
-                & all_finite(&stage.hux)
-                & all_finite(&stage.huu)
-                & all_finite(&stage.gx)
-                & all_finite(&stage.gu)
-                & all_finite(&stage.cx)
-                & all_finite(&stage.cu)
-                & all_finite(&stage.value)
-                & node_finite;
-            if !finite {
+            if !stage.is_finite() {
                 return Err(Failure::NonFinite);
             }
         }

@@ -339,12 +339,8 @@ where
                     node.0 += cxx;
                 }
             }
-            finite &= (stage.hxx.iter().chain(&stage.hux).chain(&stage.huu))
-                .chain(stage.gx.iter().chain(&stage.gu).chain(&stage.defect))
-                .chain(stage.cx.iter().chain(&stage.cu).chain(&stage.value))
-                .chain(node.0.iter().chain(&node.1))
-                .all(|v| v.is_finite());
             stage.node = Some(node);
+            finite &= stage.is_finite();
             stages.push(stage);
         }
         let last = &w.x[steps];
