@@ -1,7 +1,11 @@
 //! The feasibility restoration phase: a guess from which the filter line search jams (the
 //! slacks of the thrust bounds and the disc at their bounds, the steps cut to nothing) is
-//! brought back to the feasible region and the plan certified.
+//! brought back to the feasible region and the plan certified; a phase that cannot lower the
+//! violation at all names the point locally infeasible.
 
+use std::f64::consts::PI;
+
+use crate::cart_pole::{CartForce, CartPole, PoleTorque};
 use crate::quadrotor::{Clearance, Lateral, Quadrotor, Rotors};
 use retract::bvp::{Curve, Failure, OptimalControlProblem, PlanGuess, PlanOptions};
 
@@ -40,4 +44,35 @@ fn the_quadrotor_from_the_zero_guess_is_restored_and_certified() {
         "J = {}",
         plan.cost
     );
+}
+
+/// The cart-pole of the constrained suite with a force bound too small to swing it up in
+/// time (|F| <= 5, T = 2.5, N = 50), from the straight line: the filter's steps shrink to
+/// nothing at a violation the restoration phase cannot lower either, and the solve names
+/// the stall an infeasibility in a few dozen iterations (it ran to the iteration limit,
+/// 3000, when a phase without progress was only retried). IPOPT on the same transcription
+/// from the smoothstep also ends in local infeasibility (`Infeasible_Problem_Detected`,
+/// 224 iterations, CasADi, tol 1e-10); every guess of the failure hunt
+/// (`cargo run --release --example hunt -- cartpole T=2.5,F=5`) fails here.
+#[test]
+fn a_restoration_without_progress_names_the_infeasibility() {
+    let (mc, mp, l) = (1.0, 0.3, 0.5);
+    let system = CartPole::new(mc, mp, l);
+    let unactuated = PoleTorque::new(mp, l, 9.81);
+    let force = CartForce::new(mc, mp, l);
+    let (t_end, goal) = (2.5, [0.0, PI, 0.0, 0.0]);
+    let line = Curve::from_fn(move |t| [0.0, PI * t / t_end]);
+    let problem = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, 50)
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -5.0, 5.0);
+    let error = match problem.solve(PlanGuess::Curve(&line)) {
+        Err(e) => e,
+        Ok(plan) => panic!("certified with |F| <= 5: J = {}", plan.cost),
+    };
+    let Failure::StalledInfeasible(infeasibility) = &error.failure else {
+        panic!("{error}");
+    };
+    assert!(infeasibility.violation > 1e-3, "{infeasibility}");
+    let last = error.last.as_ref().expect("the last iterate");
+    assert!(last.iterations < 500, "{} iterations", last.iterations);
 }

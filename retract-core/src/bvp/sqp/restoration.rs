@@ -53,9 +53,13 @@ pub(super) const MAX_RESTORATION: usize = 60;
 /// The smallest $\mu_R$ relative to $\max(1, \theta_R)$.
 const MU_R_FLOOR: f64 = 1e-10;
 /// The phase gives up after `STALL` steps without lowering the least violation so far by
-/// the fraction `PROGRESS`.
+/// the fraction `PROGRESS` ([`Restoration::Unfinished`], or [`Restoration::Infeasible`]
+/// without progress at all, [`NO_PROGRESS`]).
 const STALL: usize = 10;
 const PROGRESS: f64 = 1e-3;
+/// A phase that gives up without ever lowering the violation it started from by this
+/// fraction ends at a point of local infeasibility.
+const NO_PROGRESS: f64 = 1e-2;
 /// IPOPT's $\kappa_\varepsilon$: $\mu_R$ decreases once the Newton step (relative to the
 /// iterate) and $\Vert c\Vert_1$ are below $\kappa_\varepsilon \mu_R$.
 const KAPPA_EPSILON: f64 = 10.0;
@@ -132,7 +136,9 @@ struct Evaluation {
 pub(super) enum Restoration<const N: usize, const X: usize> {
     /// At an iterate the filter accepts: it and its slacks.
     Restored(Iterate<N, X>, Vec<f64>),
-    /// At a point of local infeasibility.
+    /// At a point of local infeasibility: the phase's barrier problem solved at its floor
+    /// with the violation above the tolerance, or the phase given up without any step
+    /// lowering the violation it started from by [`NO_PROGRESS`].
     Infeasible,
     /// Without either (its budget or a factorisation ran out).
     Unfinished,
@@ -220,6 +226,12 @@ where
             if theta < (1.0 - PROGRESS) * best.0 {
                 best = (theta, step);
             } else if step - best.1 >= STALL {
+                // (no step of the phase lowered the violation by NO_PROGRESS: the iterate is
+                // where the violation is stationary, a point of local infeasibility)
+                if best.0 > (1.0 - NO_PROGRESS) * theta_r {
+                    self.finish_restoration(w, slacks);
+                    return (Restoration::Infeasible, newton);
+                }
                 break;
             }
         }
