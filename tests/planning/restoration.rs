@@ -53,7 +53,7 @@ fn the_quadrotor_from_the_zero_guess_is_restored_and_certified() {
 /// 3000, when a phase without progress was only retried). IPOPT on the same transcription
 /// from the smoothstep also ends in local infeasibility (`Infeasible_Problem_Detected`,
 /// 224 iterations, CasADi, tol 1e-10); every guess of the failure hunt
-/// (`cargo run --release --example hunt -- cartpole T=2.5,F=5`) fails here.
+/// (`cargo run --release --example hunt -- cartpole "T=2.5 F=5 N=50"`) fails here.
 #[test]
 fn a_restoration_without_progress_names_the_infeasibility() {
     let (mc, mp, l) = (1.0, 0.3, 0.5);

@@ -175,6 +175,8 @@ where
         let mut slacks = self.pool.borrow_mut().reals.take(barrier.s.len());
         // the Newton steps taken (the passes that only lower mu_R take none)
         let mut newton = 0;
+        // (how the phase ends if it leaves the loop)
+        let mut end = Restoration::Unfinished;
         for step in 1..=MAX_RESTORATION {
             if self.out_of_time() {
                 break;
@@ -229,14 +231,13 @@ where
                 // (no step of the phase lowered the violation by NO_PROGRESS: the iterate is
                 // where the violation is stationary, a point of local infeasibility)
                 if best.0 > (1.0 - NO_PROGRESS) * theta_r {
-                    self.finish_restoration(w, slacks);
-                    return (Restoration::Infeasible, newton);
+                    end = Restoration::Infeasible;
                 }
                 break;
             }
         }
         self.finish_restoration(w, slacks);
-        (Restoration::Unfinished, newton)
+        (end, newton)
     }
 
     /// Gives the phase's iterate and slacks back to the pool.
