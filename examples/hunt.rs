@@ -127,8 +127,13 @@ impl Solve {
     }
 }
 
+/// A failure's record: the last iterate's iterations (the search's, all its solves', for a
+/// free-time search that certified no horizon).
 fn failed<const N: usize, const X: usize>(error: &PlanError<N, X>) -> Solve {
-    let iterations = error.last.as_ref().map_or(0, |last| last.iterations);
+    let iterations = match error.failure {
+        Failure::FreeTimeSearch { iterations, .. } => iterations,
+        _ => error.last.as_ref().map_or(0, |last| last.iterations),
+    };
     Solve::failure(failure_name(&error.failure), iterations, error.to_string())
 }
 

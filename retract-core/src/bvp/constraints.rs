@@ -69,6 +69,14 @@ pub enum ConstraintKind {
     /// A bound on a variable ([`super::OptimalControlProblem::with_bounds`] and the vector
     /// forms).
     Bound(Variable),
+    /// The scheme's equations of a step, $x_{i+1} = \Phi_h(x_i, u_i)$, the [`ConstraintRef`]'s
+    /// index their jet entry: named where a solve stalls with their defect
+    /// $\Phi_h(x_i, u_i) - x_{i+1}$ the largest violation ([`super::Failure::StalledInfeasible`]).
+    Dynamics,
+    /// A fixed component of the start or goal (the [`ConstraintRef`]'s index its jet entry),
+    /// missed by the first or last node: named where a solve stalls with that miss the
+    /// largest violation.
+    FixedEnd,
 }
 
 /// A constraint as the user added it: its kind, its index among the constraints of that
@@ -81,7 +89,8 @@ pub struct ConstraintRef {
     pub kind: ConstraintKind,
     /// The index among the constraints of its class, from 0 in the order they were added.
     pub index: usize,
-    /// The function's type name (e.g. `CartForce`); `"bound"` for a bound.
+    /// The function's type name (e.g. `CartForce`); `"bound"` for a bound, `"dynamics"` and
+    /// `"end"` for [`ConstraintKind::Dynamics`] and [`ConstraintKind::FixedEnd`].
     pub name: &'static str,
 }
 
@@ -105,6 +114,10 @@ impl core::fmt::Display for ConstraintRef {
             ConstraintKind::Bound(Variable::Top(a)) => {
                 write!(f, "bound #{} on top derivative {a}", self.index)
             }
+            ConstraintKind::Dynamics => {
+                write!(f, "the dynamics (the scheme's jet entry {})", self.index)
+            }
+            ConstraintKind::FixedEnd => write!(f, "the fixed jet entry {}", self.index),
         }
     }
 }

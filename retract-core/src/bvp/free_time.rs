@@ -174,7 +174,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// [`Failure::Invalid`] for bad [`FreeTime`] data or a problem $T$ outside it; the
     /// first solve's error where no horizon could be solved; [`Failure::NotAMinimum`] with the
     /// plan where $\varphi'' \le 0$ at the end (or $\varphi$ decreases out of the interval at
-    /// a bound), or [`Failure::IterationLimit`] with the best plan where the search used its
+    /// a bound), or [`Failure::FreeTimeSearch`] with the best plan where the search used its
     /// 150 solves or 4 rounds.
     pub fn solve_free_time<const S: usize, const M: usize>(
         &self,
@@ -219,7 +219,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 Probed::Lower(t) => bracket = (free.lower.max(0.9 * t), free.upper.min(1.1 * t)),
             }
         }
-        Err(search.failure(Failure::IterationLimit))
+        Err(search.failure(false))
     }
 
     /// $\varphi(T)$, solving at horizon `t_end` from `guess` or else from the best plan so
@@ -338,7 +338,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 }
             }
         }
-        Err(search.failure(Failure::IterationLimit))
+        Err(search.failure(true))
     }
 
     /// The certificate of the module docs at `search`'s best horizon: the curvature, or the
@@ -365,7 +365,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             }
         }
         let Some((t_end, cost, plan)) = search.best.take() else {
-            return Probed::Done(Box::new(Err(search.failure(Failure::IterationLimit))));
+            return Probed::Done(Box::new(Err(search.failure(false))));
         };
         let delta = 1e-3 * t_end;
         let (at_lower, at_upper) = (t_end == free.lower, t_end == free.upper);
@@ -417,8 +417,14 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
 }
 
 impl<const N: usize, const X: usize> Search<N, X> {
-    /// `failure` with the best plan so far, or the first solve's error where none succeeded.
-    fn failure(&mut self, failure: Failure) -> PlanError<N, X> {
+    /// [`Failure::FreeTimeSearch`] (its budget of solves spent if `budget_spent`, else its
+    /// rounds) with the best plan so far, or the first solve's error where none succeeded.
+    fn failure(&mut self, budget_spent: bool) -> PlanError<N, X> {
+        let failure = Failure::FreeTimeSearch {
+            solves: self.solves,
+            iterations: self.iterations,
+            budget_spent,
+        };
         match self.best.take() {
             Some((_, _, plan)) => PlanError {
                 failure,

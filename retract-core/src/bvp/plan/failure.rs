@@ -36,10 +36,27 @@ pub enum Failure {
     Infeasible(Infeasibility),
     /// The iteration stalled at a point that violates a constraint (the inertia correction or
     /// the line search failed there): the constraint violated most at the last iterate, where,
-    /// and by how much. The constraints may contradict each other there (a point of local
+    /// and by how much, among the inequalities, the stage equalities, the scheme's equations
+    /// of each step ([`crate::bvp::ConstraintKind::Dynamics`]) and the fixed ends
+    /// ([`crate::bvp::ConstraintKind::FixedEnd`]). The constraints may contradict each other there (a point of local
     /// infeasibility), or the guess meets an obstacle head on, with no side to pass it
     /// preferred.
     StalledInfeasible(Infeasibility),
+    /// The free-time search ([`crate::bvp::OptimalControlProblem::solve_free_time`]) ended
+    /// without a certified horizon, with the best plan found attached: it made `solves`
+    /// fixed-horizon solves (`iterations` SQP iterations in all) and either spent its budget of
+    /// solves (`budget_spent`) or ran its rounds, each ended by a probe at $T \pm 10^{-3} T$
+    /// that found a lower $\varphi(T) = w T + J^*(T)$ than the minimiser found ($\varphi$ is
+    /// not unimodal or not smooth there: the fixed-horizon solves at nearby horizons end in
+    /// different local minima, or the active set changes).
+    FreeTimeSearch {
+        /// Fixed-horizon solves made.
+        solves: usize,
+        /// SQP iterations of all of them.
+        iterations: usize,
+        /// Whether the budget of solves ran out (else the rounds did).
+        budget_spent: bool,
+    },
     /// The goal cannot be reached: its fixed component `component` depends on the stage
     /// equalities (linearised at the last iterate) and the dynamics alone (they leave it no
     /// control), and at the last iterate no step reduces its miss `miss` $= |x_N -
@@ -116,9 +133,10 @@ impl core::fmt::Display for Failure {
             Failure::Infeasible(infeasibility) => write!(f, "infeasible: {infeasibility}"),
             Failure::StalledInfeasible(infeasibility) => write!(
                 f,
-                "stalled at an infeasible point: {infeasibility}; check that the constraints \
-                 can hold together there, or start from a guess that satisfies them (around \
-                 an obstacle, not through it)"
+                "stalled at an infeasible point: {infeasibility}; check that the constraints, \
+                 the dynamics and the fixed ends can hold together there (bounds wide enough \
+                 for the horizon), or start from a guess that satisfies them (around an \
+                 obstacle, not through it)"
             ),
             Failure::UnreachableGoal { component, miss } => write!(
                 f,
@@ -129,6 +147,33 @@ impl core::fmt::Display for Failure {
                  there), free that component (with_free_end), or make the goal consistent \
                  with the equalities"
             ),
+            Failure::FreeTimeSearch {
+                solves,
+                iterations,
+                budget_spent,
+            } => {
+                write!(
+                    f,
+                    "the free-time search certified no horizon in {solves} fixed-horizon \
+                     solves ({iterations} iterations in all): "
+                )?;
+                if *budget_spent {
+                    write!(f, "its budget of solves ran out")?;
+                } else {
+                    write!(
+                        f,
+                        "each of its rounds ended with a probe at 0.1 % from the minimiser \
+                         found finding a lower w T + J (not unimodal or not smooth in T there: \
+                         e.g. the fixed-horizon solves at nearby horizons end in different \
+                         local minima, or an active bound changes)"
+                    )?;
+                }
+                write!(
+                    f,
+                    "; the best plan found is attached: solve at its horizon (h N) with it as \
+                     the guess, or narrow [T_min, T_max] about that horizon"
+                )
+            }
             Failure::NotAMinimum {
                 negative_directions: 0,
             } => write!(

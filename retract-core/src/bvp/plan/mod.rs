@@ -279,6 +279,12 @@ impl<const N: usize, const X: usize> core::fmt::Display for PlanError<N, X> {
         write!(f, "{}", self.failure)?;
         if let Some(last) = &self.last {
             let c = &last.certificate;
+            if matches!(self.failure, Failure::FreeTimeSearch { .. }) {
+                // (the iterations are the search's, in the failure)
+                let horizon = last.h * last.u.len() as f64;
+                write!(f, " (the best plan: T = {horizon}, J = {:e})", last.cost)?;
+                return Ok(());
+            }
             write!(
                 f,
                 " (after {} iterations: cost {:e}, stationarity {:e}, feasibility {:e})",

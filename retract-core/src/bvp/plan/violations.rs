@@ -4,7 +4,7 @@
 //! interpolant's check points. The measurement itself is the problem's
 //! (`OptimalControlProblem::violations`).
 
-use crate::bvp::constraints::ConstraintRef;
+use crate::bvp::constraints::{ConstraintKind, ConstraintRef};
 use crate::bvp::guess::Hermite;
 
 /// The parts each step is cut into to check the interpolant ([`Violations::interpolant`]):
@@ -92,6 +92,17 @@ impl core::fmt::Display for Infeasibility {
                 "{c} has a lower side {v:e} above an upper side (of itself or of another bound \
                  of the same variable): no point satisfies it"
             ),
+            Location::Start | Location::Goal if c.kind == ConstraintKind::FixedEnd => {
+                let (node, end) = match self.location {
+                    Location::Start => ("first", "start"),
+                    _ => ("last", "goal"),
+                };
+                write!(
+                    f,
+                    "the {node} node misses the {end}'s jet entry {} by {v:e}",
+                    c.index
+                )
+            }
             Location::Start => write!(f, "the start violates {c} by {v:e}"),
             Location::Goal => write!(f, "the goal violates {c} by {v:e}"),
             Location::Node(i) => write!(f, "{c} is violated by {v:e} at node {i}"),

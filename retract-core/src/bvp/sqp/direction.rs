@@ -51,7 +51,10 @@ where
                     (failure, Self::unsolved_certificate(&models, barrier))
                 } else {
                     let partial = self.failure_certificate(&models, barrier);
-                    (self.name_infeasibility(failure, iterate, None), partial)
+                    (
+                        self.name_infeasibility(failure, (iterate, &models), None),
+                        partial,
+                    )
                 };
                 let cost = models.cost;
                 self.give_models(models);

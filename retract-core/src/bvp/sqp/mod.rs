@@ -423,7 +423,7 @@ where
                     continue;
                 }
                 Err(failure) => {
-                    let failure = self.name_infeasibility(failure, &st.iterate, goal);
+                    let failure = self.name_infeasibility(failure, (&st.iterate, &models), goal);
                     self.pool.borrow_mut().reals.give(ds);
                     let (cost, certificate, momenta) = self.hand_back(models, sub);
                     return Err(fail(failure, cost, certificate, momenta));

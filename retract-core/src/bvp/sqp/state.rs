@@ -11,12 +11,13 @@ use nalgebra::SVector;
 use super::acceptable::Kept;
 use super::filter::Filter;
 use crate::bvp::barrier::Barrier;
-use crate::bvp::constraints::{Inequality, Linearized};
+use crate::bvp::constraints::{ConstraintKind, ConstraintRef, Inequality, Linearized};
 use crate::bvp::dynamics::Dynamics;
 use crate::bvp::iterate::Iterate;
 use crate::bvp::kkt::model::{StageModel, Terminal};
 use crate::bvp::kkt::riccati::{Direction, Riccati};
 use crate::bvp::options::PlanOptions;
+use crate::bvp::plan::violations::{Infeasibility, Location};
 use crate::bvp::plan::{Certificate, Plan};
 use crate::bvp::problem::OptimalControlProblem;
 use crate::bvp::workspace::Pool;
@@ -105,6 +106,40 @@ pub(super) struct State<const N: usize, const X: usize> {
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
+    /// The largest entry of the scheme's defects $\Phi_h(x_i, u_i) - x_{i+1}$ and of the
+    /// fixed ends' misses $|x_0 - \text{start}|$, $|x_N - \text{goal}|$ (the equality rows the
+    /// problem's own [`OptimalControlProblem::violations`] leaves out), as the constraint a
+    /// stalled solve names; `None` without steps.
+    pub(super) fn worst_defect(&self) -> Option<Infeasibility> {
+        let named = |kind, index, location, violation: f64| Infeasibility {
+            constraint: ConstraintRef {
+                kind,
+                index,
+                name: if kind == ConstraintKind::Dynamics {
+                    "dynamics"
+                } else {
+                    "end"
+                },
+            },
+            location,
+            violation: violation.abs(),
+        };
+        let steps = self.stages.iter().enumerate().map(|(i, stage)| {
+            let r = stage.defect.iamax();
+            named(
+                ConstraintKind::Dynamics,
+                r,
+                Location::Step(i),
+                stage.defect[r],
+            )
+        });
+        let ends = [(&self.r0, Location::Start), (&self.r_end, Location::Goal)]
+            .map(|(miss, end)| named(ConstraintKind::FixedEnd, miss.iamax(), end, miss.amax()));
+        steps
+            .chain(ends)
+            .max_by(|a, b| a.violation.total_cmp(&b.violation))
+    }
+
     /// $\Vert c\Vert_1$ over defects, stage constraints and boundary data.
     pub(super) fn violation_l1(&self) -> f64 {
         self.slack_violation.0

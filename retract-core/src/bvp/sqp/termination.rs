@@ -298,17 +298,19 @@ where
         None
     }
 
-    /// A failure at `iterate` named for what stopped it: a line search that finds no step
-    /// where the subproblem cannot reach the goal (`goal`: the component and its miss,
-    /// [`Self::unreachable_goal`]) as [`Failure::UnreachableGoal`] (the goal stops it, not the
-    /// merit function: a sideways guess for a car that cannot slip); a failure of the inertia
-    /// correction or the line search at an iterate that violates a constraint beyond the
-    /// tolerance as [`Failure::StalledInfeasible`] naming the constraint violated most (and
-    /// where); any other failure as it is.
+    /// A failure at `iterate` (with its `models`) named for what stopped it: a line search
+    /// that finds no step where the subproblem cannot reach the goal (`goal`: the component
+    /// and its miss, [`Self::unreachable_goal`]) as [`Failure::UnreachableGoal`] (the goal
+    /// stops it, not the merit function: a sideways guess for a car that cannot slip); a
+    /// failure of the inertia correction or the line search at an iterate that violates a
+    /// constraint beyond the tolerance as [`Failure::StalledInfeasible`] naming the
+    /// constraint violated most, where, and by how much: an inequality or stage equality
+    /// ([`violations`](crate::bvp::problem::OptimalControlProblem::violations)), the scheme's equations of a step or a fixed end
+    /// ([`Models::worst_defect`]), whichever is larger; any other failure as it is.
     pub(super) fn name_infeasibility(
         &self,
         failure: Failure,
-        iterate: &Iterate<N, X>,
+        (iterate, models): (&Iterate<N, X>, &Models<N, X>),
         goal: Option<(usize, f64)>,
     ) -> Failure {
         if let (Failure::LineSearch, Some((component, miss))) = (&failure, goal) {
@@ -317,11 +319,18 @@ where
         if !matches!(failure, Failure::Regularization | Failure::LineSearch) {
             return failure;
         }
-        match self.problem.violations(iterate, self.dynamics.theta) {
-            (violations, Some(worst))
-                if violations.imposed().is_nan()
-                    || violations.imposed() > self.options.tolerance =>
-            {
+        let (violations, constraint) = self.problem.violations(iterate, self.dynamics.theta);
+        // (a NaN violation of a constraint is named before any finite defect)
+        let worst = if violations.imposed().is_nan() {
+            constraint
+        } else {
+            [constraint, models.worst_defect()]
+                .into_iter()
+                .flatten()
+                .max_by(|a, b| a.violation.total_cmp(&b.violation))
+        };
+        match worst {
+            Some(worst) if worst.violation.is_nan() || worst.violation > self.options.tolerance => {
                 Failure::StalledInfeasible(worst)
             }
             _ => failure,
