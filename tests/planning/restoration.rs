@@ -9,7 +9,8 @@ use std::f64::consts::PI;
 use crate::cart_pole::{CartForce, CartPole, PoleTorque};
 use crate::quadrotor::{Clearance, Lateral, Quadrotor, Rotors};
 use retract::bvp::{
-    ConstraintKind, Curve, Failure, Location, OptimalControlProblem, PlanGuess, PlanOptions,
+    ConstraintKind, Curve, Failure, Location, OptimalControlProblem, Plan, PlanError, PlanGuess,
+    PlanOptions,
 };
 
 /// The quadrotor of the constrained suite (thrusts in [0, 15], the disc, T = 2, N = 50) from
@@ -59,16 +60,9 @@ fn the_quadrotor_from_the_zero_guess_is_restored_and_certified() {
 /// (`cargo run --release --example hunt -- cartpole "T=2.5 F=5 N=50"`) fails here.
 #[test]
 fn a_restoration_without_progress_names_the_infeasibility() {
-    let (mc, mp, l) = (1.0, 0.3, 0.5);
-    let system = CartPole::new(mc, mp, l);
-    let unactuated = PoleTorque::new(mp, l, 9.81);
-    let force = CartForce::new(mc, mp, l);
-    let (t_end, goal) = (2.5, [0.0, PI, 0.0, 0.0]);
+    let t_end = 2.5;
     let line = Curve::from_fn(move |t| [0.0, PI * t / t_end]);
-    let problem = OptimalControlProblem::new(&system, &[0.0; 4], &goal, t_end, 50)
-        .with_equality(&unactuated)
-        .with_function_bounds(&force, -5.0, 5.0);
-    let error = match problem.solve(PlanGuess::Curve(&line)) {
+    let error = match swing_up(5.0, (t_end, 50), PlanGuess::Curve(&line)) {
         Err(e) => e,
         Ok(plan) => panic!("certified with |F| <= 5: J = {}", plan.cost),
     };
@@ -78,10 +72,10 @@ fn a_restoration_without_progress_names_the_infeasibility() {
     assert!(infeasibility.violation > 1e-3, "{infeasibility}");
     let last = error.last.as_ref().expect("the last iterate");
     assert!(last.iterations < 500, "{} iterations", last.iterations);
-    // from the zero path (the goal's node too) the solve stalls with the inequalities nearly
-    // met (|F| <= 5 violated by 6e-2) but the goal's angle missed by 0.40: the miss is named
+    // from the zero path (the goal's node too) the solve stalls with the goal's angle missed
+    // by more than any constraint is violated (0.38): the miss is named
     let zero = Curve::from_derivatives(|_, _| [0.0; 2]);
-    let error = match problem.solve(PlanGuess::Curve(&zero)) {
+    let error = match swing_up(5.0, (t_end, 50), PlanGuess::Curve(&zero)) {
         Err(e) => e,
         Ok(plan) => panic!("certified with |F| <= 5: J = {}", plan.cost),
     };
@@ -95,9 +89,45 @@ fn a_restoration_without_progress_names_the_infeasibility() {
         (1, Location::Goal)
     );
     assert_eq!(missed.violation, last.certificate.feasibility, "{error}");
-    assert!(
-        last.violations.imposed() < missed.violation / 2.0,
-        "{error}"
-    );
+    assert!(last.violations.imposed() <= missed.violation, "{error}");
     assert!(error.to_string().contains("misses the goal's jet entry 1"));
+}
+
+/// The cart-pole of the constrained suite with |F| <= 8, T = 2.5 on a fine grid (N = 800)
+/// from the smoothstep, certified at IPOPT's minimum on the same transcription from the same
+/// guess, J = 20.4183113258 in 85 iterations (`NSTEPS=800 python3
+/// validation/ipopt/constrained_suite.py cartpole-T2.5-F8`), in no more iterations. The two
+/// sides of |F| <= 8 have a slack each where IPOPT has one, and the line search's constraint
+/// violation counted the nonlinearity of F in both: the first full step raised it (802
+/// against IPOPT's 511 at the same trial point), the steps shrank to 1e-5 and the solve
+/// stalled as infeasible after 359 iterations. Each side now weighs a half.
+#[test]
+fn both_sides_of_a_bound_count_once_in_the_violation() {
+    let plan = swing_up(8.0, (2.5, 800), PlanGuess::Spline).unwrap_or_else(|e| panic!("{e}"));
+    let ipopt = 20.418_311_325_8;
+    assert!(
+        (plan.cost - ipopt).abs() <= 1e-7 * ipopt,
+        "J = {}",
+        plan.cost
+    );
+    assert!(plan.iterations <= 85, "{} iterations", plan.iterations);
+    assert_eq!(plan.certificate.negative_directions, 0);
+    assert!(plan.violations.imposed() <= 1e-8, "{:?}", plan.violations);
+}
+
+/// The cart-pole of the constrained suite (rest to upright) with |F| <= `limit`, horizon and
+/// steps `(t_end, steps)`, solved from `guess`.
+fn swing_up(
+    limit: f64,
+    (t_end, steps): (f64, usize),
+    guess: PlanGuess<'_, 2, 4>,
+) -> Result<Plan<2, 4>, PlanError<2, 4>> {
+    let (mc, mp, l) = (1.0, 0.3, 0.5);
+    let system = CartPole::new(mc, mp, l);
+    let unactuated = PoleTorque::new(mp, l, 9.81);
+    let force = CartForce::new(mc, mp, l);
+    OptimalControlProblem::new(&system, &[0.0; 4], &[0.0, PI, 0.0, 0.0], t_end, steps)
+        .with_equality(&unactuated)
+        .with_function_bounds(&force, -limit, limit)
+        .solve(guess)
 }

@@ -419,30 +419,49 @@ impl Barrier {
             .fold(1.0_f64, |a, (s, d)| a.min(-tau * s / d))
     }
 
-    /// $-h \mu \sum \ln(s + \alpha \delta s)$ and $\sum |g - s - \alpha \delta s|$ at a trial
-    /// point where the constraints take `values`.
-    pub fn trial_terms(&self, values: &[f64], ds: &[f64], alpha: f64, h: f64) -> (f64, f64) {
+    /// The weight of entry `k` in the constraint violation, from the `weights` of the
+    /// inequalities at a step and at a node ([`super::constraints::violation_weights`]; 1
+    /// where missing).
+    fn weight(&self, k: usize, (steps, nodes): (&[f64], &[f64])) -> f64 {
+        let at_steps = self.at_steps();
+        let own = if k < at_steps {
+            steps.get(k % self.count.max(1))
+        } else {
+            nodes.get((k - at_steps) % self.nodes.max(1))
+        };
+        own.copied().unwrap_or(1.0)
+    }
+
+    /// $-h \mu \sum \ln(s + \alpha \delta s)$ and $\sum_k w_k |g_k - s_k - \alpha \delta s_k|$
+    /// (the `weights` of [`Self::weight`]) at a trial point where the constraints take `values`.
+    pub fn trial_terms(
+        &self,
+        values: &[f64],
+        (ds, alpha): (&[f64], f64),
+        h: f64,
+        weights: (&[f64], &[f64]),
+    ) -> (f64, f64) {
         let mut log = 0.0;
         let mut violation = 0.0;
-        for ((s, d), g) in self.s.iter().zip(ds).zip(values) {
+        for (k, ((s, d), g)) in self.s.iter().zip(ds).zip(values).enumerate() {
             let next = s + alpha * d;
             log += next.ln();
-            violation += (g - next).abs();
+            violation += self.weight(k, weights) * (g - next).abs();
         }
         (-h * self.mu * log, violation)
     }
 
-    /// The barrier term and $\sum |g - s|$ at the current iterate.
+    /// The barrier term and $\sum_k w_k |g_k - s_k|$ at the current iterate (the `weights` of
+    /// [`Self::weight`]).
     pub fn current_terms<const N: usize, const X: usize>(
         &self,
         lin: &[Linearized<N, X>],
         h: f64,
+        weights: (&[f64], &[f64]),
     ) -> (f64, f64) {
         let log: f64 = self.s.iter().map(|s| s.ln()).sum();
-        let violation = lin
-            .iter()
-            .zip(&self.s)
-            .map(|(c, s)| (c.value - s).abs())
+        let violation = (lin.iter().zip(&self.s).enumerate())
+            .map(|(k, (c, s))| self.weight(k, weights) * (c.value - s).abs())
             .sum();
         (-h * self.mu * log, violation)
     }

@@ -419,20 +419,42 @@ pub(super) fn slack_push<const N: usize, const K: usize>(
     let alone = |c: &Inequality<'_, N, K>| KAPPA * c.value.abs().max(1.0);
     list.iter()
         .enumerate()
-        .map(|(j, c)| {
-            let partner = list.iter().enumerate().find(|(k, d)| {
-                *k != j && d.sign == -c.sign && d.index == c.index && c.same_source(d)
-            });
-            match partner {
-                Some((_, d)) => {
-                    let width = c.sign * (d.value - c.value);
-                    let own = alone(c).min(KAPPA * width);
-                    let other = alone(d).min(KAPPA * width);
-                    (own, width - other)
-                }
-                None => (alone(c), f64::INFINITY),
+        .map(|(j, c)| match partner(list, j) {
+            Some(d) => {
+                let width = c.sign * (d.value - c.value);
+                let own = alone(c).min(KAPPA * width);
+                let other = alone(d).min(KAPPA * width);
+                (own, width - other)
             }
+            None => (alone(c), f64::INFINITY),
         })
+        .collect()
+}
+
+/// The other side of the interval of `list[j]`, if it is one side of an interval
+/// $\ell \le v \le u$ (the same source and user's constraint, the opposite sign).
+fn partner<'l, 'a, const N: usize, const K: usize>(
+    list: &'l [Inequality<'a, N, K>],
+    j: usize,
+) -> Option<&'l Inequality<'a, N, K>> {
+    let c = &list[j];
+    (list.iter().enumerate())
+        .find(|(k, d)| *k != j && d.sign == -c.sign && d.index == c.index && c.same_source(d))
+        .map(|(_, d)| d)
+}
+
+/// The weight of each inequality of `list` in the constraint violation $\theta$ of the line
+/// search, $\sum_j w_j |g_j - s_j|$: $\tfrac12$ for a side of an interval, 1 for a side
+/// alone. The two sides of $\ell \le v \le u$ have two slacks where IPOPT has one ($v - s
+/// = 0$, $s \in [\ell, u]$), and along a Newton step their residuals are equal and opposite
+/// (the nonlinearity of $v$ in each): with the halves, $\theta$ is IPOPT's. (The restoration
+/// phase counts each side's elastic violation whole: it returns only where that larger
+/// measure has fallen.)
+pub(super) fn violation_weights<const N: usize, const K: usize>(
+    list: &[Inequality<'_, N, K>],
+) -> Vec<f64> {
+    (0..list.len())
+        .map(|j| if partner(list, j).is_some() { 0.5 } else { 1.0 })
         .collect()
 }
 
@@ -490,6 +512,14 @@ mod tests {
             index,
             sample: None,
         }
+    }
+
+    /// The two sides of an interval weigh a half each in the constraint violation, a side
+    /// alone (or a side of another constraint of the same variable) the whole.
+    #[test]
+    fn the_sides_of_an_interval_share_one_weight() {
+        let list = [side(-1.0, 1.0, 0), side(2.0, -1.0, 0), side(0.5, 1.0, 1)];
+        assert_eq!(violation_weights(&list), vec![0.5, 0.5, 1.0]);
     }
 
     /// $g = q_0^2 q_1' + q_1 \sin q_0'$ on $\mathbb{R}^2$, $k = 2$ (a function of the jet alone).

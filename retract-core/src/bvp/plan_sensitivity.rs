@@ -131,6 +131,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             started: Instant::now(),
             at_steps: &placed.at_steps,
             at_nodes: &placed.at_nodes,
+            violation_weights: (&placed.violation_weights.0, &placed.violation_weights.1),
             pool: &workspace.pool,
             options: self.options,
             real_time: false,

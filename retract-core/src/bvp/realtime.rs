@@ -287,6 +287,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             started: Instant::now(),
             at_steps: &[],
             at_nodes: &[],
+            violation_weights: (&[], &[]),
             pool: &workspace.pool,
             options: self.options,
             real_time: true,

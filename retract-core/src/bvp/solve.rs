@@ -103,6 +103,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             started,
             at_steps: &placed.at_steps,
             at_nodes: &placed.at_nodes,
+            violation_weights: (&placed.violation_weights.0, &placed.violation_weights.1),
             pool: &workspace.pool,
             options,
             real_time,

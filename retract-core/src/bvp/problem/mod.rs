@@ -61,6 +61,9 @@ pub(in crate::bvp) struct Placed<'a, const N: usize, const K: usize> {
     /// The weights of the interpolant inside a step
     /// ([`super::plan::violations::interpolant_weights`]).
     pub interpolant: Option<Vec<f64>>,
+    /// The weights of `at_steps` and of `at_nodes` in the line search's constraint violation
+    /// ([`super::constraints::violation_weights`]).
+    pub violation_weights: (Vec<f64>, Vec<f64>),
 }
 
 impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize> Clone
@@ -190,10 +193,15 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 placed(Placement::at_nodes)
             };
             let interpolant = super::plan::violations::interpolant_weights(self.h(), K);
+            let violation_weights = (
+                super::constraints::violation_weights(&at_steps),
+                super::constraints::violation_weights(&at_nodes),
+            );
             Placed {
                 at_steps,
                 at_nodes,
                 interpolant,
+                violation_weights,
             }
         })
     }

@@ -108,7 +108,7 @@ where
             values.extend(self.at_steps.iter().map(|c| c.value(&xt, u)));
         }
         self.node_values(iterate, &mut values);
-        let (log, slack) = barrier.trial_terms(&values, ds, alpha, h);
+        let (log, slack) = barrier.trial_terms(&values, (ds, alpha), h, self.violation_weights);
         self.pool.borrow_mut().trial_values = (values, alpha);
         let last = &iterate.x[iterate.x.len() - 1];
         violation += slack

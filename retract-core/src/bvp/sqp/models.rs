@@ -194,7 +194,8 @@ where
         let last = &iterate.x[iterate.x.len() - 1];
         let fixed = self.problem.fixed_end;
         let r_end = (self.problem.goal - last).component_mul(&fixed);
-        let (log, slack_l1) = barrier.current_terms(&inequalities, self.dynamics.h);
+        let (log, slack_l1) =
+            barrier.current_terms(&inequalities, self.dynamics.h, self.violation_weights);
         let slack_violation = (slack_l1, barrier.residual(&inequalities));
         let (phi, terminal_gradient, hessian) = self.terminal_model(last);
         let cost = cost + phi;

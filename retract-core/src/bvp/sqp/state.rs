@@ -41,6 +41,9 @@ pub(in crate::bvp) struct Sqp<
     pub at_steps: &'p [Inequality<'a, N, K>],
     /// The inequalities placed at the nodes (imposed at the interior ones).
     pub at_nodes: &'p [Inequality<'a, N, K>],
+    /// The weights of `at_steps` and `at_nodes` in the constraint violation
+    /// ([`crate::bvp::constraints::violation_weights`]; 1 where missing).
+    pub violation_weights: (&'p [f64], &'p [f64]),
     /// The vectors kept between iterations and solves.
     pub pool: &'p RefCell<Pool<N, X>>,
     /// The options of this run (the problem's, or those of a real-time iteration).
