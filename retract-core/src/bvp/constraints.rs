@@ -437,7 +437,7 @@ fn partner<'l, 'a, const N: usize, const K: usize>(
     list: &'l [Inequality<'a, N, K>],
     j: usize,
 ) -> Option<&'l Inequality<'a, N, K>> {
-    let c = &list[j];
+    let c = list.get(j)?;
     (list.iter().enumerate())
         .find(|(k, d)| *k != j && d.sign == -c.sign && d.index == c.index && c.same_source(d))
         .map(|(_, d)| d)
