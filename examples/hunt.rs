@@ -6,7 +6,8 @@
 //! the variant is a run of `key=value` words (`T=2.5 F=8 N=250 guess=line`), the outcome
 //! `certified` or the failure's variant name (`NotAMinimum(k)` with its negative directions),
 //! `J` the certified plan's cost (`-` on a failure), `iterations` those of the last iterate on
-//! a failure (0 without one); a failure's line ends with ` # <its message>`. After each
+//! a failure (0 without one; a free-time search's of all its solves); a failure's line ends
+//! with ` # <its message>`. After each
 //! family a line `summary <family> solves=<n> certified=<c> failures=<kind:count,...>
 //! certified_iterations=<sum over the certified> time_s=<t>`.
 //!
