@@ -419,21 +419,23 @@ impl Barrier {
             .fold(1.0_f64, |a, (s, d)| a.min(-tau * s / d))
     }
 
-    /// The weight of entry `k` in the constraint violation, from the `weights` of the
-    /// inequalities at a step and at a node ([`super::constraints::violation_weights`]; 1
-    /// where missing).
-    fn weight(&self, k: usize, (steps, nodes): (&[f64], &[f64])) -> f64 {
-        let at_steps = self.at_steps();
-        let own = if k < at_steps {
-            steps.get(k % self.count.max(1))
-        } else {
-            nodes.get((k - at_steps) % self.nodes.max(1))
+    /// The weight of every entry in the constraint violation, in order, from the `weights` of
+    /// the inequalities at a step and at a node ([`super::constraints::violation_weights`]; 1
+    /// where missing): the step pattern once per step, then the node pattern once per node.
+    fn weights<'w>(
+        &self,
+        (steps, nodes): (&'w [f64], &'w [f64]),
+    ) -> impl Iterator<Item = f64> + 'w {
+        let pattern = |weights: &'w [f64], len: usize| {
+            (0..len).map(move |j| weights.get(j).copied().unwrap_or(1.0))
         };
-        own.copied().unwrap_or(1.0)
+        let at_steps = pattern(steps, self.count).cycle().take(self.at_steps());
+        let at_nodes = pattern(nodes, self.nodes).cycle();
+        at_steps.chain(at_nodes).take(self.s.len())
     }
 
     /// $-h \mu \sum \ln(s + \alpha \delta s)$ and $\sum_k w_k |g_k - s_k - \alpha \delta s_k|$
-    /// (the `weights` of [`Self::weight`]) at a trial point where the constraints take `values`.
+    /// (the `weights` of [`Self::weights`]) at a trial point where the constraints take `values`.
     pub fn trial_terms(
         &self,
         values: &[f64],
@@ -443,16 +445,16 @@ impl Barrier {
     ) -> (f64, f64) {
         let mut log = 0.0;
         let mut violation = 0.0;
-        for (k, ((s, d), g)) in self.s.iter().zip(ds).zip(values).enumerate() {
+        for (((s, d), g), w) in self.s.iter().zip(ds).zip(values).zip(self.weights(weights)) {
             let next = s + alpha * d;
             log += next.ln();
-            violation += self.weight(k, weights) * (g - next).abs();
+            violation += w * (g - next).abs();
         }
         (-h * self.mu * log, violation)
     }
 
     /// The barrier term and $\sum_k w_k |g_k - s_k|$ at the current iterate (the `weights` of
-    /// [`Self::weight`]).
+    /// [`Self::weights`]).
     pub fn current_terms<const N: usize, const X: usize>(
         &self,
         lin: &[Linearized<N, X>],
@@ -460,8 +462,8 @@ impl Barrier {
         weights: (&[f64], &[f64]),
     ) -> (f64, f64) {
         let log: f64 = self.s.iter().map(|s| s.ln()).sum();
-        let violation = (lin.iter().zip(&self.s).enumerate())
-            .map(|(k, (c, s))| self.weight(k, weights) * (c.value - s).abs())
+        let violation = (lin.iter().zip(&self.s).zip(self.weights(weights)))
+            .map(|((c, s), w)| w * (c.value - s).abs())
             .sum();
         (-h * self.mu * log, violation)
     }

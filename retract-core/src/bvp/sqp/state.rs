@@ -114,30 +114,19 @@ impl<const N: usize, const X: usize> Models<N, X> {
     /// problem's own [`OptimalControlProblem::violations`] leaves out), as the constraint a
     /// stalled solve names; `None` without steps.
     pub(super) fn worst_defect(&self) -> Option<Infeasibility> {
-        let named = |kind, index, location, violation: f64| Infeasibility {
-            constraint: ConstraintRef {
-                kind,
-                index,
-                name: if kind == ConstraintKind::Dynamics {
-                    "dynamics"
-                } else {
-                    "end"
-                },
-            },
+        let named = |(kind, name), index, location, violation: f64| Infeasibility {
+            constraint: ConstraintRef { kind, index, name },
             location,
             violation: violation.abs(),
         };
+        let dynamics = (ConstraintKind::Dynamics, "dynamics");
         let steps = self.stages.iter().enumerate().map(|(i, stage)| {
             let r = stage.defect.iamax();
-            named(
-                ConstraintKind::Dynamics,
-                r,
-                Location::Step(i),
-                stage.defect[r],
-            )
+            named(dynamics, r, Location::Step(i), stage.defect[r])
         });
+        let end = (ConstraintKind::FixedEnd, "end");
         let ends = [(&self.r0, Location::Start), (&self.r_end, Location::Goal)]
-            .map(|(miss, end)| named(ConstraintKind::FixedEnd, miss.iamax(), end, miss.amax()));
+            .map(|(miss, at)| named(end, miss.iamax(), at, miss.amax()));
         steps
             .chain(ends)
             .max_by(|a, b| a.violation.total_cmp(&b.violation))
