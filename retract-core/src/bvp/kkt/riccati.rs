@@ -1052,8 +1052,9 @@ mod tests {
             let r0 = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
             let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
             // the ends fixed; then q' free at the end with a terminal cost and q'_1 free at the
-            // start
-            for free_end in [false, true] {
+            // start; without and with an inertia correction rho, which the dense system has on
+            // the diagonal of every stage Hessian in (x_theta, u) and of the terminal cost's
+            for (free_end, rho) in [(false, 0.0), (true, 0.0), (false, 0.7), (true, 0.7)] {
                 let (terminal, s_end) = if free_end {
                     let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
                     let terminal = Terminal {
@@ -1071,15 +1072,26 @@ mod tests {
                 let free = X - terminal.rows();
                 let free_start = terminal.start_fixed.iter().filter(|f| **f == 0.0).count();
                 let riccati =
-                    Riccati::factor_with(&dynamics, &stages, 0.0, &terminal, &mut Pool::default());
+                    Riccati::factor_with(&dynamics, &stages, rho, &terminal, &mut Pool::default());
                 assert!(!riccati.singular);
                 assert_eq!(riccati.boundary() > 0, steps > 2);
                 let solve = || {
                     let pool = &mut Pool::default();
-                    riccati.solve(&dynamics, &stages, 0.0, &r0, (&r_end, &s_end), pool)
+                    riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end), pool)
                 };
                 let d = solve();
-                let (kkt, rhs) = dense_kkt(&dynamics, &stages, &terminal, (&r0, &r_end), &s_end);
+                let shifted: Vec<StageModel<N, X>> = (stages.iter())
+                    .map(|stage| {
+                        let mut stage = stage.clone();
+                        stage.hxx += SMatrix::<f64, X, X>::identity() * rho;
+                        stage.huu += SMatrix::<f64, N, N>::identity() * rho;
+                        stage
+                    })
+                    .collect();
+                let mut dense_end = terminal;
+                dense_end.hessian += SMatrix::<f64, X, X>::identity() * rho;
+                let ends = (&r0, &r_end);
+                let (kkt, rhs) = dense_kkt(&dynamics, &shifted, &dense_end, ends, &s_end);
                 let nc = (steps + 2) * X;
                 let xc = |i: usize| i * X;
                 let uc = |i: usize| (steps + 1) * X + i * N;
@@ -1089,7 +1101,7 @@ mod tests {
                 assert_eq!(
                     riccati.negative,
                     negative - (nc - free - free_start),
-                    "{steps} steps, shift {shift}, free end {free_end}"
+                    "{steps} steps, shift {shift}, free end {free_end}, rho {rho}"
                 );
                 if shift > 0.0 {
                     assert!(riccati.positive_definite());
@@ -1121,7 +1133,7 @@ mod tests {
                     &riccati,
                     &dynamics,
                     model,
-                    0.0,
+                    rho,
                     &r0,
                     end,
                     (&mut wrong, pool),
