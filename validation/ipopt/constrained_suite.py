@@ -1,4 +1,5 @@
-"""IPOPT on the constrained suite C1-C4 (../shared/BENCHMARKS.md), transcribed as
+"""IPOPT on the constrained suite C1-C4 (../shared/BENCHMARKS.md) and the swing-up suite's
+acrobot (`acrobot-T2`, `acrobot-T2-zero` from the zero path), transcribed as
 retract's optimizer transcribes it: jets x_i = (q, q') at the nodes (the ends fixed), u_i = q''
 per step, the lifted midpoint (theta = 1/2) dynamics, J = sum_i h L(x_mid_i, u_i), each
 constraint where examples/constrained.rs places it (node constraints as rows of g, as the
@@ -93,6 +94,25 @@ def problem(name):
         P['mid'] = lambda q, v, u: [(forces(q, v, u)[1], 0, 0), (forces(q, v, u)[0], -F, F)]
         P['node'] = lambda q, v: []
         P['guess'] = smoothstep(P['q0'], P['qT'], T)
+    elif name.startswith('acrobot'):
+        # the swing-up suite's acrobot (examples/common/pendulum.rs): the double pendulum with
+        # only the elbow actuated, L = 1/2 tau_2^2, the shoulder torque 0 at every step; from
+        # the hanging rest to upright rest; `acrobot-T2-zero` starts from the zero path (the
+        # failure hunt's guess), `acrobot-T2` from the smoothstep
+        T = float(name.split('-')[1][1:]); g = 9.81
+        P.update(n=2, T=T, q0=[0, 0], qT=[math.pi, 0])
+        def torque(q, v, u):
+            c2 = ca.cos(q[1]); m11 = 3 + 2 * c2; m12 = 1 + c2; m22 = 1; b = ca.sin(q[1])
+            g1 = 2 * g * ca.sin(q[0]) + g * ca.sin(q[0] + q[1]); g2 = g * ca.sin(q[0] + q[1])
+            return (m11 * u[0] + m12 * u[1] - b * (2 * v[0] * v[1] + v[1] ** 2) + g1,
+                    m12 * u[0] + m22 * u[1] + b * v[0] ** 2 + g2)
+        P['L'] = lambda q, v, u: 0.5 * torque(q, v, u)[1] ** 2
+        P['mid'] = lambda q, v, u: [(torque(q, v, u)[0], 0, 0)]
+        P['node'] = lambda q, v: []
+        if name.endswith('-zero'):
+            P['guess'] = lambda t: (np.zeros(2), np.zeros(2), np.zeros(2))
+        else:
+            P['guess'] = smoothstep(P['q0'], P['qT'], T)
     elif name.startswith('quadrotor'):
         fmax = float(name.split('-f')[1]); m, I, a, g = 1.0, 0.01, 0.1, 9.81
         P.update(n=3, T=2.0, q0=[0, 0, 0], qT=[2, 1, 0])
