@@ -9,13 +9,15 @@
 //!
 //! Run: `cargo run --release --example constrained` (add `-- quick` for a smaller version of
 //! each problem: a tenth of the steps; `cargo test --example constrained` runs that as a test,
-//! and `cargo test --workspace` with it).
+//! and `cargo test --workspace` with it; add `adaptive` for the adaptive barrier update,
+//! [`BarrierUpdate::Adaptive`], and a suite's name for that suite alone).
 
 use std::f64::consts::PI;
 use std::time::Instant;
 
 use retract::bvp::{
-    Curve, FreeTime, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, Variable,
+    BarrierUpdate, Curve, FreeTime, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess,
+    PlanOptions, Variable,
 };
 use retract::higher_order_lagrangian;
 
@@ -38,6 +40,18 @@ type Outcome = Result<(), Box<dyn std::error::Error>>;
 
 /// A suite of problems, run at full or reduced size.
 type Suite = fn(bool) -> Outcome;
+
+/// The options of every solve: the defaults, with the adaptive barrier update when the
+/// command line says `adaptive`.
+fn options() -> PlanOptions {
+    let adaptive = std::env::args().any(|a| a == "adaptive");
+    let update = if adaptive {
+        BarrierUpdate::Adaptive
+    } else {
+        BarrierUpdate::Monotone
+    };
+    PlanOptions::default().with_barrier_update(update)
+}
 
 /// The planar n-link chain's cost 1/2 |tau|^2, tau the Euler-Lagrange torques of T - V (unit
 /// lengths and masses at the link ends, joint angles relative, q_1 from the downward vertical):
@@ -132,6 +146,7 @@ fn cart_pole_suite(quick: bool) -> Outcome {
         )
         .with_equality(&unactuated)
         .with_function_bounds(&force, -limit, limit)
+        .with_options(options())
         .solve(PlanGuess::Spline);
         outcome = outcome.and(report(&name, start, result));
     }
@@ -150,6 +165,7 @@ fn min_time_suite(quick: bool) -> Outcome {
         .with_equalities(&passive)
         .with_function_bounds(&force[0], -10.0, 10.0)
         .with_bounds(Variable::Jet(0), -1.0, 1.0)
+        .with_options(options())
         .solve_free_time(FreeTime::new(0.5, 5.0, 1.0), PlanGuess::Spline);
     let ms = start.elapsed().as_secs_f64() * 1e3;
     match result {
@@ -193,6 +209,7 @@ fn quadrotor_suite(quick: bool) -> Outcome {
         .with_equality(&no_lateral)
         .with_vector_bounds(&thrusts, &[0.0; 2], &[fmax; 2])
         .with_inequality(&disc)
+        .with_options(options())
         .solve(PlanGuess::Spline);
         outcome = outcome.and(report(&name, start, result));
     }
@@ -223,6 +240,7 @@ fn parking_suite(quick: bool) -> Outcome {
         // of the jet alone would otherwise be placed at the nodes too)
         .with_inequality_at(&turn, Placement::Midpoints)
         .with_bounds(Variable::Jet(0), -xbox, xbox)
+        .with_options(options())
         .solve(PlanGuess::Curve(&guess));
         outcome = outcome.and(report(&name, start, result));
     }
@@ -244,7 +262,11 @@ fn chain_suite(quick: bool) -> Outcome {
         problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
     }
     let start = Instant::now();
-    let first = report("chain3", start, problem.solve(PlanGuess::Spline));
+    let first = report(
+        "chain3",
+        start,
+        problem.with_options(options()).solve(PlanGuess::Spline),
+    );
     let system = Chain7::new();
     let mut goal = [0.0; 14];
     goal[..7].fill(0.5);
@@ -254,12 +276,16 @@ fn chain_suite(quick: bool) -> Outcome {
         problem = problem.with_bounds(Variable::Jet(joint), -2.0, 2.0);
     }
     let start = Instant::now();
-    first.and(report("chain7", start, problem.solve(PlanGuess::Spline)))
+    first.and(report(
+        "chain7",
+        start,
+        problem.with_options(options()).solve(PlanGuess::Spline),
+    ))
 }
 
 fn main() {
     let quick = std::env::args().any(|a| a == "quick");
-    let only = std::env::args().nth(1).filter(|a| a != "quick");
+    let only = (std::env::args().skip(1)).find(|a| a != "quick" && a != "adaptive");
     let mut failed = false;
     let suites: [(&str, Suite); 5] = [
         ("cartpole", cart_pole_suite),

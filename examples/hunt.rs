@@ -41,6 +41,9 @@
 //! 63 s, mintime 25 s, swing 57 s); no grid was shrunk, two were widened (mintime's boxes,
 //! swing's guesses). The solves are deterministic: two runs differ only in `time_ms`.
 //!
+//! A last argument `--adaptive` runs every solve with the adaptive barrier update
+//! (`BarrierUpdate::Adaptive`) instead of the default.
+//!
 //! Compare two runs (e.g. the parent commit's and a change's output):
 //! `cargo run --release --example hunt -- --compare A.txt B.txt` lists per family the solves
 //! certified in one but not the other, the costs that moved by more than 1e-6 relative, the
@@ -52,9 +55,21 @@ use std::io::Write;
 use std::time::Instant;
 
 use retract::bvp::{
-    Curve, Failure, FreeTime, FreeTimePlan, OptimalControlProblem, Placement, Plan, PlanError,
-    PlanGuess, Variable,
+    BarrierUpdate, Curve, Failure, FreeTime, FreeTimePlan, OptimalControlProblem, Placement, Plan,
+    PlanError, PlanGuess, PlanOptions, Variable,
 };
+
+/// The options of every solve: the defaults, with the adaptive barrier update
+/// ([`BarrierUpdate::Adaptive`]) when the command line ends with `--adaptive`.
+fn options() -> PlanOptions {
+    let adaptive = std::env::args().any(|a| a == "--adaptive");
+    let update = if adaptive {
+        BarrierUpdate::Adaptive
+    } else {
+        BarrierUpdate::Monotone
+    };
+    PlanOptions::default().with_barrier_update(update)
+}
 
 #[path = "common/cart_pole.rs"]
 mod cart_pole;
@@ -81,7 +96,8 @@ const G: f64 = 9.81;
 
 const USAGE: &str = "usage: hunt FAMILY [FILTER]   FAMILY: cartpole quadrotor parking chain \
                      mintime swing all; FILTER: a substring of the variant\n       \
-                     hunt --compare A.txt B.txt";
+                     hunt --compare A.txt B.txt\n       \
+                     (a last argument --adaptive: the adaptive barrier update)";
 
 /// One solve as the hunt records it.
 struct Solve {
@@ -321,7 +337,7 @@ fn cartpole(filter: &str) {
                     if let Some(limit) = limit {
                         problem = problem.with_function_bounds(&force, -limit, limit);
                     }
-                    planned(problem.solve(plan_guess(&curve)))
+                    planned(problem.with_options(options()).solve(plan_guess(&curve)))
                 });
             }
         }
@@ -358,7 +374,7 @@ fn quadrotor(filter: &str) {
                             if with_disc {
                                 problem = problem.with_inequality(&disc);
                             }
-                            planned(problem.solve(plan_guess(&curve)))
+                            planned(problem.with_options(options()).solve(plan_guess(&curve)))
                         });
                     }
                 }
@@ -400,7 +416,7 @@ fn parking(filter: &str) {
                         if let Some(xbox) = xbox {
                             problem = problem.with_bounds(Variable::Jet(0), -xbox, xbox);
                         }
-                        planned(problem.solve(plan_guess(&curve)))
+                        planned(problem.with_options(options()).solve(plan_guess(&curve)))
                     });
                 }
             }
@@ -422,7 +438,7 @@ macro_rules! chain_solve {
                 problem = problem.with_bounds(Variable::Jet(joint), -limit, limit);
             }
         }
-        planned(problem.solve(PlanGuess::Spline))
+        planned(problem.with_options(options()).solve(PlanGuess::Spline))
     }};
 }
 
@@ -473,6 +489,7 @@ fn mintime(filter: &str) {
                         }
                         planned_free(
                             problem
+                                .with_options(options())
                                 .solve_free_time(FreeTime::new(0.5, 5.0, 1.0), PlanGuess::Spline),
                         )
                     });
@@ -508,15 +525,18 @@ fn swing(filter: &str) {
                         planned(match problem_name {
                             "pendulum" => {
                                 OptimalControlProblem::new(&pendulum, &hanging, &goal, t_end, n)
+                                    .with_options(options())
                                     .solve(guess)
                             }
                             "cartpole" => {
                                 OptimalControlProblem::new(&cart, &hanging, &goal, t_end, n)
                                     .with_equality(&unactuated)
+                                    .with_options(options())
                                     .solve(guess)
                             }
                             _ => OptimalControlProblem::new(&acrobot, &hanging, &goal, t_end, n)
                                 .with_equality(&passive)
+                                .with_options(options())
                                 .solve(guess),
                         })
                     });
@@ -633,7 +653,9 @@ fn compare(a: &str, b: &str) -> Result<(), String> {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let args: Vec<String> = (std::env::args().skip(1))
+        .filter(|a| a != "--adaptive")
+        .collect();
     let families: [(&str, Run); 6] = [
         ("cartpole", cartpole),
         ("quadrotor", quadrotor),

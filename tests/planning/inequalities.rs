@@ -6,7 +6,9 @@ use std::f64::consts::PI;
 
 use crate::common::models::DoublePendulum;
 
-use retract::bvp::{Failure, OptimalControlProblem, PlanGuess, PlanOptions, Variable};
+use retract::bvp::{
+    BarrierUpdate, Failure, OptimalControlProblem, Plan, PlanGuess, PlanOptions, Variable,
+};
 use retract::{JetFunction, higher_order_lagrangian, jet_function};
 
 /// limit - tau1 >= 0 (sign = 1) or limit + tau1 >= 0 (sign = -1): the shoulder torque limit.
@@ -99,6 +101,22 @@ fn double_integrator(_q: f64, _dq: f64, ddq: f64) -> f64 {
     0.5 * ddq * ddq
 }
 
+/// The double integrator from rest at 0 to rest at 1 in T = 1 with |u| <= `bound`, in
+/// `steps` steps, solved from the spline with `options`.
+fn bounded_plan(steps: usize, bound: f64, options: PlanOptions) -> Plan<1, 2> {
+    OptimalControlProblem::new(
+        &DoubleIntegrator::new(),
+        &[0.0, 0.0],
+        &[1.0, 0.0],
+        1.0,
+        steps,
+    )
+    .with_bounds(Variable::Top(0), -bound, bound)
+    .with_options(options)
+    .solve(PlanGuess::Spline)
+    .unwrap()
+}
+
 /// With |u| <= U (4 < U < 6) the optimal control saturates near both ends:
 /// u = U on [0, 1/2 - a], U (1 - 2t) / (2a) in between, -U after, with a^2 = 3/4 - 3/U, and
 /// J = U^2 (1 - 4a/3) / 2 (a closed form independent of the solver). The bounded plan
@@ -110,16 +128,7 @@ fn bounded_control_converges_to_the_closed_form() {
     let exact = 0.5 * bound * bound * (1.0 - 4.0 * a / 3.0);
     let mut errors = Vec::new();
     for steps in [25, 50, 100, 200] {
-        let plan = OptimalControlProblem::new(
-            &DoubleIntegrator::new(),
-            &[0.0, 0.0],
-            &[1.0, 0.0],
-            1.0,
-            steps,
-        )
-        .with_bounds(Variable::Top(0), -bound, bound)
-        .solve(PlanGuess::Spline)
-        .unwrap();
+        let plan = bounded_plan(steps, bound, PlanOptions::default());
         assert!(plan.u.iter().all(|u| u[0].abs() <= bound + 1e-9));
         assert_eq!(plan.certificate.negative_directions, 0);
         errors.push((plan.cost - exact).abs());
@@ -197,6 +206,33 @@ fn an_inactive_bound_costs_few_iterations() {
             "T = {t}: {} iterations bounded, {} unbounded",
             bounded.iterations,
             free.iterations
+        );
+    }
+}
+
+/// The adaptive barrier update ([`BarrierUpdate::Adaptive`]) ends at the same minimum as the
+/// monotone one on a convex problem (the bounded double integrator of
+/// `bounded_control_converges_to_the_closed_form`, whose minimum is unique), certified, with
+/// the bound held at every step.
+#[test]
+fn the_adaptive_barrier_reaches_the_monotone_minimum() {
+    let bound = 5.0;
+    for steps in [25, 100, 400] {
+        let solve = |update| {
+            let options = PlanOptions::default().with_barrier_update(update);
+            bounded_plan(steps, bound, options)
+        };
+        let (monotone, adaptive) = (
+            solve(BarrierUpdate::Monotone),
+            solve(BarrierUpdate::Adaptive),
+        );
+        assert!(adaptive.u.iter().all(|u| u[0].abs() <= bound + 1e-9));
+        assert_eq!(adaptive.certificate.negative_directions, 0);
+        assert!(
+            (adaptive.cost - monotone.cost).abs() <= 1e-8 * monotone.cost,
+            "N = {steps}: {} against {}",
+            adaptive.cost,
+            monotone.cost
         );
     }
 }

@@ -16,7 +16,9 @@
 //! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
 //! \min(\mu / 5, \mu^{1.5}))$ in the transcribed problem's units (IPOPT's: its barrier term
-//! is $h \mu \sum \ln s$, so its parameter is $h \mu$). The first slacks are pushed into the
+//! is $h \mu \sum \ln s$, so its parameter is $h \mu$); with
+//! [`BarrierUpdate::Adaptive`](super::BarrierUpdate::Adaptive), $\mu$ follows the LOQO rule
+//! ([`Barrier::loqo`]) instead, safeguarded by that monotone update. The first slacks are pushed into the
 //! interior as IPOPT's, the two sides of one interval sharing IPOPT's single slack
 //! ([`super::constraints::slack_push`]); the inertia correction shifts the eliminated slacks'
 //! Hessian too ([`Barrier::shift_slacks`]).
@@ -562,6 +564,34 @@ impl Barrier {
         }
     }
 
+    /// The average and the smallest $z_k s_k$ over the inequalities (per unit time, as
+    /// $\mu$); `(0, 0)` without any.
+    pub fn average_complementarity(&self) -> (f64, f64) {
+        if self.s.is_empty() {
+            return (0.0, 0.0);
+        }
+        let products = self.z.iter().zip(&self.s).map(|(z, s)| z * s);
+        let (sum, min) = products.fold((0.0, f64::INFINITY), |(a, m), p| (a + p, m.min(p)));
+        (sum / self.s.len() as f64, min)
+    }
+
+    /// The barrier parameter of the LOQO rule (Vanderbei and Shanno; IPOPT's `mu_oracle
+    /// loqo`): $\sigma \bar c$ with the average complementarity $\bar c$ = mean $z_k s_k$,
+    /// the centrality $\xi = \min_k z_k s_k / \bar c \in [0, 1]$ and $\sigma = 0.1
+    /// \min(0.05 (1 - \xi) / \xi, 2)^3$: well centred ($\xi \to 1$) the parameter drops
+    /// towards 0, off centre ($\xi \le 0.024$) it is $0.8 \bar c$. 0 without inequalities
+    /// or with $\bar c$ not finite and positive.
+    pub fn loqo(&self) -> f64 {
+        let (average, min) = self.average_complementarity();
+        if !(average.is_finite() && average > 0.0) {
+            return 0.0;
+        }
+        let xi = (min / average).clamp(0.0, 1.0);
+        // (xi = 0: the quotient is +infinity and the minimum 2)
+        let sigma = 0.1 * (0.05 * (1.0 - xi) / xi).min(2.0).powi(3);
+        sigma * average
+    }
+
     /// Lowers $\mu$ towards `floor` by IPOPT's monotone rule on the transcribed problem's
     /// parameter $h \mu$: $\mu \leftarrow \max(\mu_{\min}, \min(\mu / 5, (h \mu)^{1.5} / h))$.
     pub fn decrease(&mut self, floor: f64, h: f64) {
@@ -572,6 +602,30 @@ impl Barrier {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The LOQO rule at hand-computed points: complementarities (1, 2, 3) have the average
+    /// 2 and the centrality 1/2, so sigma = 0.1 (0.05)^3; (1e-3, 1, 1) are off centre
+    /// (xi below 0.024), so sigma = 0.8; equal products give 0.
+    #[test]
+    fn the_loqo_rule_follows_the_centrality() {
+        let empty = [Vec::new(), Vec::new(), Vec::new()];
+        let mut barrier = Barrier::new(
+            (0.1, 1.0),
+            (3, 0, 1),
+            &[1.0, 1.0, 1.0],
+            |_| (0.01, f64::INFINITY),
+            empty,
+        );
+        barrier.z = vec![1.0, 2.0, 3.0];
+        let expected = 0.1 * 0.05f64.powi(3) * 2.0;
+        assert!((barrier.loqo() - expected).abs() <= 1e-15 * expected);
+        barrier.z = vec![1e-3, 1.0, 1.0];
+        let average = (1e-3 + 2.0) / 3.0;
+        assert!((barrier.loqo() - 0.8 * average).abs() <= 1e-14 * average);
+        barrier.z = vec![0.5, 0.5, 0.5];
+        assert_eq!(barrier.loqo(), 0.0);
+        assert_eq!(barrier.average_complementarity(), (0.5, 0.5));
+    }
 
     /// A half step ($\alpha = 1/2$): the slack moves by half its step, $z$ by its own length
     /// (here the whole Newton step), and the curvature multiplier $y$ by half the way from

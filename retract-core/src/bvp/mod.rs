@@ -140,7 +140,7 @@ pub use control::{Control, ControlOptions, ControlStatus, Fallback, InputSource}
 pub use curve::Curve;
 pub use extrapolate::Extrapolated;
 pub use free_time::{FreeTime, FreeTimePlan};
-pub use options::{MAX_INTERIOR_SAMPLES, PlanGuess, PlanOptions};
+pub use options::{BarrierUpdate, MAX_INTERIOR_SAMPLES, PlanGuess, PlanOptions};
 pub use plan::duals::Duals;
 pub use plan::violations::{INTERPOLANT_DIVISIONS, Infeasibility, Location, Violations};
 pub use plan::{Certificate, Failure, Plan, PlanError, RealTime};

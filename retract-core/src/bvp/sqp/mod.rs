@@ -43,6 +43,7 @@
 
 use nalgebra::SVector;
 
+use crate::bvp::BarrierUpdate;
 use crate::bvp::barrier::Barrier;
 use crate::bvp::constraints::slack_push;
 use crate::bvp::iterate::Iterate;
@@ -51,6 +52,7 @@ use crate::bvp::plan::{Failure, Plan, PlanError};
 use crate::{Lagrangian, LiftedSystem};
 
 mod acceptable;
+mod adaptive;
 mod at_solution;
 mod correction;
 mod direction;
@@ -65,6 +67,7 @@ mod second_order;
 mod state;
 mod termination;
 
+use adaptive::Adaptive;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 use line_search::Progress;
@@ -218,6 +221,9 @@ where
             _ => y.resize(steps, SVector::zeros()),
         }
         let cold = warm.is_none();
+        let adaptive = (self.options.barrier_update == BarrierUpdate::Adaptive
+            && !barrier.s.is_empty())
+        .then(|| Adaptive::new(self.pool.borrow_mut().pairs.take(16)));
         let mut state = State {
             iterate,
             y,
@@ -226,8 +232,9 @@ where
             full_step: None,
             kept: None,
             acceptable: None,
+            adaptive,
         };
-        if cold {
+        if cold && state.adaptive.is_none() {
             self.first_barrier_test(&mut state);
         }
         let result = self.iterate_from(&mut state);
@@ -288,6 +295,9 @@ where
         if let Some(filter) = state.filter {
             pool.pairs.give(filter.into_entries());
         }
+        if let Some(adaptive) = state.adaptive {
+            pool.pairs.give(adaptive.into_entries());
+        }
         if let Some(direction) = state.full_step {
             direction.recycle(&mut *pool);
         }
@@ -312,6 +322,7 @@ where
         let mut unreachable = 0;
         let unconstrained = count == 0 && self.problem.equalities.is_empty();
         loop {
+            st.choose_barrier(floor);
             let done = iterations;
             let point = (&st.iterate, &st.y[..], &st.barrier);
             let fail = |failure, cost, certificate, momenta| PlanError {
@@ -348,16 +359,30 @@ where
                 Some(_) => unreachable += 1,
                 None => unreachable = 0,
             }
-            // the barrier problem solved to 10 mu (IPOPT's test, in absolute units)
-            if st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
+            // converged, or at the acceptable level with no progress left but rounding
+            let complementarity = st.barrier.complementarity().0;
+            let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
+            let converged = sub.error.max(complementarity) <= options.tolerance || acceptable;
+            // (the adaptive update's progress test: a changed mu changes the models)
+            let at = |a: &mut Adaptive| {
+                let point = (models.cost, models.violation_l1(), sub.error, converged);
+                a.test(&st.barrier, point, floor)
+            };
+            if let Some(mu) = st.adaptive.as_mut().and_then(at) {
+                st.set_barrier(mu);
+                self.give_models(models);
+                self.give_subproblem(sub);
+                continue;
+            }
+            // the barrier problem solved to 10 mu (IPOPT's test, in absolute units; the
+            // adaptive update's monotone mode)
+            let monotone = st.adaptive.as_ref().is_none_or(|a| !a.free);
+            if monotone && st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
                 self.decrease_barrier(st, sub.error);
                 self.give_models(models);
                 self.give_subproblem(sub);
                 continue;
             }
-            let complementarity = st.barrier.complementarity().0;
-            // converged, or at the acceptable level with no progress left but rounding
-            let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
             let mut sub =
                 if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
                     match self.finish(point, &models, sub, iterations) {

@@ -9,6 +9,7 @@ use std::time::Instant;
 use nalgebra::SVector;
 
 use super::acceptable::Kept;
+use super::adaptive::Adaptive;
 use super::filter::Filter;
 use crate::bvp::barrier::Barrier;
 use crate::bvp::constraints::{ConstraintKind, ConstraintRef, Inequality, Linearized};
@@ -106,6 +107,30 @@ pub(super) struct State<const N: usize, const X: usize> {
     /// tolerance and the complementarity below the acceptable level, kept for the
     /// acceptable-level exit ([`super::acceptable`]).
     pub acceptable: Option<Kept<N, X>>,
+    /// The adaptive barrier update's state ([`crate::bvp::BarrierUpdate::Adaptive`] with
+    /// inequalities; `None` for the monotone update).
+    pub adaptive: Option<Adaptive>,
+}
+
+impl<const N: usize, const X: usize> State<N, X> {
+    /// In the adaptive update's free mode, $\mu$ chosen afresh ([`Adaptive::choose`]) and
+    /// the filter emptied with it (the barrier cost changes with $\mu$, as in IPOPT).
+    pub(super) fn choose_barrier(&mut self, floor: f64) {
+        if let Some(adaptive) = &mut self.adaptive
+            && adaptive.choose(&mut self.barrier, floor)
+            && let Some(filter) = &mut self.filter
+        {
+            filter.reset();
+        }
+    }
+
+    /// $\mu$ set to `mu`, the filter emptied with it.
+    pub(super) fn set_barrier(&mut self, mu: f64) {
+        self.barrier.mu = mu;
+        if let Some(filter) = &mut self.filter {
+            filter.reset();
+        }
+    }
 }
 
 impl<const N: usize, const X: usize> Models<N, X> {
