@@ -8,6 +8,7 @@ use retract::bvp::{
     Curve, Failure, OptimalControlProblem, Placement, Plan, PlanError, PlanGuess, PlanOptions,
     Variable,
 };
+use retract::nalgebra::DMatrix;
 use retract::{higher_order_lagrangian, jet_function};
 
 #[higher_order_lagrangian(order = 2)]
@@ -282,5 +283,95 @@ fn a_global_minimum_with_rounding_sized_curvature_is_not_a_saddle() {
             assert!(plan.cost < 1e-20, "{case}: J = {}", plan.cost);
             assert_eq!(plan.certificate.min_reduced_hessian_eig, 0.0, "{case}");
         }
+    }
+}
+
+/// The smallest eigenvalue of the reduced Hessian of the coupled problem's plan by a dense
+/// computation: the Hessian of the Lagrangian is $h I$ on the top derivatives (the equality's
+/// curvature $-0.1 \sin d$ vanishes with $d$ on the plan), and the null space is that of the
+/// scheme's rows $x_{i+1} - x_i - h (q'_\theta, u_i) = 0$ and of the equality's linearisation
+/// $0.1 \cos d_\theta (\delta q_0 - \delta q_1)_\theta + \delta u_0 - \delta u_1 = 0$ over
+/// the interior nodes and the top derivatives, by the eigenvectors of $C^T C$ whose
+/// eigenvalues are rounding (dependent rows allowed).
+fn dense_coupled_eigenvalue(plan: &Plan<2, 4>) -> f64 {
+    let (h, theta, steps) = (plan.h, plan.theta, plan.u.len());
+    let inner = (steps - 1) * 4;
+    let dim = inner + 2 * steps;
+    let xcol = |i: usize, r: usize| (i > 0 && i < steps).then(|| (i - 1) * 4 + r);
+    let ucol = |i: usize, a: usize| inner + 2 * i + a;
+    let mut c = DMatrix::<f64>::zeros(5 * steps, dim);
+    let mut hessian = DMatrix::<f64>::zeros(dim, dim);
+    for i in 0..steps {
+        // the scheme's rows: position from the velocity at x_theta, velocity from u
+        for r in 0..4 {
+            let row = 4 * i + r;
+            if let Some(col) = xcol(i + 1, r) {
+                c[(row, col)] += 1.0;
+            }
+            if let Some(col) = xcol(i, r) {
+                c[(row, col)] -= 1.0;
+            }
+            if r < 2 {
+                for (node, weight) in [(i, 1.0 - theta), (i + 1, theta)] {
+                    if let Some(col) = xcol(node, r + 2) {
+                        c[(row, col)] -= h * weight;
+                    }
+                }
+            } else {
+                c[(row, ucol(i, r - 2))] -= h;
+            }
+        }
+        // the equality's row at (x_theta, u_i)
+        let xt = plan.x[i] * (1.0 - theta) + plan.x[i + 1] * theta;
+        let slope = 0.1 * (xt[0] - xt[1]).cos();
+        let row = 4 * steps + i;
+        for (node, weight) in [(i, 1.0 - theta), (i + 1, theta)] {
+            for (r, sign) in [(0, 1.0), (1, -1.0)] {
+                if let Some(col) = xcol(node, r) {
+                    c[(row, col)] += sign * slope * weight;
+                }
+            }
+        }
+        c[(row, ucol(i, 0))] += 1.0;
+        c[(row, ucol(i, 1))] -= 1.0;
+        for a in 0..2 {
+            hessian[(ucol(i, a), ucol(i, a))] = h;
+        }
+    }
+    let eigen = (c.transpose() * &c).symmetric_eigen();
+    let largest = eigen.eigenvalues.amax();
+    let null: Vec<usize> = (0..dim)
+        .filter(|j| eigen.eigenvalues[*j] <= 1e-12 * largest)
+        .collect();
+    assert!(!null.is_empty(), "no direction left");
+    let z = DMatrix::<f64>::from_fn(dim, null.len(), |r, k| eigen.eigenvectors[(r, null[k])]);
+    (z.transpose() * hessian * &z).symmetric_eigenvalues().min()
+}
+
+/// With N = 3 and 4 steps the scheme's and the equality's rows (5N) are as many as the
+/// variables or more, but the goal and the equality are dependent (two rows fewer bind): the
+/// plan keeps directions, and the certificate's smallest eigenvalue is theirs (a dense
+/// computation), not the +infinity of the row count.
+#[test]
+fn dependent_rows_leave_directions_the_certificate_measures() {
+    for steps in [3, 4, 8] {
+        let plan = OptimalControlProblem::new(
+            &Effort::new(),
+            &[0.0; 4],
+            &[1.0, 1.0, 0.0, 0.0],
+            1.0,
+            steps,
+        )
+        .with_equality(&Coupled::new())
+        .solve(PlanGuess::Spline)
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert!(plan.x.iter().all(|x| (x[0] - x[1]).abs() < 1e-8));
+        let dense = dense_coupled_eigenvalue(&plan);
+        let lanczos = plan.certificate.min_reduced_hessian_eig;
+        assert!(dense > 0.0, "N = {steps}: dense {dense:e}");
+        assert!(
+            (lanczos - dense).abs() <= 1e-6 * dense,
+            "N = {steps}: Lanczos {lanczos:e}, dense {dense:e}"
+        );
     }
 }

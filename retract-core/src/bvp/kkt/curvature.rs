@@ -17,7 +17,10 @@ use crate::bvp::dynamics::Dynamics;
 /// $x_N$ (`fixed` 0) and the top derivatives. $+\infty$ where the constraints (the scheme's
 /// $N X$ rows and the stages' `equalities` rows) leave no direction: the minimum over an
 /// empty set (e.g. $N = k$ steps between fixed ends, where the plan is the one path that
-/// meets the ends). Lanczos stops when the Ritz residual of
+/// meets the ends). That count holds for independent rows only: where the goal and the stage
+/// equalities are dependent (the factorisation's terminal pivot needed its $\delta_c$ shift,
+/// [`Riccati::regularized`]) fewer rows bind than are counted, and Lanczos runs whatever the
+/// count. Lanczos stops when the Ritz residual of
 /// the top Ritz value $\vartheta$ is below $10^{-3}\vartheta$ (the eigenvalue then has about
 /// six digits; 2 to 12 solves on the constrained suite and the swing-ups, less than one SQP
 /// iteration). NaN if the start vector vanishes.
@@ -29,7 +32,7 @@ pub(crate) fn min_reduced_eigenvalue<const N: usize, const X: usize>(
 ) -> f64 {
     let packing = Packing::new(riccati.steps(), end);
     let dim = packing.dim::<N>();
-    if dim <= riccati.steps() * X + equalities {
+    if dim <= riccati.steps() * X + equalities && !riccati.regularized {
         return f64::INFINITY;
     }
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
