@@ -18,8 +18,8 @@
 //! \min(\mu / 5, \mu^{1.5}))$ in the transcribed problem's units (IPOPT's: its barrier term
 //! is $h \mu \sum \ln s$, so its parameter is $h \mu$); with
 //! [`BarrierUpdate::Adaptive`](super::BarrierUpdate::Adaptive), $\mu$ follows the LOQO rule
-//! ([`Barrier::loqo`]) instead, safeguarded by that monotone update. The first slacks are pushed into the
-//! interior as IPOPT's, the two sides of one interval sharing IPOPT's single slack
+//! ([`Barrier::loqo`]) instead, safeguarded by that monotone update. The first slacks are
+//! pushed into the interior as IPOPT's, the two sides of one interval sharing IPOPT's single slack
 //! ([`super::constraints::slack_push`]); the inertia correction shifts the eliminated slacks'
 //! Hessian too ([`Barrier::shift_slacks`]).
 

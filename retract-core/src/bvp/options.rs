@@ -124,14 +124,18 @@ pub enum BarrierUpdate {
     /// Optim. 19, 2009): in its free mode $\mu$ is chosen afresh at every iterate by the
     /// LOQO rule, $\mu = \sigma \bar c$ with the average complementarity $\bar c$ and
     /// $\sigma = 0.1 \min(0.05 (1 - \xi)/\xi, 2)^3$ from the centrality $\xi = \min z s /
-    /// \bar c$, at most $10^3$ times the first $\bar c$; an iterate whose cost and constraint
-    /// violation are both no better than those of an earlier free-mode iterate (by a margin
-    /// $10^{-5} \min(1, E)$, $E$ the error) ends the free mode, and the monotone update runs
-    /// from $\mu = 0.8 \bar c$ until an iterate passes that test again. On problems with
-    /// many local minima the two updates end in different ones, as IPOPT's do; on the
-    /// constrained suite the adaptive one ends at IPOPT's adaptive minima, mostly higher
-    /// than the monotone update's, and reaches the iteration limit on the 7-link chain, as
-    /// IPOPT's does (the guide's section on the optimizer gives the figures).
+    /// \bar c$, between half the tolerance and $10^3$ times the first $\bar c$; an iterate
+    /// whose cost and constraint violation are both no better than those of an earlier
+    /// free-mode iterate (by a margin $10^{-5} \min(1, E)$, $E$ the error) ends the free
+    /// mode, and the monotone update runs from $\mu = 0.8 \bar c$ until an iterate passes
+    /// that test again; once the error and the complementarity are below the tolerance, $\mu$
+    /// goes to half the tolerance for the certificate. On problems with many local minima the
+    /// two updates end in different ones, as IPOPT's do: on the constrained suite the
+    /// adaptive one ends at the minima of IPOPT's adaptive update with the LOQO oracle, the
+    /// cart-poles and the quadrotor with $f_{\max} = 15$ where the monotone update does, the
+    /// other quadrotor, the parkings and the 3-link chain higher, and it reaches the
+    /// iteration limit on the 7-link chain, as IPOPT's does (the guide's section on the
+    /// optimizer gives the figures).
     Adaptive,
 }
 
