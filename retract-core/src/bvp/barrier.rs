@@ -599,6 +599,15 @@ impl Barrier {
     }
 }
 
+/// A barrier of one step ($h = 1$, $\mu = 0.1$) whose inequalities take the `values`
+/// (slacks pushed at least 0.01 inside), for the tests here and in the SQP's.
+#[cfg(test)]
+pub(crate) fn one_step(values: &[f64]) -> Barrier {
+    let empty = [Vec::new(), Vec::new(), Vec::new()];
+    let push = |_| (0.01, f64::INFINITY);
+    Barrier::new((0.1, 1.0), (values.len(), 0, 1), values, push, empty)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -608,14 +617,7 @@ mod tests {
     /// (xi below 0.024), so sigma = 0.8; equal products give 0.
     #[test]
     fn the_loqo_rule_follows_the_centrality() {
-        let empty = [Vec::new(), Vec::new(), Vec::new()];
-        let mut barrier = Barrier::new(
-            (0.1, 1.0),
-            (3, 0, 1),
-            &[1.0, 1.0, 1.0],
-            |_| (0.01, f64::INFINITY),
-            empty,
-        );
+        let mut barrier = one_step(&[1.0, 1.0, 1.0]);
         barrier.z = vec![1.0, 2.0, 3.0];
         let expected = 0.1 * 0.05f64.powi(3) * 2.0;
         assert!((barrier.loqo() - expected).abs() <= 1e-15 * expected);
@@ -632,14 +634,7 @@ mod tests {
     /// its value to the Newton value $z + \delta z$.
     #[test]
     fn the_curvature_multiplier_follows_the_primal_step() {
-        let empty = [Vec::new(), Vec::new(), Vec::new()];
-        let mut barrier = Barrier::new(
-            (0.1, 1.0),
-            (1, 0, 1),
-            &[0.5],
-            |_| (0.01, f64::INFINITY),
-            empty,
-        );
+        let mut barrier = one_step(&[0.5]);
         barrier.y = vec![3.0];
         let (s, z) = (barrier.s[0], barrier.z[0]);
         let ds = -0.45;

@@ -123,14 +123,7 @@ mod tests {
     use super::*;
 
     fn barrier(z: [f64; 2]) -> Barrier {
-        let empty = [Vec::new(), Vec::new(), Vec::new()];
-        let mut barrier = Barrier::new(
-            (0.1, 1.0),
-            (2, 0, 1),
-            &[1.0, 1.0],
-            |_| (0.01, f64::INFINITY),
-            empty,
-        );
+        let mut barrier = crate::bvp::barrier::one_step(&[1.0, 1.0]);
         barrier.z = z.to_vec();
         barrier
     }

@@ -72,7 +72,7 @@ pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
 use line_search::Progress;
 pub(super) use state::Sqp;
-use state::{State, Subproblem};
+use state::{Models, State, Subproblem};
 use termination::{Finished, barrier_floor};
 
 /// The end of a solve: the plan and whether it is certified (if not, the iterate of a
@@ -363,12 +363,8 @@ where
             let complementarity = st.barrier.complementarity().0;
             let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
             let converged = sub.error.max(complementarity) <= options.tolerance || acceptable;
-            // (the adaptive update's progress test: a changed mu changes the models)
-            let at = |a: &mut Adaptive| {
-                let point = (models.cost, models.violation_l1(), sub.error, converged);
-                a.test(&st.barrier, point, floor)
-            };
-            if let Some(mu) = st.adaptive.as_mut().and_then(at) {
+            let at = (&models, &sub);
+            if let Some(mu) = self.adapted(&mut st.adaptive, &st.barrier, at, converged) {
                 st.set_barrier(mu);
                 self.give_models(models);
                 self.give_subproblem(sub);
@@ -464,6 +460,22 @@ where
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
         }
+    }
+
+    /// The adaptive barrier update's new $\mu$ at the iterate of `models` and `sub`
+    /// ([`Adaptive::test`] with its cost, violation, error and whether it `converged`; a
+    /// changed $\mu$ changes the models, which are then formed again); `None` with the
+    /// monotone update or where $\mu$ stays.
+    fn adapted(
+        &self,
+        adaptive: &mut Option<Adaptive>,
+        barrier: &Barrier,
+        (models, sub): (&Models<N, X>, &Subproblem<N, X>),
+        converged: bool,
+    ) -> Option<f64> {
+        let point = (models.cost, models.violation_l1(), sub.error, converged);
+        let floor = barrier_floor(self.options.tolerance);
+        adaptive.as_mut()?.test(barrier, point, floor)
     }
 
     /// $\mu$ decreased at a point `st` where the barrier problem is solved (the filter reset
