@@ -1,6 +1,6 @@
 //! A controller crate without std: a generated integrator, stepped without allocation, and a
 //! generated stage constraint evaluated without allocation.
-//! CI builds it alone (`cargo build -p retract-no-std-check`), so `retract` has no `std`.
+//! CI checks it alone (`cargo clippy -p retract-no-std-check`), so `retract` has no `std`.
 #![no_std]
 #![forbid(unsafe_code)]
 
