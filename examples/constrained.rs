@@ -10,7 +10,8 @@
 //! Run: `cargo run --release --example constrained` (add `-- quick` for a smaller version of
 //! each problem: a tenth of the steps; `cargo test --example constrained` runs that as a test,
 //! and `cargo test --workspace` with it; add `adaptive` for the adaptive barrier update,
-//! [`BarrierUpdate::Adaptive`], and a suite's name for that suite alone).
+//! [`BarrierUpdate::Adaptive`], a suite's name for that suite alone, and `steps=N` for N steps
+//! on every fixed horizon instead of 100 per unit time, as the IPOPT reference's `NSTEPS`).
 
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -121,10 +122,19 @@ fn report<const N: usize, const X: usize>(
     }
 }
 
-/// The number of steps for a horizon: 100 T, a tenth of it in the quick run.
+/// The number of steps for a horizon: 100 T, a tenth of it in the quick run, or the command
+/// line's `steps=N` ([`given_steps`]).
 fn steps(t_end: f64, quick: bool) -> usize {
     let full = (100.0 * t_end).round() as usize;
-    if quick { full / 10 } else { full }
+    given_steps()
+        .and_then(Result::ok)
+        .unwrap_or(if quick { full / 10 } else { full })
+}
+
+/// The command line's `steps=N`, if any: `N` if it is a positive integer, else the text.
+fn given_steps() -> Option<Result<usize, String>> {
+    let text = std::env::args().find_map(|a| a.strip_prefix("steps=").map(str::to_owned))?;
+    Some(text.parse().ok().filter(|&n| n > 0).ok_or(text))
 }
 
 fn cart_pole_suite(quick: bool) -> Outcome {
@@ -285,7 +295,12 @@ fn chain_suite(quick: bool) -> Outcome {
 
 fn main() {
     let quick = std::env::args().any(|a| a == "quick");
-    let only = (std::env::args().skip(1)).find(|a| a != "quick" && a != "adaptive");
+    if let Some(Err(text)) = given_steps() {
+        eprintln!("steps={text}: give the number of steps as a positive integer");
+        std::process::exit(2);
+    }
+    let only = (std::env::args().skip(1))
+        .find(|a| a != "quick" && a != "adaptive" && !a.starts_with("steps="));
     let mut failed = false;
     let suites: [(&str, Suite); 5] = [
         ("cartpole", cart_pole_suite),
