@@ -473,9 +473,10 @@ where
         (models, sub): (&Models<N, X>, &Subproblem<N, X>),
         converged: bool,
     ) -> Option<f64> {
+        // (the O(N) violation only with the adaptive update: the monotone one needs none)
+        let adaptive = adaptive.as_mut()?;
         let point = (models.cost, models.violation_l1(), sub.error, converged);
-        let floor = barrier_floor(self.options.tolerance);
-        adaptive.as_mut()?.test(barrier, point, floor)
+        adaptive.test(barrier, point, barrier_floor(self.options.tolerance))
     }
 
     /// $\mu$ decreased at a point `st` where the barrier problem is solved (the filter reset
