@@ -1,5 +1,6 @@
 """IPOPT on the constrained suite C1-C4 (../shared/BENCHMARKS.md) and the swing-up suite's
-acrobot (`acrobot-T2`, `acrobot-T2-zero` from the zero path), transcribed as
+acrobot (`acrobot-T2`, `acrobot-T2-zero` from the zero path) and the quadrotor from the zero
+path (`quadrotor-f15-zero`, as `tests/planning/restoration.rs`, with `NSTEPS=50`), transcribed as
 retract's optimizer transcribes it: jets x_i = (q, q') at the nodes (the ends fixed), u_i = q''
 per step, the lifted midpoint (theta = 1/2) dynamics, J = sum_i h L(x_mid_i, u_i), each
 constraint where examples/constrained.rs places it (node constraints as rows of g, as the
@@ -114,7 +115,7 @@ def problem(name):
         else:
             P['guess'] = smoothstep(P['q0'], P['qT'], T)
     elif name.startswith('quadrotor'):
-        fmax = float(name.split('-f')[1]); m, I, a, g = 1.0, 0.01, 0.1, 9.81
+        fmax = float(name.split('-f')[1].split('-')[0]); m, I, a, g = 1.0, 0.01, 0.1, 9.81
         P.update(n=3, T=2.0, q0=[0, 0, 0], qT=[2, 1, 0])
         def rot(q, v, u):
             fx = m * u[0]; fz = m * u[1] + m * g; tq = I * u[2]
@@ -125,7 +126,10 @@ def problem(name):
         disc = lambda q: (q[0] - 1)**2 + (q[1] - 0.5)**2 - 0.09
         P['mid'] = lambda q, v, u: [(rot(q, v, u)[2], 0, 0), (rot(q, v, u)[0], 0, fmax), (rot(q, v, u)[1], 0, fmax), (disc(q), 0, ca.inf)]
         P['node'] = lambda q, v: [(disc(q), 0, ca.inf)]
-        P['guess'] = smoothstep(P['q0'], P['qT'], 2.0)
+        if name.endswith('-zero'):
+            P['guess'] = lambda t: (np.zeros(3), np.zeros(3), np.zeros(3))
+        else:
+            P['guess'] = smoothstep(P['q0'], P['qT'], 2.0)
     return P
 
 FORM = 'mid'
