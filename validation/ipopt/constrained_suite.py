@@ -1,6 +1,8 @@
 """IPOPT on the constrained suite C1-C4 (../shared/BENCHMARKS.md) and the swing-up suite's
 acrobot (`acrobot-T2`, `acrobot-T2-zero` from the zero path) and the quadrotor from the zero
-path (`quadrotor-f15-zero`, as `tests/planning/restoration.rs`, with `NSTEPS=50`), transcribed as
+path (`quadrotor-f15-zero`, as `tests/planning/restoration.rs`, with `NSTEPS=50`) and the
+double pendulum with a shoulder torque limit (`pendulum-tau10`, as
+`tests/planning/inequalities.rs`, with `NSTEPS=50`), transcribed as
 retract's optimizer transcribes it: jets x_i = (q, q') at the nodes (the ends fixed), u_i = q''
 per step, the lifted midpoint (theta = 1/2) dynamics, J = sum_i h L(x_mid_i, u_i), each
 constraint where examples/constrained.rs places it (node constraints as rows of g, as the
@@ -114,6 +116,21 @@ def problem(name):
             P['guess'] = lambda t: (np.zeros(2), np.zeros(2), np.zeros(2))
         else:
             P['guess'] = smoothstep(P['q0'], P['qT'], T)
+    elif name.startswith('pendulum-tau'):
+        # the double pendulum of tests/planning/inequalities.rs: L = 1/2 |tau|^2, the shoulder
+        # torque limited by two one-sided rows limit -+ tau_1 >= 0 at the midpoints (as the
+        # test's two functions), from the hanging rest to upright rest in T = 2 (NSTEPS=50)
+        limit = float(name.split('tau')[1]); g = 9.81
+        P.update(n=2, T=2.0, q0=[0, 0], qT=[math.pi, 0])
+        def torque(q, v, u):
+            c2 = ca.cos(q[1]); m11 = 3 + 2 * c2; m12 = 1 + c2; m22 = 1; b = ca.sin(q[1])
+            g1 = 2 * g * ca.sin(q[0]) + g * ca.sin(q[0] + q[1]); g2 = g * ca.sin(q[0] + q[1])
+            return (m11 * u[0] + m12 * u[1] - b * (2 * v[0] * v[1] + v[1] ** 2) + g1,
+                    m12 * u[0] + m22 * u[1] + b * v[0] ** 2 + g2)
+        P['L'] = lambda q, v, u: 0.5 * (torque(q, v, u)[0] ** 2 + torque(q, v, u)[1] ** 2)
+        P['mid'] = lambda q, v, u: [(limit - torque(q, v, u)[0], 0, ca.inf), (limit + torque(q, v, u)[0], 0, ca.inf)]
+        P['node'] = lambda q, v: []
+        P['guess'] = smoothstep(P['q0'], P['qT'], 2.0)
     elif name.startswith('quadrotor'):
         fmax = float(name.split('-f')[1].split('-')[0]); m, I, a, g = 1.0, 0.01, 0.1, 9.81
         P.update(n=3, T=2.0, q0=[0, 0, 0], qT=[2, 1, 0])
