@@ -48,6 +48,16 @@ def smoothstep(q0, qT, T):
         return (q0 + (qT - q0) * (3 * s * s - 2 * s**3), (qT - q0) * (6 * s - 6 * s * s) / T, (qT - q0) * (6 - 12 * s) / T**2)
     return f
 
+def double_pendulum_torques(g):
+    """The torques (tau_1, tau_2) of the unit double pendulum (examples/common/pendulum.rs,
+    tests/planning's DoublePendulum) as a function of (q, q', q'')."""
+    def torque(q, v, u):
+        c2 = ca.cos(q[1]); m11 = 3 + 2 * c2; m12 = 1 + c2; m22 = 1; b = ca.sin(q[1])
+        g1 = 2 * g * ca.sin(q[0]) + g * ca.sin(q[0] + q[1]); g2 = g * ca.sin(q[0] + q[1])
+        return (m11 * u[0] + m12 * u[1] - b * (2 * v[0] * v[1] + v[1] ** 2) + g1,
+                m12 * u[0] + m22 * u[1] + b * v[0] ** 2 + g2)
+    return torque
+
 def problem(name):
     P = {}
     if name.startswith('parking'):
@@ -104,11 +114,7 @@ def problem(name):
         # failure hunt's guess), `acrobot-T2` from the smoothstep
         T = float(name.split('-')[1][1:]); g = 9.81
         P.update(n=2, T=T, q0=[0, 0], qT=[math.pi, 0])
-        def torque(q, v, u):
-            c2 = ca.cos(q[1]); m11 = 3 + 2 * c2; m12 = 1 + c2; m22 = 1; b = ca.sin(q[1])
-            g1 = 2 * g * ca.sin(q[0]) + g * ca.sin(q[0] + q[1]); g2 = g * ca.sin(q[0] + q[1])
-            return (m11 * u[0] + m12 * u[1] - b * (2 * v[0] * v[1] + v[1] ** 2) + g1,
-                    m12 * u[0] + m22 * u[1] + b * v[0] ** 2 + g2)
+        torque = double_pendulum_torques(g)
         P['L'] = lambda q, v, u: 0.5 * torque(q, v, u)[1] ** 2
         P['mid'] = lambda q, v, u: [(torque(q, v, u)[0], 0, 0)]
         P['node'] = lambda q, v: []
@@ -122,11 +128,7 @@ def problem(name):
         # test's two functions), from the hanging rest to upright rest in T = 2 (NSTEPS=50)
         limit = float(name.split('tau')[1]); g = 9.81
         P.update(n=2, T=2.0, q0=[0, 0], qT=[math.pi, 0])
-        def torque(q, v, u):
-            c2 = ca.cos(q[1]); m11 = 3 + 2 * c2; m12 = 1 + c2; m22 = 1; b = ca.sin(q[1])
-            g1 = 2 * g * ca.sin(q[0]) + g * ca.sin(q[0] + q[1]); g2 = g * ca.sin(q[0] + q[1])
-            return (m11 * u[0] + m12 * u[1] - b * (2 * v[0] * v[1] + v[1] ** 2) + g1,
-                    m12 * u[0] + m22 * u[1] + b * v[0] ** 2 + g2)
+        torque = double_pendulum_torques(g)
         P['L'] = lambda q, v, u: 0.5 * (torque(q, v, u)[0] ** 2 + torque(q, v, u)[1] ** 2)
         P['mid'] = lambda q, v, u: [(limit - torque(q, v, u)[0], 0, ca.inf), (limit + torque(q, v, u)[0], 0, ca.inf)]
         P['node'] = lambda q, v: []
