@@ -155,7 +155,11 @@ fn flat_hessian(h: &retract::Hessian<2, 2>) -> [[f64; 6]; 6] {
 
 /// |tau1| <= 10 on the swing-up (T = 2, N = 50) as the first component of the vector of
 /// torques (the second unbounded) gives the plan of the scalar bound on tau1: the same cost to
-/// 1e-9 and the same iterations (the barrier sees the same two sides).
+/// 1e-9 (the barrier sees the same two sides). Not the same iterations: the two formulations
+/// evaluate the torque in different orders, their iterates, equal to 11 digits for two
+/// iterations, part at 3e-9 at the third (a rounding difference that a step of size 200
+/// amplifies), and this problem's end phase, where the limit's barrier weights reach 1e8 and
+/// cost the Riccati recursion digits (`inequalities.rs`), takes 45 and 66 iterations.
 #[test]
 fn a_vector_bound_solves_as_the_scalar_bound_it_replaces() {
     let system = unit(TorqueCost::new);
@@ -180,7 +184,6 @@ fn a_vector_bound_solves_as_the_scalar_bound_it_replaces() {
         scalar.cost,
         vector.cost
     );
-    assert_eq!(scalar.iterations, vector.iterations);
     // the bound is active: the unbounded swing-up peaks above 11
     let peak = (0..vector.u.len())
         .map(|i| {

@@ -57,9 +57,10 @@ pub(super) struct Barrier {
     pub z: Vec<f64>,
     /// The multipliers $y$ of $g - s = 0$ (per unit time, as `z`), which weigh the
     /// constraints' curvature $-h y \nabla^2 g$ in the Hessian of the Lagrangian (IPOPT's
-    /// $y_d$): they take the primal step towards $z + \delta z$, while `z` takes its own
-    /// (a violated constraint's $z$ grows as $\mu / s$ while its slack collapses; $y$ stays
-    /// with the step). Equal to $z$ at a solution.
+    /// $y_d$): they start at IPOPT's least-squares estimate and take the primal step towards
+    /// the subproblem's $z + \delta z - w \rho \delta s$ ([`Self::update`]), while `z` takes
+    /// its own (a violated constraint's $z$ grows as $\mu / s$ while its slack collapses; $y$
+    /// stays with the step). Equal to $z$ at a solution.
     pub y: Vec<f64>,
     /// Inequalities per step.
     pub count: usize,
@@ -107,6 +108,14 @@ impl Barrier {
             nodes,
             steps,
         }
+    }
+
+    /// A copy in the three empty `vectors` (for $s$, $z$, $y$, from the workspace).
+    pub fn copy_into(&self, [mut s, mut z, mut y]: [Vec<f64>; 3]) -> Self {
+        s.extend_from_slice(&self.s);
+        z.extend_from_slice(&self.z);
+        y.extend_from_slice(&self.y);
+        Self { s, z, y, ..*self }
     }
 
     /// Its vectors $s$, $z$, $y$ (to keep for a later [`Self::new`] or [`Self::warm`]).
@@ -294,7 +303,7 @@ impl Barrier {
 
     /// The largest step in $(0, 1]$ along $\delta z$ ([`Self::dual_step`]) that keeps every
     /// multiplier above $(1 - \tau)$ times its value.
-    fn dual_step_length(&self, ds: &[f64]) -> f64 {
+    pub fn dual_step_length(&self, ds: &[f64]) -> f64 {
         let tau = self.tau();
         (0..self.z.len())
             .map(|k| (self.z[k], self.dual_step(k, ds)))
@@ -329,21 +338,38 @@ impl Barrier {
         }
     }
 
-    /// Adds the inertia correction `rho_h` of the eliminated slacks, $\rho_h \nabla g
-    /// \nabla g^T$ per inequality, to the stage and node Hessians (IPOPT corrects the
-    /// slacks' Hessian $\Sigma$ as every other variable's: eliminated, $\Sigma + \rho_h$
-    /// weighs $\nabla g \nabla g^T$).
+    /// Adds the inertia correction `rho_h` of the eliminated slacks, $w_k \rho_h \nabla g_k
+    /// \nabla g_k^T$ per inequality, to the stage and node Hessians and $w_k \rho_h (g_k -
+    /// s_k) \nabla g_k$ to their gradients (IPOPT corrects the slacks' Hessian $\Sigma$ as
+    /// every other variable's: eliminated, $\Sigma + \rho_h$ weighs $\nabla g \nabla g^T$ and
+    /// the residual $g - s$), with the `weights` of [`Self::weights`]: $\frac12$ for
+    /// each side of an interval, whose two sides share IPOPT's one slack.
     pub fn shift_slacks<const N: usize, const X: usize>(
         &self,
         stages: &mut [StageModel<N, X>],
         lin: &[Linearized<N, X>],
         rho_h: f64,
+        weights: (&[f64], &[f64]),
     ) {
         if rho_h == 0.0 {
             return;
         }
-        for (k, c) in lin.iter().enumerate() {
-            self.add_outer(stages, k, c, rho_h);
+        for ((k, c), w) in lin.iter().enumerate().zip(self.weights(weights)) {
+            let weight = w * rho_h;
+            self.add_outer(stages, k, c, weight);
+            // (the slack's Hessian also weighs its residual g - s in the eliminated gradient)
+            let pull = weight * (c.value - self.s[k]);
+            match self.slot(k) {
+                Slot::Step(i) => {
+                    stages[i].gx += c.gx * pull;
+                    stages[i].gu += c.gu * pull;
+                }
+                Slot::Node(i) => {
+                    if let Some(node) = &mut stages[i].node {
+                        node.1 += c.gx * pull;
+                    }
+                }
+            }
         }
     }
 
@@ -424,7 +450,7 @@ impl Barrier {
     /// The weight of every entry in the constraint violation, in order, from the `weights` of
     /// the inequalities at a step and at a node ([`super::constraints::violation_weights`]; 1
     /// where missing): the step pattern once per step, then the node pattern once per node.
-    fn weights<'w>(
+    pub fn weights<'w>(
         &self,
         (steps, nodes): (&'w [f64], &'w [f64]),
     ) -> impl Iterator<Item = f64> + 'w {
@@ -504,13 +530,23 @@ impl Barrier {
             .fold(0.0, |m, (c, s)| m.max((c.value - s).abs()))
     }
 
-    /// Takes the step: slacks by `alpha` along `ds`, the multipliers $z$ by their own
-    /// length, the multipliers $y$ by `alpha` towards $z + \delta z$.
-    pub fn update(&mut self, ds: &[f64], alpha: f64) {
-        let alpha_z = self.dual_step_length(ds);
+    /// Takes the step: slacks by `alpha` along `ds`, the multipliers $z$ by `alpha_z`
+    /// (their own length, [`Self::dual_step_length`], or `alpha` in a soft restoration step),
+    /// the multipliers $y$ by `alpha` towards the step's $y^+ = z + \delta z - w_k \rho\,
+    /// \delta s$ (the slack's stationarity with the inertia correction $\rho$ per unit time of
+    /// the direction, shared as in [`Self::shift_slacks`] with the `weights`).
+    pub fn update(
+        &mut self,
+        ds: &[f64],
+        (alpha, alpha_z): (f64, f64),
+        (rho, weights): (f64, (&[f64], &[f64])),
+    ) {
+        let mut shares = self.weights(weights);
         for k in 0..self.z.len() {
             let dzk = self.dual_step(k, ds);
-            self.y[k] += alpha * (self.z[k] + dzk - self.y[k]);
+            let share = shares.next().unwrap_or(1.0);
+            let target = self.z[k] + dzk - share * rho * ds[k];
+            self.y[k] += alpha * (target - self.y[k]);
             self.s[k] += alpha * ds[k];
             let s = self.s[k];
             self.z[k] = (self.z[k] + alpha_z * dzk)
@@ -640,7 +676,8 @@ mod tests {
         let ds = -0.45;
         let dz = (barrier.mu - z * s - z * ds) / s;
         let alpha = 0.5;
-        barrier.update(&[ds], alpha);
+        let alpha_z = barrier.dual_step_length(&[ds]);
+        barrier.update(&[ds], (alpha, alpha_z), (0.0, (&[], &[])));
         let expected_y = 3.0 + alpha * (z + dz - 3.0);
         assert!((barrier.y[0] - expected_y).abs() <= 1e-14 * expected_y.abs());
         assert!((barrier.s[0] - (s + alpha * ds)).abs() <= 1e-15);

@@ -437,10 +437,18 @@ fn partner<'l, 'a, const N: usize, const K: usize>(
     list: &'l [Inequality<'a, N, K>],
     j: usize,
 ) -> Option<&'l Inequality<'a, N, K>> {
+    partner_index(list, j).map(|k| &list[k])
+}
+
+/// The index in `list` of the other side of the interval of `list[j]` ([`partner`]).
+pub(super) fn partner_index<const N: usize, const K: usize>(
+    list: &[Inequality<'_, N, K>],
+    j: usize,
+) -> Option<usize> {
     let c = list.get(j)?;
     (list.iter().enumerate())
         .find(|(k, d)| *k != j && d.sign == -c.sign && d.index == c.index && c.same_source(d))
-        .map(|(_, d)| d)
+        .map(|(k, _)| k)
 }
 
 /// The weight of each inequality of `list` in the constraint violation $\theta$ of the line

@@ -73,15 +73,14 @@ pub struct PlanOptions {
     /// certified plan's interpolant violation is within the tolerance there. Orders $k \le 4$.
     #[cfg_attr(feature = "serde", serde(default))]
     pub interior_samples: usize,
-    /// The most second-order corrections per line search (IPOPT's `max_soc`, whose default
-    /// is 4; here 0, none, by default): where the full step is rejected and raises the
+    /// The most second-order corrections per line search (IPOPT's `max_soc`, and its
+    /// default 4; 0 turns them off): where the full step is rejected and raises the
     /// constraint violation, the step is recomputed with the same factorisation for the
     /// accumulated residual of the nonlinear constraints ($c_{\rm soc} = \alpha c(x) + c(x +
     /// \alpha d)$), as long as each correction lowers the violation by the factor 0.99.
-    /// Off by default: with 4, the spline on the sphere past a keep-out cap
-    /// (`tests/integrators/sphere.rs`) ends north of the cap at a cost of 2.2536 instead of
-    /// south at 1.3908, and the constrained suite's quadrotor with $f_{\max} = 6$ at IPOPT's
-    /// minimum 51.7053 instead of 51.5202 (in 45 iterations instead of 32).
+    /// Without them the constrained suite's quadrotor with $f_{\max} = 15$ leaves IPOPT's path
+    /// at its second step (IPOPT's first trial is rejected there and its correction taken)
+    /// and ends at 51.5119 instead of IPOPT's 51.3900.
     #[cfg_attr(feature = "serde", serde(default = "default_corrections"))]
     pub second_order_corrections: usize,
     /// The most escapes from saddles per solve (2 by default; 0: a saddle ends the solve in
@@ -175,7 +174,7 @@ impl Default for PlanOptions {
             initial_barrier: 0.1,
             min_eigenvalue: true,
             interior_samples: 0,
-            second_order_corrections: 0,
+            second_order_corrections: 4,
             saddle_escapes: 2,
             restoration: true,
             barrier_update: BarrierUpdate::Monotone,

@@ -331,7 +331,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                     }
                 }
             }
-            let mut d = riccati.solve(&dynamics, &stages, 0.0, r0, ends, &mut *pool);
+            let mut d = riccati.solve(&dynamics, &stages, r0, ends, &mut *pool);
             for _ in 0..REFINEMENTS {
                 let model = (&stages[..], &self.at.terminal);
                 refine(

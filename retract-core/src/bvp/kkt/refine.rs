@@ -16,7 +16,7 @@ use crate::bvp::dynamics::Dynamics;
 
 /// The gradient in $(\delta x_i, \delta u_i)$ of the Lagrangian of stage $i$'s model
 /// $\ell_i + y^T (G_x \delta y_x + G_u \delta u + g)$ at `(dx, du)`, with $\rho$ on the
-/// diagonal of its Hessian as in [`Riccati::factor_with`] and
+/// diagonal of its Hessian in $(\delta x_i, \delta u_i)$ as in [`Riccati::factor_with`] and
 /// $\delta y_x = E \delta x + \theta \bar B \delta u + \theta c$; and the residual of its
 /// constraints.
 fn stage_gradient<const N: usize, const X: usize>(
@@ -27,7 +27,7 @@ fn stage_gradient<const N: usize, const X: usize>(
 ) -> (SVector<f64, X>, SVector<f64, N>, SVector<f64, N>) {
     let theta = dynamics.theta;
     let yx = dynamics.poly_e.left(dx) + dynamics.poly_b.left(du) * theta + stage.defect * theta;
-    let mut gx = stage.hxx * yx + stage.hux.transpose() * du + yx * rho + stage.gx;
+    let mut gx = stage.hxx * yx + stage.hux.transpose() * du + stage.gx;
     let mut gu = stage.hux * yx + stage.huu * du + du * rho + stage.gu;
     let mut constraint = SVector::<f64, N>::zeros();
     if stage.constraints > 0 {
@@ -43,6 +43,7 @@ fn stage_gradient<const N: usize, const X: usize>(
     if let Some(node) = &stage.node {
         lx += node.0 * dx + node.1;
     }
+    lx += dx * rho;
     (lx, lu, constraint)
 }
 

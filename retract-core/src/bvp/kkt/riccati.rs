@@ -227,10 +227,7 @@ fn stage_factor<const N: usize, const X: usize>(
 ) -> (StageFactor<N, X>, SMatrix<f64, X, X>, Option<usize>) {
     let (a, b, e) = (&dynamics.poly_a, &dynamics.poly_b, &dynamics.poly_e);
     let theta = dynamics.theta;
-    let (mut hxx, mut huu) = (stage.hxx, stage.huu);
-    for r in 0..X {
-        hxx[(r, r)] += rho;
-    }
+    let (hxx, mut huu) = (stage.hxx, stage.huu);
     for a in 0..N {
         huu[(a, a)] += rho;
     }
@@ -241,6 +238,9 @@ fn stage_factor<const N: usize, const X: usize>(
     let mut qxx = e.left_t(&e.right(&hxx)) + a.left_t(&a.right(p));
     if let Some(node) = &stage.node {
         qxx += node.0;
+    }
+    for r in 0..X {
+        qxx[(r, r)] += rho;
     }
     let qux = e.right(&(bth + stage.hux)) + a.right(&btp);
     let cross = b.right(&stage.hux) * theta;
@@ -325,8 +325,9 @@ fn regularized_inverse<const X: usize>(
 const TAIL_CONDITION: f64 = 1e6;
 
 impl<const N: usize, const X: usize> Riccati<N, X> {
-    /// The backward pass over `stages` with $\rho$ added to the diagonal of every $H_i$
-    /// (inertia correction). Over the tail the cost-to-go carries $\nu$:
+    /// The backward pass over `stages` with $\rho$ added to the diagonal of the Hessian in
+    /// every node $\delta x_i$ and every top $\delta u_i$ (the inertia correction: IPOPT's
+    /// $\delta_w I$ in the transcribed variables). Over the tail the cost-to-go carries $\nu$:
     /// $V_i(\delta x) = \tfrac12 \delta x^T P_i \delta x + \delta x^T (s_i + S_i \nu)$,
     /// $S_N = I$ (on the fixed components), $S_i = (\bar A + \bar B K_i)^T S_{i+1}$, and
     /// $D = \partial \delta x_N / \partial \nu = \sum_i (\bar B^T S_{i+1})^T K_{\nu,i}$. The tail
@@ -345,17 +346,20 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         terminal: &Terminal<X>,
         pool: &mut impl Vectors<N, X>,
     ) -> Self {
-        Self::factor_until(dynamics, stages, rho, terminal, (None, pool))
+        Self::factor_until(dynamics, stages, rho, terminal, (None, false, pool))
     }
 
-    /// [`Self::factor_with`], stopped (`interrupted`) once `deadline` has passed: the clock is
-    /// read every [`STEPS_PER_CLOCK_CHECK`] steps.
+    /// [`Self::factor_with`], stopped (`interrupted`) once `deadline` has passed (the clock is
+    /// read every [`STEPS_PER_CLOCK_CHECK`] steps), and, with `stop_indefinite`, as soon as the
+    /// negative pivots outnumber the terminal constraint's rows: the reduced Hessian is then
+    /// indefinite, and its factor (not [`Self::positive_definite`], its count of negative
+    /// eigenvalues a lower bound) serves no solve (an inertia correction's trial).
     pub fn factor_until(
         dynamics: &Dynamics<N, X>,
         stages: &[StageModel<N, X>],
         rho: f64,
         terminal: &Terminal<X>,
-        (deadline, pool): (Option<Instant>, &mut impl Vectors<N, X>),
+        (deadline, stop_indefinite, pool): (Option<Instant>, bool, &mut impl Vectors<N, X>),
     ) -> Self {
         let (a, b) = (&dynamics.poly_a, &dynamics.poly_b);
         let steps = stages.len();
@@ -382,6 +386,10 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
             let (factor, qxx, neg) = stage_factor(dynamics, stage, rho, &p);
             singular |= neg.is_none();
             negative += neg.unwrap_or(0);
+            if stop_indefinite && negative > terminal.rows() {
+                // (the count only grows: the reduced Hessian is indefinite whatever follows)
+                break;
+            }
             // V_i(dx) = Q(dx, K dx + k + K_nu nu): the general form (K need not minimise Q
             // over all du when the stage is constrained)
             let (k, qux) = (&factor.gain, &factor.qux);
@@ -518,12 +526,11 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         &self,
         dynamics: &Dynamics<N, X>,
         stages: &[StageModel<N, X>],
-        rho: f64,
         r0: &SVector<f64, X>,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
         pool: &mut impl Vectors<N, X>,
     ) -> Direction<N, X> {
-        let prepared = self.prepare(dynamics, stages, rho, (r_end, s_end), pool);
+        let prepared = self.prepare(dynamics, stages, (r_end, s_end), pool);
         let direction = self.forward(dynamics, &prepared, r0, r_end, pool);
         prepared.recycle(pool);
         direction
@@ -537,7 +544,6 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         &self,
         dynamics: &Dynamics<N, X>,
         stages: &[StageModel<N, X>],
-        rho: f64,
         (r_end, s_end): (&SVector<f64, X>, &SVector<f64, X>),
         pool: &mut impl Vectors<N, X>,
     ) -> Prepared<N, X> {
@@ -545,7 +551,7 @@ impl<const N: usize, const X: usize> Riccati<N, X> {
         let linear = |i: usize| {
             let stage = &stages[i];
             let offset = stage.defect * theta;
-            let gx = stage.gx + stage.hxx * offset + offset * rho;
+            let gx = stage.gx + stage.hxx * offset;
             let gu = stage.gu + stage.hux * offset;
             let mut lx = dynamics.poly_e.left_t(&gx);
             if let Some(node) = &stage.node {
@@ -972,7 +978,7 @@ mod tests {
         assert!(riccati.positive_definite());
         let solve = || {
             let pool = &mut Pool::default();
-            riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end), pool)
+            riccati.solve(&dynamics, &stages, &r0, (&r_end, &s_end), pool)
         };
         let exact = solve();
         let model = (&stages[..], &terminal);
@@ -1053,7 +1059,7 @@ mod tests {
             let r_end = SVector::<f64, X>::from_fn(|_, _| noise(&mut seed));
             // the ends fixed; then q' free at the end with a terminal cost and q'_1 free at the
             // start; without and with an inertia correction rho, which the dense system has on
-            // the diagonal of every stage Hessian in (x_theta, u) and of the terminal cost's
+            // the diagonal of every node's Hessian (x_i), every top's (u_i) and the terminal's
             for (free_end, rho) in [(false, 0.0), (true, 0.0), (false, 0.7), (true, 0.7)] {
                 let (terminal, s_end) = if free_end {
                     let m = SMatrix::<f64, X, X>::from_fn(|_, _| noise(&mut seed));
@@ -1077,13 +1083,16 @@ mod tests {
                 assert_eq!(riccati.boundary() > 0, steps > 2);
                 let solve = || {
                     let pool = &mut Pool::default();
-                    riccati.solve(&dynamics, &stages, rho, &r0, (&r_end, &s_end), pool)
+                    riccati.solve(&dynamics, &stages, &r0, (&r_end, &s_end), pool)
                 };
                 let d = solve();
                 let shifted: Vec<StageModel<N, X>> = (stages.iter())
                     .map(|stage| {
                         let mut stage = stage.clone();
-                        stage.hxx += SMatrix::<f64, X, X>::identity() * rho;
+                        let node = stage
+                            .node
+                            .get_or_insert((SMatrix::zeros(), SVector::zeros()));
+                        node.0 += SMatrix::<f64, X, X>::identity() * rho;
                         stage.huu += SMatrix::<f64, N, N>::identity() * rho;
                         stage
                     })

@@ -140,7 +140,9 @@ where
 
     /// The subproblem's solution with the factorisation `factor` for the residuals `soc` of
     /// the nonlinear constraints in place of those at the iterate of `models`: the barrier's
-    /// gradient $-h \nabla g (\mu / s - (z / s) r)$ of each inequality with $r$ from `soc`,
+    /// gradient $-\nabla g (h \mu / s - (h z / s + w \rho_h) r)$ of each inequality with $r$
+    /// from `soc` ($w \rho_h$ the slack's share of the inertia correction, as in
+    /// [`Barrier::shift_slacks`]),
     /// the stage equalities' offsets from `soc`; its slack steps $\nabla g^T \delta y + r$.
     fn corrected_direction(
         &self,
@@ -153,9 +155,11 @@ where
         let mut pool = self.pool.borrow_mut();
         let mut stages = pool.stages.take(models.stages.len());
         stages.extend_from_slice(&models.stages);
-        for (k, c) in models.inequalities.iter().enumerate() {
+        let weights = barrier.weights(self.violation_weights);
+        for ((k, c), w) in models.inequalities.iter().enumerate().zip(weights) {
             let (s, z) = (barrier.s[k], barrier.z[k]);
-            let shift = h * z / s * (soc.inequalities[k] - (c.value - s));
+            // (the inertia correction shifts the slacks' Hessian: Barrier::shift_slacks)
+            let shift = (h * z / s + w * rho_h) * (soc.inequalities[k] - (c.value - s));
             match barrier.slot(k) {
                 Slot::Step(i) => {
                     stages[i].gx += c.gx * shift;
@@ -172,7 +176,7 @@ where
             stage.value = *value;
         }
         let end = (&models.r_end, &models.terminal_gradient);
-        let direction = riccati.solve(&self.dynamics, &stages, rho_h, &models.r0, end, &mut *pool);
+        let direction = riccati.solve(&self.dynamics, &stages, &models.r0, end, &mut *pool);
         pool.stages.give(stages);
         let ds = pool.reals.take(barrier.s.len());
         drop(pool);

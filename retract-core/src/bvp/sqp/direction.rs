@@ -19,6 +19,10 @@ use crate::{Lagrangian, LiftedSystem};
 const REFINE_RATIO: f64 = 1e6;
 const REFINEMENTS: usize = 2;
 
+/// IPOPT's first inertia correction $\bar\delta_w^0$ (`first_hessian_perturbation`), in the
+/// transcribed problem's units: $h \rho$.
+const FIRST_CORRECTION: f64 = 1e-4;
+
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
 where
@@ -107,7 +111,7 @@ where
         let rho_h = self.dynamics.h * rho;
         let mut pool = self.pool.borrow_mut();
         let stages = &models.stages;
-        let mut direction = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut *pool);
+        let mut direction = riccati.solve(&self.dynamics, stages, r0, end, &mut *pool);
         if ill_conditioned {
             let model = (&models.stages[..], &models.terminal);
             for _ in 0..REFINEMENTS {
@@ -144,11 +148,16 @@ where
         }
     }
 
-    /// The Riccati factorisation with an inertia correction $\rho$ (scaled by $h$) that makes
-    /// the reduced Hessian positive definite: none if the last iteration needed none (or
-    /// little), else from a third of the `last` one (the correction decays geometrically
-    /// instead of dropping to 0 at a point where the Hessian is barely definite), growing by 8
-    /// (100 from scratch) until the inertia is right; with inequalities the correction shifts
+    /// The Riccati factorisation with an inertia correction $\rho$ (per unit time: $h \rho$
+    /// is added to the Hessian) that makes the reduced Hessian positive definite, IPOPT's
+    /// (Wächter and Biegler 2006, §3.1): none first (in a real-time iteration only where
+    /// `last` is below $10^{-8}$: a correction there decays geometrically instead of
+    /// dropping to 0 where the Hessian is barely definite, whose long step the fixed
+    /// iteration count cannot take back; the pendulum of `tests/no_alloc.rs` kicked by (+8,
+    /// -8) rad/s fell without it); then $h \rho = 10^{-4}$
+    /// ([`FIRST_CORRECTION`]) if no correction was needed before (`last` = 0), else a third of
+    /// the `last` positive one, growing by 100 (the first growth, or where the trial exceeds
+    /// $10^5$ times `last`) or else by 8 until the inertia is right; with inequalities the correction shifts
     /// the eliminated slacks' Hessian too, as IPOPT's ([`Barrier::shift_slacks`]: the stages
     /// of `models` are left shifted by the correction found, for the solve that follows).
     /// Fails with [`Failure::Regularization`]
@@ -173,10 +182,15 @@ where
                     base
                 });
                 models.stages.clone_from_slice(base);
-                barrier.shift_slacks(&mut models.stages, &models.inequalities, rho);
+                barrier.shift_slacks(
+                    &mut models.stages,
+                    &models.inequalities,
+                    rho,
+                    self.violation_weights,
+                );
             }
             let (stages, end) = (&models.stages, &models.terminal);
-            let clock = (self.deadline(), &mut *pool);
+            let clock = (self.deadline(), true, &mut *pool);
             let riccati = Riccati::factor_until(&self.dynamics, stages, rho, end, clock);
             if riccati.interrupted {
                 riccati.recycle(&mut *pool);
@@ -189,15 +203,23 @@ where
             Ok(None)
         };
         // (no correction first; then rho growing until the inertia is right, or a failure)
-        let mut found = if last < 1e-8 {
+        let mut found = if (!self.real_time && !barrier.s.is_empty()) || last < 1e-8 {
             factor(0.0).map(|r| r.map(|r| (r, 0.0)))
         } else {
             Ok(None)
         };
-        let mut rho = if last > 0.0 { last / 3.0 } else { 1e-4 };
+        let mut rho = if last > 0.0 {
+            last / 3.0
+        } else {
+            FIRST_CORRECTION / h
+        };
         while matches!(found, Ok(None)) && rho < 1e40 {
             found = factor(h * rho).map(|r| r.map(|r| (r, rho)));
-            rho *= if last > 0.0 { 8.0 } else { 100.0 };
+            rho *= if last == 0.0 || 1e5 * last < rho {
+                100.0
+            } else {
+                8.0
+            };
         }
         if let Some(base) = base {
             self.pool.borrow_mut().stages.give(base);

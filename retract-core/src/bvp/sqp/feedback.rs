@@ -69,10 +69,9 @@ where
             }
         };
         let ends = (&models.r_end, &models.terminal_gradient);
-        let rho_h = self.dynamics.h * rho;
         let prepared = {
             let mut pool = self.pool.borrow_mut();
-            riccati.prepare(&self.dynamics, &models.stages, rho_h, ends, &mut *pool)
+            riccati.prepare(&self.dynamics, &models.stages, ends, &mut *pool)
         };
         let linearization = Linearization {
             riccati,

@@ -1,11 +1,12 @@
 //! The first multipliers: IPOPT's least-squares estimate of the equality multipliers at the
 //! first iterate (Wächter and Biegler 2006, §3.6), for the barrier error that decides whether
-//! $\mu$ falls before the first step.
+//! $\mu$ falls before the first step and as the multipliers the first step starts from.
 
 use nalgebra::{SMatrix, SVector};
 
 use super::state::{Models, Sqp};
-use crate::bvp::barrier::Barrier;
+use crate::bvp::barrier::{Barrier, Slot};
+use crate::bvp::constraints::partner_index;
 use crate::bvp::kkt::riccati::{Direction, Riccati};
 use crate::{Lagrangian, LiftedSystem};
 
@@ -18,50 +19,91 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
-    /// The multipliers of every equality (the dynamics' costates and the stage equalities')
-    /// that minimise the norm of the gradient of the Lagrangian at the models' iterate, with
-    /// the inequality multipliers $z$ of `barrier` held: the solution of
+    /// IPOPT's first multipliers: the equalities' (the dynamics' costates and the stage
+    /// equalities') and the inequalities' $y$ of $g - s = 0$ that minimise, jointly, the norm
+    /// of the gradient of the Lagrangian in the transcribed variables and in the slacks, with
+    /// the inequality multipliers $z$ of `barrier` held
+    /// ([`Self::least_squares_direction`] with the slacks' rows): per IPOPT row $v$ (one
+    /// side alone, or the two sides $\ell \le v \le u$ of an interval, which share one
+    /// slack), $y_d = r_s + h \nabla v^T w$ with $r_s = -h \sum_k \sigma_k z_k$ its slack's
+    /// gradient, which per side $g_k = \sigma_k (v - c_k)$ is $y_k = z_k - \nabla g_k^T w /
+    /// m_k$ ($m_k$ the sides of the row: the two of an interval split $y_d$ evenly).
+    /// Returns the direction (whose `multipliers` and costates are the equalities') and $y$ in
+    /// the barrier's order; `None` if the factorisation is not positive definite, or a
+    /// multiplier (IPOPT's units: $h y$ for the inequalities) is not finite or exceeds
+    /// [`MAX_FIRST_MULTIPLIER`] (IPOPT then starts every multiplier at 0).
+    pub(super) fn least_squares_multipliers(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+    ) -> Option<(Direction<N, X>, Vec<f64>)> {
+        let h = self.dynamics.h;
+        let direction = self.least_squares_direction(models, barrier, true)?;
+        let y = self.pool.borrow_mut().reals.take(barrier.s.len());
+        let mut y = barrier.slack_steps(&models.inequalities, &direction, self.dynamics.theta, y);
+        for (k, (yk, c)) in y.iter_mut().zip(&models.inequalities).enumerate() {
+            let along = *yk - (c.value - barrier.s[k]);
+            let sides = if self.interval_partner(barrier, k).is_some() {
+                2.0
+            } else {
+                1.0
+            };
+            *yk = barrier.z[k] - along / sides;
+        }
+        let stage = direction.multipliers.iter().flat_map(|v| v.iter().copied());
+        let costates = direction.costate.iter().flat_map(|v| v.iter().copied());
+        let largest =
+            (stage.chain(costates))
+                .chain(y.iter().map(|v| h * v))
+                .fold(0.0_f64, |m, v| {
+                    if v.is_finite() {
+                        m.max(v.abs())
+                    } else {
+                        f64::INFINITY
+                    }
+                });
+        if largest <= MAX_FIRST_MULTIPLIER {
+            Some((direction, y))
+        } else {
+            let mut pool = self.pool.borrow_mut();
+            pool.reals.give(y);
+            direction.recycle(&mut *pool);
+            None
+        }
+    }
+
+    /// The index in the barrier of the other side of entry `k`'s interval, if it is one side
+    /// of an interval ([`partner_index`] in its list).
+    fn interval_partner(&self, barrier: &Barrier, k: usize) -> Option<usize> {
+        match barrier.slot(k) {
+            Slot::Step(i) => {
+                let j = k - i * barrier.count;
+                partner_index(self.at_steps, j).map(|p| i * barrier.count + p)
+            }
+            Slot::Node(i) => {
+                let j = k - barrier.node_index(i, 0);
+                partner_index(self.at_nodes, j).map(|p| barrier.node_index(i, p))
+            }
+        }
+    }
+
+    /// The solution of the least-squares system
     ///
     /// $$\begin{pmatrix} h I & C^T \\ C & 0 \end{pmatrix}
     ///   \begin{pmatrix} w \\ \lambda \end{pmatrix} =
     ///   -\begin{pmatrix} \nabla (J - h z^T g^{\ge}) \\ 0 \end{pmatrix}$$
     ///
-    /// ($C$ the Jacobian of the dynamics, the stage equalities and the boundary data), by one
-    /// Riccati solve with identity stage Hessians ($h I$ in $(x_\theta, u)$ and at every node)
-    /// and zero constraint residuals. `None` if that factorisation is not positive definite
-    /// (the equalities' Jacobian is rank-deficient), a multiplier is not finite or exceeds
-    /// [`MAX_FIRST_MULTIPLIER`].
-    pub(super) fn least_squares_multipliers(
-        &self,
-        models: &Models<N, X>,
-        barrier: &Barrier,
-    ) -> Option<Direction<N, X>> {
-        let direction = self.least_squares_direction(models, barrier)?;
-        let largest = direction
-            .multipliers
-            .iter()
-            .flat_map(|y| y.iter())
-            .fold(0.0_f64, |m, y| {
-                if y.is_finite() {
-                    m.max(y.abs())
-                } else {
-                    f64::INFINITY
-                }
-            });
-        if largest <= MAX_FIRST_MULTIPLIER {
-            Some(direction)
-        } else {
-            direction.recycle(&mut *self.pool.borrow_mut());
-            None
-        }
-    }
-
-    /// The solution of [`Self::least_squares_multipliers`]' system, whatever the size of its
-    /// multipliers; `None` if its factorisation is not positive definite.
+    /// ($C$ the Jacobian of the dynamics, the stage equalities and the boundary data; $h I$
+    /// in the transcribed variables, the nodes $x_i$ and the tops $u_i$, as IPOPT's identity),
+    /// by one Riccati solve with zero constraint residuals; with `slacks`, each IPOPT row $v$
+    /// of the inequalities also has its slack, eliminated: $h \nabla v \nabla v^T$ added to
+    /// its step's or node's Hessian (once for the two sides of an interval). `None` if the
+    /// factorisation is not positive definite (the equalities' Jacobian is rank-deficient).
     pub(super) fn least_squares_direction(
         &self,
         models: &Models<N, X>,
         barrier: &Barrier,
+        slacks: bool,
     ) -> Option<Direction<N, X>> {
         let h = self.dynamics.h;
         let mut pool = self.pool.borrow_mut();
@@ -73,7 +115,7 @@ where
         let mut stages = pool.stages.take(models.stages.len());
         for (i, (stage, (gx, gu))) in models.stages.iter().zip(&gradients).enumerate() {
             let mut stage = stage.clone();
-            stage.hxx = SMatrix::identity() * h;
+            stage.hxx = SMatrix::zeros();
             stage.hux = SMatrix::zeros();
             stage.huu = SMatrix::identity() * h;
             (stage.gx, stage.gu) = (*gx, *gu);
@@ -83,6 +125,13 @@ where
             stage.node = Some((SMatrix::identity() * h, node));
             stages.push(stage);
         }
+        if slacks {
+            for (k, c) in models.inequalities.iter().enumerate() {
+                if self.interval_partner(barrier, k).is_none_or(|p| p > k) {
+                    barrier.add_outer(&mut stages, k, c, h);
+                }
+            }
+        }
         let mut terminal = models.terminal;
         terminal.hessian = SMatrix::identity() * h;
         let riccati = Riccati::factor_with(&self.dynamics, &stages, 0.0, &terminal, &mut *pool);
@@ -90,7 +139,7 @@ where
         let end = (&zero, &models.terminal_gradient);
         let direction = riccati
             .positive_definite()
-            .then(|| riccati.solve(&self.dynamics, &stages, 0.0, &zero, end, &mut *pool));
+            .then(|| riccati.solve(&self.dynamics, &stages, &zero, end, &mut *pool));
         riccati.recycle(&mut *pool);
         pool.stages.give(stages);
         pool.gradients.give(gradients);

@@ -37,6 +37,12 @@ const GAMMA_ALPHA: f64 = 0.05;
 /// is often followed by full ones.
 const TINY_STEPS: usize = 5;
 
+/// IPOPT's `max_soft_resto_iters`: the soft restoration steps in a row.
+const MAX_SOFT_STEPS: usize = 10;
+
+/// IPOPT's `soft_resto_pderror_reduction_factor`.
+const SOFT_REDUCTION: f64 = 0.9999;
+
 /// What the line search carries from one iteration to the next besides the filter and the
 /// penalty: the successive steps shorter than $\gamma_\alpha \gamma_\theta$ (the trigger of
 /// restoration) and the Newton steps restoration phases took since the loop last read them
@@ -45,6 +51,8 @@ const TINY_STEPS: usize = 5;
 pub(super) struct Progress {
     tiny: usize,
     restoration_steps: usize,
+    /// IPOPT's soft restoration: the soft steps taken in a row (0: not in that mode).
+    soft: usize,
 }
 
 impl Progress {
@@ -64,6 +72,8 @@ pub(super) struct Accepted<const N: usize, const X: usize> {
     pub at_rounding: bool,
     pub corrected: Option<Corrected<N, X>>,
     pub restored: Option<Vec<f64>>,
+    /// The dual step length where it is the primal one (a soft restoration step).
+    pub dual_alpha: Option<f64>,
 }
 
 /// The subproblem a line search searches along: the iterate, its models, the direction and,
@@ -209,7 +219,7 @@ where
     pub(super) fn advance(
         &self,
         mut accepted: Accepted<N, X>,
-        (direction, ds): (&Direction<N, X>, &[f64]),
+        (direction, ds, rho): (&Direction<N, X>, &[f64], f64),
         (iterate, barrier, y): (&mut Iterate<N, X>, &mut Barrier, &mut [SVector<f64, N>]),
     ) -> (f64, bool, bool) {
         if let Some(slacks) = accepted.restored.take() {
@@ -227,7 +237,10 @@ where
         };
         let left = core::mem::replace(iterate, accepted.trial);
         self.give_iterate(left);
-        barrier.update(ds, alpha);
+        let dual = accepted
+            .dual_alpha
+            .unwrap_or_else(|| barrier.dual_step_length(ds));
+        barrier.update(ds, (alpha, dual), (rho, self.violation_weights));
         if !barrier.s.is_empty() {
             // the accepted point is the last trial evaluated: its values are kept
             let (mut values, at) = core::mem::take(&mut self.pool.borrow_mut().trial_values);
@@ -263,12 +276,40 @@ where
         searched: Searched<'_, N, X>,
         slacks: (&Barrier, &[f64]),
         (filter, penalty, progress): (&mut Option<Filter>, &mut f64, &mut Progress),
+        carried: (&[SVector<f64, N>], Option<&[SVector<f64, X>]>),
     ) -> Result<Accepted<N, X>, Failure> {
         let (iterate, models, direction, factor) = searched;
         let filter = filter.get_or_insert_with(|| {
             Filter::new(models.violation_l1(), self.pool.borrow_mut().pairs.take(16))
         });
+        let soft_on = self.options.restoration
+            && !self.real_time
+            && factor.is_some()
+            && !slacks.0.s.is_empty();
+        let costate = carried.1.filter(|_| soft_on);
+        if let Some(costate) = costate
+            && (1..=MAX_SOFT_STEPS).contains(&progress.soft)
+        {
+            match self.soft_step(searched, slacks, filter, (carried.0, costate)) {
+                Some((accepted, satisfied)) => {
+                    progress.soft = if satisfied { 0 } else { progress.soft + 1 };
+                    progress.tiny = 0;
+                    return Ok(accepted);
+                }
+                None => progress.soft = 0,
+            }
+        }
         if let Some(accepted) = self.filter_search(searched, slacks, filter)? {
+            progress.tiny = 0;
+            progress.soft = 0;
+            return Ok(accepted);
+        }
+        if let Some(costate) = costate
+            && progress.soft == 0
+            && let Some((accepted, satisfied)) =
+                self.soft_step(searched, slacks, filter, (carried.0, costate))
+        {
+            progress.soft = if satisfied { 0 } else { 1 };
             progress.tiny = 0;
             return Ok(accepted);
         }
@@ -312,6 +353,7 @@ where
                     at_rounding: false,
                     corrected: None,
                     restored: Some(s),
+                    dual_alpha: None,
                 })
             }
             _ if self.out_of_time() => {
@@ -378,10 +420,12 @@ where
                     at_rounding,
                     corrected: None,
                     restored: None,
+                    dual_alpha: None,
                 }));
             }
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
                 && theta_t >= theta
+                && theta > options.tolerance
                 && options.second_order_corrections > 0
                 && (!self.problem.equalities.is_empty() || !barrier.s.is_empty())
             {
@@ -396,6 +440,7 @@ where
                         at_rounding,
                         corrected: Some(step),
                         restored: None,
+                        dual_alpha: None,
                     }));
                 }
             }
@@ -403,6 +448,98 @@ where
             alpha *= 0.5;
         }
         Ok(None)
+    }
+
+    /// IPOPT's soft restoration step (its `TrySoftRestoStep`): the primal and dual step
+    /// of the same length $\alpha = \min(\alpha_{\max}, \alpha^z_{\max})$ (the fractions to
+    /// the boundary), accepted if the filter accepts it (`true`: the soft mode ends) or if it
+    /// lowers the barrier problem's error at the carried multipliers (the stage
+    /// equalities', the costates and $z$, each a fraction $\alpha$ of the way to the
+    /// subproblem's) by the factor [`SOFT_REDUCTION`] (`false`: the mode goes on).
+    fn soft_step(
+        &self,
+        (iterate, models, direction, _): Searched<'_, N, X>,
+        (barrier, ds): (&Barrier, &[f64]),
+        filter: &mut Filter,
+        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
+    ) -> Option<(Accepted<N, X>, bool)> {
+        let alpha = barrier.max_step(ds).min(barrier.dual_step_length(ds));
+        let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
+        let accepted = |trial| Accepted {
+            trial,
+            alpha,
+            at_rounding: false,
+            corrected: None,
+            restored: None,
+            dual_alpha: Some(alpha),
+        };
+        let (theta, phi) = (models.violation_l1(), models.barrier_cost);
+        let slope = self.slope(models, direction, barrier, ds);
+        let current = (theta, phi, slope, 1e-14 * phi.abs().max(1.0));
+        if slope.is_finite()
+            && let Some((phi_t, theta_t)) = parts
+            && self.filter_accepts(filter, current, (theta_t, phi_t), alpha)
+        {
+            return Some((accepted(trial), true));
+        }
+        let now = self.error_at_multipliers(models, barrier, (y, costate), &[]);
+        let then = self.soft_trial_error(&trial, (barrier, ds), direction, (y, costate), alpha);
+        if then <= SOFT_REDUCTION * now {
+            Some((accepted(trial), false))
+        } else {
+            self.give_iterate(trial);
+            None
+        }
+    }
+
+    /// The barrier problem's error at the soft restoration step's `trial` point: with the
+    /// slacks and $z$ moved by `alpha` along `ds`, and the stage equalities' multipliers and
+    /// the costates `carried` a fraction `alpha` of the way to the `direction`'s.
+    fn soft_trial_error(
+        &self,
+        trial: &Iterate<N, X>,
+        (barrier, ds): (&Barrier, &[f64]),
+        direction: &Direction<N, X>,
+        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
+        alpha: f64,
+    ) -> f64 {
+        let (mut moved, mut y_t, mut c_t) = {
+            let mut pool = self.pool.borrow_mut();
+            let vectors = [(); 3].map(|_| pool.reals.take(barrier.s.len()));
+            let moved = barrier.copy_into(vectors);
+            (
+                moved,
+                pool.tops.take(y.len()),
+                pool.jets.take(costate.len()),
+            )
+        };
+        moved.update(ds, (alpha, alpha), (0.0, self.violation_weights));
+        y_t.extend(
+            y.iter()
+                .zip(&direction.multipliers)
+                .map(|(a, b)| a + (b - a) * alpha),
+        );
+        c_t.extend(
+            costate
+                .iter()
+                .zip(&direction.costate)
+                .map(|(a, b)| a + (b - a) * alpha),
+        );
+        let error = match self.models(trial, &y_t, &moved) {
+            Ok(models) => {
+                let error = self.error_at_multipliers(&models, &moved, (&y_t, &c_t), &[]);
+                self.give_models(models);
+                error
+            }
+            Err(_) => f64::INFINITY,
+        };
+        let mut pool = self.pool.borrow_mut();
+        pool.tops.give(y_t);
+        pool.jets.give(c_t);
+        for v in moved.into_vectors() {
+            pool.reals.give(v);
+        }
+        error
     }
 
     /// Whether the filter accepts a trial point $(\theta_t, \varphi_t)$ at step length
@@ -491,6 +628,7 @@ where
                     at_rounding: -descent <= noise,
                     corrected: None,
                     restored: None,
+                    dual_alpha: None,
                 });
             }
             self.give_iterate(trial);

@@ -227,6 +227,7 @@ where
         let mut state = State {
             iterate,
             y,
+            costate: None,
             barrier,
             filter: None,
             full_step: None,
@@ -247,16 +248,15 @@ where
         (result, below)
     }
 
-    /// IPOPT's test of the barrier error before the first step of a cold solve: $\mu$
-    /// decreased ([`Barrier::decrease`]) while the barrier error with the least-squares
-    /// multipliers ([`Self::least_squares_multipliers`]) is at most $10 \mu$. (The loop's own
-    /// test uses the subproblem's Newton multipliers, which at a first guess far from
-    /// stationary are far larger: on parking-x0.4 of the constrained suite they gave 698 per
-    /// unit time against the threshold 100, and $\mu$ stayed at $\mu_0$ for 35 iterations.)
-    /// The stage equalities' first multipliers stay 0: IPOPT starts them at the
-    /// least-squares estimate, which on the constrained suite moves the parkings to other
-    /// minima, one lower and one higher (parking-x0.8 2.880 against 2.979, parking-x0.4 6.863
-    /// against 6.842; the other problems unchanged): no clear gain.
+    /// IPOPT's first multipliers and its test of the barrier error before the first step of a
+    /// cold solve: the multipliers start at IPOPT's least-squares estimate
+    /// ([`Self::least_squares_multipliers`]: the stage equalities' in `st.y`, the
+    /// inequalities' curvature weights in the barrier's $y$), or at 0 where that estimate is
+    /// discarded; and $\mu$ is decreased ([`Barrier::decrease`]) while the barrier error with
+    /// them is at most $10 \mu$. (The loop's own test uses the subproblem's Newton
+    /// multipliers, which at a first guess far from stationary are far larger: on
+    /// parking-x0.4 of the constrained suite they gave 698 per unit time against the
+    /// threshold 100, and $\mu$ stayed at $\mu_0$ for 35 iterations.)
     fn first_barrier_test(&self, st: &mut State<N, X>) {
         if st.barrier.s.is_empty() {
             return;
@@ -264,22 +264,37 @@ where
         let Ok(models) = self.models(&st.iterate, &st.y, &st.barrier) else {
             return;
         };
-        if let Some(ls) = self.least_squares_multipliers(&models, &st.barrier) {
-            let barrier = &st.barrier;
-            let (momenta, _, _) = self.residuals(&models, barrier, 0, &ls, &barrier.z);
-            let floor = barrier_floor(self.options.tolerance);
-            while st.barrier.mu > floor {
-                let z = &st.barrier.z;
-                let error = self.barrier_error(&models, &st.barrier, &ls, (z, &momenta));
-                if error > 10.0 * st.barrier.mu {
-                    break;
-                }
-                st.barrier.decrease(floor, self.dynamics.h);
+        let Some((ls, y)) = self.least_squares_multipliers(&models, &st.barrier) else {
+            st.barrier.y.iter_mut().for_each(|y| *y = 0.0);
+            st.y.iter_mut().for_each(|y| *y = SVector::zeros());
+            let mut costate = self.pool.borrow_mut().jets.take(models.stages.len());
+            costate.resize(models.stages.len(), SVector::zeros());
+            st.costate = Some(costate);
+            self.give_models(models);
+            return;
+        };
+        let barrier = &st.barrier;
+        let (momenta, _, _) = self.residuals(&models, barrier, 0, &ls, &barrier.z);
+        let floor = barrier_floor(self.options.tolerance);
+        while st.barrier.mu > floor {
+            let z = &st.barrier.z;
+            let error = self.barrier_error(&models, &st.barrier, &ls, (z, &momenta));
+            if error > 10.0 * st.barrier.mu {
+                break;
             }
-            let mut pool = self.pool.borrow_mut();
-            pool.jets.give(momenta);
-            ls.recycle(&mut *pool);
+            st.barrier.decrease(floor, self.dynamics.h);
         }
+        for (y, first) in st.y.iter_mut().zip(&ls.multipliers) {
+            *y = *first;
+        }
+        let mut pool = self.pool.borrow_mut();
+        let mut costate = pool.jets.take(ls.costate.len());
+        costate.extend_from_slice(&ls.costate);
+        st.costate = Some(costate);
+        pool.reals.give(core::mem::replace(&mut st.barrier.y, y));
+        pool.jets.give(momenta);
+        ls.recycle(&mut *pool);
+        drop(pool);
         self.give_models(models);
     }
 
@@ -289,6 +304,9 @@ where
         pool.jets.give(state.iterate.x);
         pool.tops.give(state.iterate.u);
         pool.tops.give(state.y);
+        if let Some(costate) = state.costate {
+            pool.jets.give(costate);
+        }
         for v in state.barrier.into_vectors() {
             pool.reals.give(v);
         }
@@ -316,7 +334,10 @@ where
         let options = &self.options;
         let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
-        let (mut rho_last, mut penalty, mut iterations, mut stalled) = (0.0, 0.0, 0, 0);
+        // (the last positive inertia correction, IPOPT's: the next one starts from a third of
+        // it; and whether the last subproblem needed one)
+        let (mut rho_last, mut corrected) = (0.0, false);
+        let (mut penalty, mut iterations, mut stalled) = (0.0, 0, 0);
         let mut progress = Progress::default();
         let mut floor_stalled = 0;
         let mut unreachable = 0;
@@ -332,7 +353,7 @@ where
             // after a full step the last subproblem's multipliers are the Newton estimates
             // here: if they already certify this point, no subproblem is solved at it
             if let Some(last) = st.full_step.take() {
-                let plan = (rho_last == 0.0)
+                let plan = (!corrected)
                     .then(|| self.certify_without_solve(point, &last, iterations))
                     .flatten();
                 last.recycle(&mut *self.pool.borrow_mut());
@@ -348,7 +369,13 @@ where
                 }
                 Err((failure, None)) => return Err(PlanError::without_iterate(failure)),
             };
-            rho_last = sub.rho;
+            // (a subproblem solved again at this iterate, for a smaller mu, starts its inertia
+            // correction where this one did, as IPOPT's single factorisation per iteration)
+            let rho_before = rho_last;
+            corrected = sub.rho > 0.0;
+            if corrected {
+                rho_last = sub.rho;
+            }
             let goal = self.unreachable_goal(&models, &sub);
             match goal {
                 Some((component, miss)) if unreachable + 1 >= UNREACHABLE_ITERATIONS => {
@@ -373,28 +400,29 @@ where
             // the barrier problem solved to 10 mu (IPOPT's test, in absolute units; the
             // adaptive update's monotone mode)
             let monotone = st.adaptive.as_ref().is_none_or(|a| !a.free);
-            if monotone && st.barrier.mu > floor && sub.barrier_error <= 10.0 * st.barrier.mu {
+            let barrier_error = self.carried_barrier_error(st, &models, &sub);
+            if monotone && st.barrier.mu > floor && barrier_error <= 10.0 * st.barrier.mu {
                 self.decrease_barrier(st, sub.error);
+                rho_last = rho_before;
                 self.give_models(models);
                 self.give_subproblem(sub);
                 continue;
             }
-            let mut sub =
-                if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
-                    match self.finish(point, &models, sub, iterations) {
-                        Finished::Plan(plan) => {
-                            self.give_models(models);
-                            return Ok((plan, true));
-                        }
-                        Finished::Failed(failure, certificate, sub) => {
-                            let (cost, _, momenta) = self.hand_back(models, sub);
-                            return Err(fail(failure, cost, certificate, momenta));
-                        }
-                        Finished::Not(sub) => sub,
+            let sub = if (sub.error <= options.tolerance || acceptable) && st.barrier.mu <= floor {
+                match self.finish(point, &models, sub, iterations) {
+                    Finished::Plan(plan) => {
+                        self.give_models(models);
+                        return Ok((plan, true));
                     }
-                } else {
-                    sub
-                };
+                    Finished::Failed(failure, certificate, sub) => {
+                        let (cost, _, momenta) = self.hand_back(models, sub);
+                        return Err(fail(failure, cost, certificate, momenta));
+                    }
+                    Finished::Not(sub) => sub,
+                }
+            } else {
+                sub
+            };
             if let Some(plan) =
                 self.exit_at_kept(&mut st.acceptable, (floor_stalled, sub.error), iterations)
             {
@@ -403,22 +431,8 @@ where
                 return Ok((plan, true));
             }
             let out_of_time = self.out_of_time();
-            if iterations == options.max_iterations && self.real_time && !out_of_time {
-                let point = (&st.iterate, &st.y[..], &st.barrier);
-                let momenta = core::mem::take(&mut sub.momenta);
-                let plan = self.plan(point, models.cost, done, momenta, sub.certificate);
-                self.give_models(models);
-                self.give_subproblem(sub);
-                return Ok((plan, false));
-            }
             if iterations == options.max_iterations || out_of_time {
-                let failure = if out_of_time {
-                    Failure::TimeLimit
-                } else {
-                    Failure::IterationLimit
-                };
-                let (cost, certificate, momenta) = self.hand_back(models, sub);
-                return Err(fail(failure, cost, certificate, momenta));
+                return self.stop_at_limit(st, (models, sub), done, out_of_time);
             }
             iterations += 1;
             let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
@@ -430,7 +444,8 @@ where
             );
             let factor = (!sub.stale).then_some((&sub.riccati, self.dynamics.h * sub.rho));
             let searched = (&st.iterate, &models, &sub.direction, factor);
-            let searched = self.line_search(searched, slacks, globals);
+            let carried = (&st.y[..], st.costate.as_deref());
+            let searched = self.line_search(searched, slacks, globals, carried);
             // (the restoration phases' Newton steps count as iterations)
             iterations = (iterations + progress.take_steps()).min(options.max_iterations);
             let accepted = match searched {
@@ -450,9 +465,14 @@ where
                     return Err(fail(failure, cost, certificate, momenta));
                 }
             };
+            let restored = accepted.restored.is_some();
             let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
-            let (alpha, at_rounding, plain) = self.advance(accepted, (&sub.direction, &ds), state);
-            self.pool.borrow_mut().reals.give(ds);
+            let (alpha, at_rounding, plain) =
+                self.advance(accepted, (&sub.direction, &ds, sub.rho), state);
+            let mut pool = self.pool.borrow_mut();
+            st.carry_costate(&sub.direction.costate, (alpha, restored), &mut pool);
+            pool.reals.give(ds);
+            drop(pool);
             self.give_models(models);
             stalled = if at_rounding { stalled + 1 } else { 0 };
             let at_floor = at_rounding && st.barrier.mu <= floor;
@@ -460,6 +480,52 @@ where
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
         }
+    }
+
+    /// The end of a solve at its iteration limit or out of time (`out_of_time`) after `done`
+    /// iterations: a real-time iteration's plan (not certified) at its iteration limit, else
+    /// [`Failure::IterationLimit`] or [`Failure::TimeLimit`] with the iterate.
+    fn stop_at_limit(
+        &self,
+        st: &State<N, X>,
+        (models, mut sub): (Models<N, X>, Subproblem<N, X>),
+        done: usize,
+        out_of_time: bool,
+    ) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
+        let point = (&st.iterate, &st.y[..], &st.barrier);
+        if self.real_time && !out_of_time {
+            let momenta = core::mem::take(&mut sub.momenta);
+            let plan = self.plan(point, models.cost, done, momenta, sub.certificate);
+            self.give_models(models);
+            self.give_subproblem(sub);
+            return Ok((plan, false));
+        }
+        let failure = if out_of_time {
+            Failure::TimeLimit
+        } else {
+            Failure::IterationLimit
+        };
+        let (cost, certificate, momenta) = self.hand_back(models, sub);
+        Err(PlanError {
+            failure,
+            last: Some(Box::new(self.plan(point, cost, done, momenta, certificate))),
+        })
+    }
+
+    /// IPOPT's barrier error $E_\mu$ at the current iterate with its carried multipliers
+    /// (the stage equalities' `st.y`, the costates `st.costate` and the inequalities'
+    /// current $z$; [`Self::barrier_error`]); where the costates are not carried, the
+    /// subproblem's own (with the Newton multipliers, `sub.barrier_error`).
+    fn carried_barrier_error(
+        &self,
+        st: &State<N, X>,
+        models: &Models<N, X>,
+        sub: &Subproblem<N, X>,
+    ) -> f64 {
+        let Some(costate) = &st.costate else {
+            return sub.barrier_error;
+        };
+        self.error_at_multipliers(models, &st.barrier, (&st.y, costate), &sub.momenta)
     }
 
     /// The adaptive barrier update's new $\mu$ at the iterate of `models` and `sub`

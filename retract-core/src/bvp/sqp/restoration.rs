@@ -187,7 +187,9 @@ where
             let Some((d, rho)) = self.restoration_direction(&w, &reference, rho_last) else {
                 break;
             };
-            rho_last = rho;
+            if rho > 0.0 {
+                rho_last = rho;
+            }
             let size = w.x.iter().map(|x| x.amax()).fold(1.0, f64::max);
             let length = (d.dx.iter().map(|v| v.amax()))
                 .chain(d.du.iter().map(|v| v.amax()))
@@ -283,9 +285,8 @@ where
         let result = factored.ok().map(|(riccati, rho)| {
             let mut pool = self.pool.borrow_mut();
             let end = (&models.r_end, &models.terminal_gradient);
-            let rho_h = self.dynamics.h * rho;
             let (stages, r0) = (&models.stages, &models.r0);
-            let d = riccati.solve(&self.dynamics, stages, rho_h, r0, end, &mut *pool);
+            let d = riccati.solve(&self.dynamics, stages, r0, end, &mut *pool);
             riccati.recycle(&mut *pool);
             (d, rho)
         });

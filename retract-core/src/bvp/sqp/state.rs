@@ -96,6 +96,11 @@ pub(super) struct State<const N: usize, const X: usize> {
     pub iterate: Iterate<N, X>,
     /// The stage equalities' multipliers.
     pub y: Vec<SVector<f64, N>>,
+    /// The dynamics' costates carried from step to step as IPOPT carries its multipliers
+    /// (from the least-squares estimate, each step a fraction $\alpha$ of the way to the
+    /// subproblem's), for IPOPT's barrier test at the current multipliers; `None` where they
+    /// are not carried (a warm start, after the restoration phase).
+    pub costate: Option<Vec<SVector<f64, X>>>,
     pub barrier: Barrier,
     pub filter: Option<Filter>,
     /// The last direction, after a full step (its multipliers are the Newton estimates at the
@@ -113,6 +118,27 @@ pub(super) struct State<const N: usize, const X: usize> {
 }
 
 impl<const N: usize, const X: usize> State<N, X> {
+    /// The carried costates a fraction `alpha` of the way to the step's `costate` (IPOPT's
+    /// $\alpha_y = \alpha$), or dropped after a point of the restoration phase (`restored`).
+    pub(super) fn carry_costate(
+        &mut self,
+        costate: &[SVector<f64, X>],
+        (alpha, restored): (f64, bool),
+        pool: &mut Pool<N, X>,
+    ) {
+        if restored {
+            if let Some(carried) = self.costate.take() {
+                pool.jets.give(carried);
+            }
+            return;
+        }
+        if let Some(carried) = &mut self.costate {
+            for (c, target) in carried.iter_mut().zip(costate) {
+                *c += (target - *c) * alpha;
+            }
+        }
+    }
+
     /// In the adaptive update's free mode, $\mu$ chosen afresh ([`Adaptive::choose`]) and
     /// the filter emptied with it (the barrier cost changes with $\mu$, as in IPOPT).
     pub(super) fn choose_barrier(&mut self, floor: f64) {

@@ -107,7 +107,7 @@ where
         models: &Models<N, X>,
         barrier: &Barrier,
     ) -> Certificate {
-        let Some(direction) = self.least_squares_direction(models, barrier) else {
+        let Some(direction) = self.least_squares_direction(models, barrier, false) else {
             return Self::unsolved_certificate(models, barrier);
         };
         let (momenta, certificate, _) = self.residuals(models, barrier, 0, &direction, &barrier.z);
@@ -210,6 +210,35 @@ where
                 .max(compl / s_c)
         };
         error(z).min(error(&barrier.z))
+    }
+
+    /// The barrier problem's error ([`Self::barrier_error`]) at the iterate of `models` with
+    /// the multipliers `(y, costate)` of the stage equalities and the dynamics and the
+    /// barrier's own $z$ (IPOPT's $E_\mu$ at its carried multipliers), with the `momenta` of
+    /// the residuals (empty: formed from the costates).
+    pub(super) fn error_at_multipliers(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
+        momenta: &[SVector<f64, X>],
+    ) -> f64 {
+        let carried = {
+            let mut pool = self.pool.borrow_mut();
+            let (mut c, mut m) = (pool.jets.take(costate.len()), pool.tops.take(y.len()));
+            c.extend_from_slice(costate);
+            m.extend_from_slice(y);
+            let (dx, du) = (pool.jets.take(0), pool.tops.take(0));
+            Direction {
+                dx,
+                du,
+                costate: c,
+                multipliers: m,
+            }
+        };
+        let error = self.barrier_error(models, barrier, &carried, (&barrier.z, momenta));
+        carried.recycle(&mut *self.pool.borrow_mut());
+        error
     }
 
     /// The goal's component whose miss the subproblem cannot reduce, and that miss: where the
