@@ -250,13 +250,14 @@ where
 
     /// IPOPT's first multipliers and its test of the barrier error before the first step of a
     /// cold solve: the multipliers start at IPOPT's least-squares estimate
-    /// ([`Self::least_squares_multipliers`]: the stage equalities' in `st.y`, the
-    /// inequalities' curvature weights in the barrier's $y$), or at 0 where that estimate is
-    /// discarded; and $\mu$ is decreased ([`Barrier::decrease`]) while the barrier error with
-    /// them is at most $10 \mu$. (The loop's own test uses the subproblem's Newton
-    /// multipliers, which at a first guess far from stationary are far larger: on
-    /// parking-x0.4 of the constrained suite they gave 698 per unit time against the
-    /// threshold 100, and $\mu$ stayed at $\mu_0$ for 35 iterations.)
+    /// ([`Self::least_squares_multipliers`]: the stage equalities' in `st.y`, the costates in
+    /// `st.costate`, the inequalities' curvature weights in the barrier's $y$), or at 0 where
+    /// that estimate is discarded; and $\mu$ is decreased ([`Barrier::decrease`]) while the
+    /// barrier error with them is at most $10 \mu$. (The loop's own test then uses the
+    /// multipliers carried from these, [`Self::carried_barrier_error`]; the subproblem's
+    /// Newton multipliers, which it used before, are far larger at a first guess far from
+    /// stationary: on parking-x0.4 of the constrained suite they gave 698 per unit time
+    /// against the threshold 100, and $\mu$ stayed at $\mu_0$ for 35 iterations.)
     fn first_barrier_test(&self, st: &mut State<N, X>) {
         if st.barrier.s.is_empty() {
             return;
