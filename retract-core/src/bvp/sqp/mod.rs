@@ -333,16 +333,14 @@ where
     /// not, the iterate of a real-time iteration at its iteration limit).
     fn iterate_from(&self, st: &mut State<N, X>) -> Result<(Plan<N, X>, bool), PlanError<N, X>> {
         let options = &self.options;
-        let count = self.at_steps.len() + self.at_nodes.len();
         let floor = barrier_floor(options.tolerance);
         // (the last positive inertia correction, IPOPT's: the next one starts from a third of
         // it; and whether the last subproblem needed one)
         let (mut rho_last, mut corrected) = (0.0, false);
         let (mut penalty, mut iterations, mut stalled) = (0.0, 0, 0);
-        let mut progress = Progress::default();
-        let mut floor_stalled = 0;
-        let mut unreachable = 0;
-        let unconstrained = count == 0 && self.problem.equalities.is_empty();
+        let (mut progress, mut floor_stalled, mut unreachable) = (Progress::default(), 0, 0);
+        let unconstrained = (self.at_steps.is_empty() && self.at_nodes.is_empty())
+            && self.problem.equalities.is_empty();
         loop {
             st.choose_barrier(floor);
             let done = iterations;
