@@ -249,3 +249,81 @@ fn the_adaptive_barrier_reaches_the_monotone_minimum() {
         );
     }
 }
+
+/// The double integrator's cost times 1000.
+#[higher_order_lagrangian(order = 2)]
+fn heavy_double_integrator(_q: f64, _dq: f64, ddq: f64) -> f64 {
+    500.0 * ddq * ddq
+}
+
+/// The cost's scale (IPOPT's gradient-based scaling, `PlanOptions::scaling_max_gradient`)
+/// is invisible in the plan: the bounded double integrator and the same problem with its cost
+/// times 1000, both scaled to the largest first gradient 1e-3, iterate on the same scaled
+/// problem, so the heavy plan is the light one with its cost, momenta, multipliers, barrier
+/// parameter and smallest eigenvalue times 1000 (a scale left in any of them is off by
+/// the factor of its own scale). With the default scaling the heavy problem's first gradients
+/// exceed 100, it is scaled, and it ends at the same controls as without scaling, whose
+/// cost it reports.
+#[test]
+fn the_cost_scale_is_invisible_in_the_plan() {
+    let solve = |heavy: bool, options: PlanOptions| {
+        let light = DoubleIntegrator::new();
+        let weighty = HeavyDoubleIntegrator::new();
+        let (start, goal) = ([0.0, 0.0], [1.0, 0.0]);
+        if heavy {
+            OptimalControlProblem::new(&weighty, &start, &goal, 1.0, 50)
+                .with_bounds(Variable::Top(0), -5.0, 5.0)
+                .with_options(options)
+                .solve(PlanGuess::Spline)
+                .unwrap()
+        } else {
+            OptimalControlProblem::new(&light, &start, &goal, 1.0, 50)
+                .with_bounds(Variable::Top(0), -5.0, 5.0)
+                .with_options(options)
+                .solve(PlanGuess::Spline)
+                .unwrap()
+        }
+    };
+    let both = PlanOptions::default().with_scaling_max_gradient(1e-3);
+    let (light, heavy) = (solve(false, both), solve(true, both));
+    assert_eq!(light.iterations, heavy.iterations);
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a - b).abs() <= 1e-7 * b.abs().max(1e-12),
+            "{what}: {a} against {b}"
+        );
+    };
+    close(heavy.cost, 1000.0 * light.cost, "cost");
+    for (h, l) in heavy.u.iter().zip(&light.u) {
+        close(h[0], l[0], "control");
+    }
+    for (h, l) in heavy.momenta.iter().zip(&light.momenta) {
+        for r in 0..2 {
+            assert!((h[r] - 1000.0 * l[r]).abs() <= 1e-6 * (1.0 + 1000.0 * l.amax()));
+        }
+    }
+    let (hz, lz) = (&heavy.duals.step_multipliers, &light.duals.step_multipliers);
+    assert!(!lz.is_empty());
+    for (h, l) in hz.iter().zip(lz) {
+        assert!((h - 1000.0 * l).abs() <= 1e-6 * (1.0 + 1000.0 * l.abs()));
+    }
+    close(heavy.duals.barrier, 1000.0 * light.duals.barrier, "barrier");
+    let (he, le) = (
+        heavy.certificate.min_reduced_hessian_eig,
+        light.certificate.min_reduced_hessian_eig,
+    );
+    assert!(
+        le > 0.0 && (he - 1000.0 * le).abs() <= 1e-6 * he,
+        "{he} against {le}"
+    );
+    // the default scaling against none, on the heavy problem
+    let scaled = solve(true, PlanOptions::default());
+    let unscaled = solve(
+        true,
+        PlanOptions::default().with_scaling_max_gradient(f64::INFINITY),
+    );
+    assert!((scaled.cost - unscaled.cost).abs() <= 1e-8 * unscaled.cost);
+    for (s, u) in scaled.u.iter().zip(&unscaled.u) {
+        assert!((s[0] - u[0]).abs() <= 1e-6, "{} against {}", s[0], u[0]);
+    }
+}

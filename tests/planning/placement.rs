@@ -279,14 +279,15 @@ fn a_solve_stalled_at_an_infeasible_point_names_the_constraint() {
         assert_eq!(restored.constraint.kind, ConstraintKind::Inequality);
         assert_eq!(restored.constraint.index, 0);
         assert!(restored.violation > 0.1, "N = {steps}: {restored}");
-        // without it, at the straight guess's centre node
+        // without it, at the straight guess's centre node, within 1e-3 of its full depth r^2
+        // (the first steps move the iterate a little before it stalls)
         let options = PlanOptions::default().with_restoration(false);
         let head_on = stalled(problem.with_options(options).solve(PlanGuess::Spline));
         assert_eq!(head_on.constraint.kind, ConstraintKind::Inequality);
         assert_eq!(head_on.constraint.index, 0);
         assert_eq!(head_on.location, Location::Node(steps / 2), "N = {steps}");
         assert!(
-            (head_on.violation - radius * radius).abs() < 1e-5,
+            (head_on.violation - radius * radius).abs() < 1e-3,
             "{head_on}"
         );
     }

@@ -12,7 +12,7 @@
 //! $y_d$)
 //! added to the model of $h L$ of its step (in $(x_\theta, u)$) or of its node (in $x_i$);
 //! then $\delta z = (\mu - z s - z\thinspace\delta s)/s$. The slacks
-//! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - \mu)$
+//! take the primal step length (at most the fraction to the boundary $\tau = \max(0.99, 1 - h\mu)$
 //! of the way to 0), the multipliers their own, clipped to $[\mu / (10^{10} s), 10^{10} \mu / s]$.
 //! When the barrier problem is solved to $10 \mu$, $\mu \leftarrow \max(\mu_{\min},
 //! \min(\mu / 5, \mu^{1.5}))$ in the transcribed problem's units (IPOPT's: its barrier term
@@ -68,6 +68,9 @@ pub(super) struct Barrier {
     pub nodes: usize,
     /// Steps $N$.
     pub steps: usize,
+    /// The step length $h$ (the barrier parameter of the transcribed problem, IPOPT's, is
+    /// $h \mu$).
+    pub h: f64,
 }
 
 /// Where entry `k` of a [`Barrier`] lives.
@@ -107,6 +110,7 @@ impl Barrier {
             count,
             nodes,
             steps,
+            h,
         }
     }
 
@@ -126,21 +130,23 @@ impl Barrier {
     /// The barrier of a primal-dual warm start from `duals` (which fit the layout `(count,
     /// nodes, steps)`) at an iterate where the inequalities take `values`, pair by pair
     /// ([`Self::warm_pair`]), and the plan's barrier parameter $\mu$ = `duals.barrier`, at
-    /// least `floor`: a plan's is at its floor (or, certified at the acceptable level, a few
+    /// least `floor`, its multipliers and $\mu$ times the cost's `scale` $\sigma$ (a plan's are
+    /// unscaled, the iteration's those of $\sigma J$): a plan's is at its floor (or, certified at the acceptable level, a few
     /// times above it), so the barrier is not restarted from $\mu_0$
     /// (which would first undo the plan's complementarity), and an unfinished plan's (a
     /// real-time iteration's) goes on from where it was.
     pub fn warm<const N: usize>(
         duals: &super::plan::duals::Duals<N>,
         (count, nodes, steps): (usize, usize, usize),
-        (floor, values): (f64, &[f64]),
+        (floor, scale, values): (f64, f64, &[f64]),
         [mut s, mut z, mut y]: [Vec<f64>; 3],
+        h: f64,
     ) -> Self {
-        let mu = duals.barrier.max(floor);
+        let mu = (duals.barrier * scale).max(floor);
         let slacks = duals.step_slacks.iter().chain(&duals.node_slacks);
         let multipliers = duals.step_multipliers.iter().chain(&duals.node_multipliers);
         for ((sk, zk), g) in slacks.zip(multipliers).zip(values) {
-            let (sk, zk) = Self::warm_pair((*sk, *zk), *g, mu);
+            let (sk, zk) = Self::warm_pair((*sk, *zk * scale), *g, mu);
             s.push(sk);
             z.push(zk);
         }
@@ -153,6 +159,7 @@ impl Barrier {
             count,
             nodes,
             steps,
+            h,
         }
     }
 
@@ -187,6 +194,7 @@ impl Barrier {
         duals: &super::plan::duals::Duals<N>,
         (count, nodes, steps): (usize, usize, usize),
         [mut s, mut z, mut y]: [Vec<f64>; 3],
+        h: f64,
     ) -> Self {
         s.extend(duals.step_slacks.iter().chain(&duals.node_slacks));
         z.extend(duals.step_multipliers.iter().chain(&duals.node_multipliers));
@@ -199,6 +207,7 @@ impl Barrier {
             count,
             nodes,
             steps,
+            h,
         }
     }
 
@@ -311,9 +320,10 @@ impl Barrier {
             .fold(1.0_f64, |a, (z, d)| a.min(-tau * z / d))
     }
 
-    /// The fraction-to-the-boundary parameter $\tau$.
+    /// The fraction-to-the-boundary parameter $\tau = \max(0.99, 1 - h\mu)$ (IPOPT's, with its
+    /// barrier parameter $h \mu$).
     pub fn tau(&self) -> f64 {
-        (1.0 - self.mu).max(0.99)
+        (1.0 - self.h * self.mu).max(0.99)
     }
 
     /// Adds the barrier's gradient and primal-dual Hessian (without the constraints' own
@@ -647,6 +657,21 @@ pub(crate) fn one_step(values: &[f64]) -> Barrier {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fraction to the boundary is IPOPT's $\max(0.99, 1 - \mu_{\text{IPOPT}})$ with its
+    /// barrier parameter $h \mu$, not the per-unit-time $\mu$: at $h = 0.01$, $\mu = 0.283$
+    /// (the 7-link chain's second value) it is $0.99717$, not 0.99; a step towards 0 keeps
+    /// $1 - \tau$ of the slack.
+    #[test]
+    fn the_fraction_to_the_boundary_uses_ipopts_barrier_parameter() {
+        let push = |_| (0.01, f64::INFINITY);
+        let empty = [Vec::new(), Vec::new(), Vec::new()];
+        let barrier = Barrier::new((0.283, 0.01), (1, 0, 1), &[1.0], push, empty);
+        assert!((barrier.tau() - (1.0 - 0.00283)).abs() < 1e-15);
+        assert!((barrier.max_step(&[-2.0]) - 0.5 * (1.0 - 0.00283)).abs() < 1e-15);
+        let coarse = one_step(&[1.0]);
+        assert_eq!(coarse.tau(), 0.99);
+    }
 
     /// The LOQO rule at hand-computed points: complementarities (1, 2, 3) have the average
     /// 2 and the centrality 1/2, so sigma = 0.1 (0.05)^3; (1e-3, 1, 1) are off centre

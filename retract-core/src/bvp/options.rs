@@ -105,6 +105,18 @@ pub struct PlanOptions {
     /// monotone by default).
     #[cfg_attr(feature = "serde", serde(default))]
     pub barrier_update: BarrierUpdate,
+    /// The largest gradient of the cost at the first iterate before the cost is scaled
+    /// (IPOPT's gradient-based scaling, `nlp_scaling_max_gradient`, whose default 100 it
+    /// shares): a solve minimises $\sigma J$ with $\sigma = \min(1, g_{\max} / |\nabla
+    /// J(x^0)|_\infty)$ (at least $10^{-8}$; the gradient over every node, the ends included,
+    /// and every top derivative), so the tolerance, the barrier parameter and the inertia
+    /// correction apply to $\sigma J$, as IPOPT's do; the plan reports $J$, its multipliers,
+    /// momenta and smallest eigenvalue unscaled. Of the constrained suite, only the 7-link
+    /// chain is scaled ($\sigma = 0.048$, as IPOPT's). Infinity turns it off; real-time
+    /// iterations never scale.
+    #[cfg_attr(feature = "serde", serde(default = "default_max_gradient"))]
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
+    pub scaling_max_gradient: f64,
 }
 
 /// The barrier parameter's update ([`PlanOptions::barrier_update`]).
@@ -150,6 +162,12 @@ fn default_restoration() -> bool {
     PlanOptions::default().restoration
 }
 
+/// IPOPT's `nlp_scaling_max_gradient`, [`PlanOptions::scaling_max_gradient`]'s default.
+#[cfg(feature = "serde")]
+fn default_max_gradient() -> f64 {
+    PlanOptions::default().scaling_max_gradient
+}
+
 /// IPOPT's `max_soc`, [`PlanOptions::second_order_corrections`]'s default.
 #[cfg(feature = "serde")]
 fn default_corrections() -> usize {
@@ -178,6 +196,7 @@ impl Default for PlanOptions {
             saddle_escapes: 2,
             restoration: true,
             barrier_update: BarrierUpdate::Monotone,
+            scaling_max_gradient: 100.0,
         }
     }
 }
@@ -186,7 +205,7 @@ impl PlanOptions {
     /// Whether these are options at all (options read back from a file hold whatever numbers
     /// they were given): $\theta \in [0, 1]$, a finite `tolerance` $> 0$, a finite
     /// `acceptable` $\ge$ `tolerance`, `max_iterations` $\ge 1$, $0 <$ `armijo` $< 1/2$, a
-    /// finite `initial_barrier` $> 0$, `chord_spacing` $> 0$ (infinity: the three points
+    /// finite `initial_barrier` $> 0$, `scaling_max_gradient` $> 0$, `chord_spacing` $> 0$ (infinity: the three points
     /// only), `max_chord_pieces` at most [`crate::step::MAX_CHORD_PIECES`] and
     /// `interior_samples` at most [`MAX_INTERIOR_SAMPLES`]. Every solve runs it first (with the
     /// checks that need the problem: $\mu_0 / h$ finite, interior samples only for orders
@@ -216,6 +235,12 @@ impl PlanOptions {
             return invalid(
                 "options",
                 "the initial barrier parameter must be finite and > 0",
+            );
+        }
+        if self.scaling_max_gradient.is_nan() || self.scaling_max_gradient <= 0.0 {
+            return invalid(
+                "options",
+                "scaling_max_gradient must be > 0 (infinity: no scaling)",
             );
         }
         if !(self.armijo > 0.0 && self.armijo < 0.5) {
@@ -288,6 +313,12 @@ impl PlanOptions {
     /// off).
     pub fn with_saddle_escapes(mut self, escapes: usize) -> Self {
         self.saddle_escapes = escapes;
+        self
+    }
+    /// Sets the largest cost gradient before the cost is scaled
+    /// ([`Self::scaling_max_gradient`]; infinity turns the scaling off).
+    pub fn with_scaling_max_gradient(mut self, max_gradient: f64) -> Self {
+        self.scaling_max_gradient = max_gradient;
         self
     }
     /// Sets the chord spacing and the cap on chord pieces of the singularity guard

@@ -135,6 +135,8 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             pool: &workspace.pool,
             options: self.options,
             real_time: false,
+            // (the plan's multipliers are unscaled: so is the cost here)
+            scale: 1.0,
         }
         .at_solution(&iterate, &y, &plan.duals)?;
         Ok(PlanSensitivities {

@@ -291,6 +291,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             pool: &workspace.pool,
             options: self.options,
             real_time: true,
+            scale: 1.0,
         }
     }
 }

@@ -97,7 +97,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
         };
         let iterate = self.first_iterate::<S, M>(guess, workspace)?;
         let placed = self.placed();
-        Sqp::<Sys, N, K, X, S, M> {
+        let mut sqp = Sqp::<Sys, N, K, X, S, M> {
             problem: self,
             dynamics: Dynamics::new(self.h(), self.options.theta),
             started,
@@ -107,8 +107,12 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             pool: &workspace.pool,
             options,
             real_time,
+            scale: 1.0,
+        };
+        if !real_time {
+            sqp.scale = sqp.objective_scale(&iterate);
         }
-        .run(iterate, warm)
+        sqp.run(iterate, warm)
     }
 
     /// The checks of a problem before any iterate: its data, the workspace's size, the

@@ -25,14 +25,15 @@ use crate::newton::max_abs;
 /// gradient $n_i$ in $x_i$ from the inequalities at the nodes; empty without them) add to
 /// $r_{x,i}$: where such a constraint is active the momentum jumps at the node, $p_{i+1} - p_i
 /// = d_i + n_{i+1}$, and $p_{i+1}$ above is the value after the jump.
-/// Returns the momenta (in `momenta`, emptied first), the
-/// relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \sigma)$ (the terminal
-/// residual without the $h$) and its scale $\sigma = \max(1, |\nabla L|_\infty)$.
+/// Where `carried` holds multipliers $\mu_i$ of their own (IPOPT's carried multipliers),
+/// they replace those formed from the costates. Returns the momenta (in `momenta`, emptied
+/// first), the relative stationarity $\max(|r_u|_\infty, |r_x|_\infty) / (h \sigma)$ (the
+/// terminal residual without the $h$) and its scale $\sigma = \max(1, |\nabla L|_\infty)$.
 pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     dynamics: &Dynamics<N, X>,
     stages: &[StageModel<N, X>],
     gradients: &[(SVector<f64, X>, SVector<f64, N>)],
-    direction: &Direction<N, X>,
+    (direction, carried): (&Direction<N, X>, Option<&[SVector<f64, X>]>),
     node_gradients: &[SVector<f64, X>],
     (terminal_gradient, fixed, start_fixed): (&SVector<f64, X>, &SVector<f64, X>, &SVector<f64, X>),
     mut momenta: Vec<SVector<f64, X>>,
@@ -59,7 +60,10 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
         } else {
             (*gx, *gu)
         };
-        let mu = -wt.left_t(&(direction.costate[i] + gx * theta));
+        let mu = match carried {
+            Some(mu) => mu[i],
+            None => -wt.left_t(&(direction.costate[i] + gx * theta)),
+        };
         let d = gx - shift_t(&mu) * h;
         for a in 0..N {
             worst = worst.max((gu[a] - h * mu[X - N + a]).abs());
@@ -95,4 +99,36 @@ pub(crate) fn kkt_residuals<const N: usize, const X: usize>(
     }
     let scale = (largest / h).max(1.0);
     (momenta, (worst / (h * scale)).max(terminal / scale), scale)
+}
+
+/// The subproblem's own multipliers $\mu_i$ of the $x$-equations at its solution
+/// `direction` (IPOPT's Newton multipliers $y_+$, which it carries from iterate to iterate),
+/// into `out` (emptied first): $\mu_i = -W^T(\lambda_{i+1} + \theta G_{x,i})$ as in
+/// [`kkt_residuals`], with $G$ the gradient of the stage's quadratic model at the step,
+/// $G_{x,i} = g_{x,i} + H_{xx,i}\thinspace \delta x_{\theta,i} + H_{ux,i}^T \delta u_i +
+/// c_{x,i}^T y_i$ ($g$ the model's gradient, the barrier's terms included; $\delta x_{\theta,i}
+/// = (1-\theta) \delta x_i + \theta \delta x_{i+1}$; $y_i$ the step's stage-equality
+/// multipliers). A direction without a step (the least-squares estimate) takes $\delta = 0$,
+/// and `gradients` in place of the models' $g_x$ where given.
+pub(crate) fn step_multipliers<const N: usize, const X: usize>(
+    dynamics: &Dynamics<N, X>,
+    stages: &[StageModel<N, X>],
+    direction: &Direction<N, X>,
+    gradients: Option<&[(SVector<f64, X>, SVector<f64, N>)]>,
+    out: &mut Vec<SVector<f64, X>>,
+) {
+    let theta = dynamics.theta;
+    out.clear();
+    let stepped = direction.dx.len() == stages.len() + 1 && direction.du.len() == stages.len();
+    for (i, stage) in stages.iter().enumerate() {
+        let mut gx = gradients.map_or(stage.gx, |g| g[i].0);
+        if stepped {
+            let dxt = direction.dx[i] * (1.0 - theta) + direction.dx[i + 1] * theta;
+            gx += stage.hxx * dxt + stage.hux.transpose() * direction.du[i];
+        }
+        if stage.constraints > 0 {
+            gx += stage.cx.transpose() * direction.multipliers[i];
+        }
+        out.push(-dynamics.poly_w.left_t(&(direction.costate[i] + gx * theta)));
+    }
 }

@@ -1126,6 +1126,17 @@ mod tests {
                         assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
                     }
                 }
+                // the x-equations' multipliers of the solution: the dense system's rows are
+                // W times the scheme's, so its multipliers nu give mu = W^T nu
+                let mut mu = Vec::new();
+                crate::bvp::kkt::residuals::step_multipliers(&dynamics, &stages, &d, None, &mut mu);
+                let nv = (steps + 1) * X + steps * N;
+                for (i, mu) in mu.iter().enumerate() {
+                    let nu = SVector::<f64, X>::from_fn(|r, _| sol[nv + (i + 1) * X + r]);
+                    let expected = dynamics.w.transpose() * nu;
+                    let off = (mu - expected).amax();
+                    assert!(off < 1e-9 * (1.0 + expected.amax()), "mu[{i}]: {off:e}");
+                }
                 // one step of iterative refinement from a wrong solution gives the right one
                 // (the system is linear), costates included
                 let mut wrong = solve();

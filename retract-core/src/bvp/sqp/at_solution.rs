@@ -90,7 +90,7 @@ where
             let mut pool = self.pool.borrow_mut();
             [0; 3].map(|_| pool.reals.take(0))
         };
-        let mut barrier = Barrier::at_solution(duals, layout, vectors);
+        let mut barrier = Barrier::at_solution(duals, layout, vectors, self.dynamics.h);
         let active_set: Vec<bool> = (barrier.s.iter().zip(&barrier.z))
             .map(|(s, z)| s < z)
             .collect();

@@ -131,7 +131,7 @@ where
         barrier.predicted(&ds, &mut z);
         let (momenta, certificate, _) =
             self.residuals(models, barrier, riccati.negative, &direction, &z);
-        let barrier_error = self.barrier_error(models, barrier, &direction, (&z, &momenta));
+        let barrier_error = self.barrier_error(models, barrier, (&direction, None), (&z, &momenta));
         let mut pool = self.pool.borrow_mut();
         pool.reals.give(ds);
         pool.reals.give(z);

@@ -7,6 +7,7 @@ use nalgebra::{SMatrix, SVector};
 use super::state::{Models, Sqp};
 use crate::bvp::barrier::{Barrier, Slot};
 use crate::bvp::constraints::partner_index;
+use crate::bvp::kkt::residuals::step_multipliers;
 use crate::bvp::kkt::riccati::{Direction, Riccati};
 use crate::{Lagrangian, LiftedSystem};
 
@@ -19,6 +20,28 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
+    /// The $x$-equations' multipliers $\mu_i$ of the least-squares estimate `ls`
+    /// ([`step_multipliers`] with no step and the gradients of the Lagrangian $h L - h z^T
+    /// g^{\ge}$ at the iterate of `models`, $z$ the barrier's): the multipliers IPOPT carries
+    /// from its first iterate.
+    pub(super) fn first_step_multipliers(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        ls: &Direction<N, X>,
+    ) -> Vec<SVector<f64, X>> {
+        let mut pool = self.pool.borrow_mut();
+        let mut gradients = pool.gradients.take(models.cost_gradient.len());
+        gradients.extend_from_slice(&models.cost_gradient);
+        let h = self.dynamics.h;
+        barrier.lagrangian_gradients(&mut gradients, &models.inequalities, &barrier.z, h);
+        let mut mu = pool.jets.take(models.stages.len());
+        let with = Some(&gradients[..]);
+        step_multipliers(&self.dynamics, &models.stages, ls, with, &mut mu);
+        pool.gradients.give(gradients);
+        mu
+    }
+
     /// IPOPT's first multipliers: the equalities' (the dynamics' costates and the stage
     /// equalities') and the inequalities' $y$ of $g - s = 0$ that minimise, jointly, the norm
     /// of the gradient of the Lagrangian in the transcribed variables and in the slacks, with
@@ -74,7 +97,7 @@ where
 
     /// The index in the barrier of the other side of entry `k`'s interval, if it is one side
     /// of an interval ([`partner_index`] in its list).
-    fn interval_partner(&self, barrier: &Barrier, k: usize) -> Option<usize> {
+    pub(super) fn interval_partner(&self, barrier: &Barrier, k: usize) -> Option<usize> {
         match barrier.slot(k) {
             Slot::Step(i) => {
                 let j = k - i * barrier.count;

@@ -86,6 +86,10 @@ pub(super) type Searched<'s, const N: usize, const X: usize> = (
     Option<(&'s Riccati<N, X>, f64)>,
 );
 
+/// The $x$-equations' multipliers carried from iterate to iterate and the subproblem's own
+/// ([`State::mu`](super::state::State::mu), [`step_multipliers`](crate::bvp::kkt::residuals::step_multipliers)).
+pub(super) type Carried<'s, const X: usize> = (&'s [SVector<f64, X>], &'s [SVector<f64, X>]);
+
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
 where
@@ -110,7 +114,7 @@ where
             let system = self.problem.system_at(i);
             let xt = self.x_theta(iterate, i);
             let xb = blocks::<N, K, X>(&xt);
-            cost += h * system.lagrangian(&xb, u);
+            cost += h * self.scale * system.lagrangian(&xb, u);
             violation += (self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1]).lp_norm(1);
             for g in &self.problem.equalities {
                 violation += g.value(&xb, u).abs();
@@ -276,7 +280,7 @@ where
         searched: Searched<'_, N, X>,
         slacks: (&Barrier, &[f64]),
         (filter, penalty, progress): (&mut Option<Filter>, &mut f64, &mut Progress),
-        carried: (&[SVector<f64, N>], Option<&[SVector<f64, X>]>),
+        carried: (&[SVector<f64, N>], Option<Carried<'_, X>>),
     ) -> Result<Accepted<N, X>, Failure> {
         let (iterate, models, direction, factor) = searched;
         let filter = filter.get_or_insert_with(|| {
@@ -286,11 +290,11 @@ where
             && !self.real_time
             && factor.is_some()
             && !slacks.0.s.is_empty();
-        let costate = carried.1.filter(|_| soft_on);
-        if let Some(costate) = costate
+        let mu = carried.1.filter(|_| soft_on);
+        if let Some(mu) = mu
             && (1..=MAX_SOFT_STEPS).contains(&progress.soft)
         {
-            match self.soft_step(searched, slacks, filter, (carried.0, costate)) {
+            match self.soft_step(searched, slacks, filter, (carried.0, mu)) {
                 Some((accepted, satisfied)) => {
                     progress.soft = if satisfied { 0 } else { progress.soft + 1 };
                     progress.tiny = 0;
@@ -304,10 +308,10 @@ where
             progress.soft = 0;
             return Ok(accepted);
         }
-        if let Some(costate) = costate
+        if let Some(mu) = mu
             && progress.soft == 0
             && let Some((accepted, satisfied)) =
-                self.soft_step(searched, slacks, filter, (carried.0, costate))
+                self.soft_step(searched, slacks, filter, (carried.0, mu))
         {
             progress.soft = if satisfied { 0 } else { 1 };
             progress.tiny = 0;
@@ -425,7 +429,6 @@ where
             }
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
                 && theta_t >= theta
-                && theta > options.tolerance
                 && options.second_order_corrections > 0
                 && (!self.problem.equalities.is_empty() || !barrier.s.is_empty())
             {
@@ -454,14 +457,14 @@ where
     /// of the same length $\alpha = \min(\alpha_{\max}, \alpha^z_{\max})$ (the fractions to
     /// the boundary), accepted if the filter accepts it (`true`: the soft mode ends) or if it
     /// lowers the barrier problem's error at the carried multipliers (the stage
-    /// equalities', the costates and $z$, each a fraction $\alpha$ of the way to the
+    /// equalities', the $x$-equations' and $z$, each a fraction $\alpha$ of the way to the
     /// subproblem's) by the factor [`SOFT_REDUCTION`] (`false`: the mode goes on).
     fn soft_step(
         &self,
         (iterate, models, direction, _): Searched<'_, N, X>,
         (barrier, ds): (&Barrier, &[f64]),
         filter: &mut Filter,
-        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
+        (y, mu): (&[SVector<f64, N>], Carried<'_, X>),
     ) -> Option<(Accepted<N, X>, bool)> {
         let alpha = barrier.max_step(ds).min(barrier.dual_step_length(ds));
         let (trial, parts) = self.trial(iterate, direction, (barrier, ds), alpha);
@@ -482,8 +485,8 @@ where
         {
             return Some((accepted(trial), true));
         }
-        let now = self.error_at_multipliers(models, barrier, (y, costate), &[]);
-        let then = self.soft_trial_error(&trial, (barrier, ds), direction, (y, costate), alpha);
+        let now = self.error_at_multipliers(models, barrier, (y, mu.0));
+        let then = self.soft_trial_error(&trial, (barrier, ds), direction, (y, mu), alpha);
         if then <= SOFT_REDUCTION * now {
             Some((accepted(trial), false))
         } else {
@@ -494,24 +497,20 @@ where
 
     /// The barrier problem's error at the soft restoration step's `trial` point: with the
     /// slacks and $z$ moved by `alpha` along `ds`, and the stage equalities' multipliers and
-    /// the costates `carried` a fraction `alpha` of the way to the `direction`'s.
+    /// the $x$-equations' `carried` a fraction `alpha` of the way to the `direction`'s.
     fn soft_trial_error(
         &self,
         trial: &Iterate<N, X>,
         (barrier, ds): (&Barrier, &[f64]),
         direction: &Direction<N, X>,
-        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
+        (y, (mu, target)): (&[SVector<f64, N>], Carried<'_, X>),
         alpha: f64,
     ) -> f64 {
         let (mut moved, mut y_t, mut c_t) = {
             let mut pool = self.pool.borrow_mut();
             let vectors = [(); 3].map(|_| pool.reals.take(barrier.s.len()));
             let moved = barrier.copy_into(vectors);
-            (
-                moved,
-                pool.tops.take(y.len()),
-                pool.jets.take(costate.len()),
-            )
+            (moved, pool.tops.take(y.len()), pool.jets.take(mu.len()))
         };
         moved.update(ds, (alpha, alpha), (0.0, self.violation_weights));
         y_t.extend(
@@ -519,15 +518,10 @@ where
                 .zip(&direction.multipliers)
                 .map(|(a, b)| a + (b - a) * alpha),
         );
-        c_t.extend(
-            costate
-                .iter()
-                .zip(&direction.costate)
-                .map(|(a, b)| a + (b - a) * alpha),
-        );
+        c_t.extend(mu.iter().zip(target).map(|(a, b)| a + (b - a) * alpha));
         let error = match self.models(trial, &y_t, &moved) {
             Ok(models) => {
-                let error = self.error_at_multipliers(&models, &moved, (&y_t, &c_t), &[]);
+                let error = self.error_at_multipliers(&models, &moved, (&y_t, &c_t));
                 self.give_models(models);
                 error
             }

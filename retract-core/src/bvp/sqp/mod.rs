@@ -47,6 +47,7 @@ use crate::bvp::BarrierUpdate;
 use crate::bvp::barrier::Barrier;
 use crate::bvp::constraints::slack_push;
 use crate::bvp::iterate::Iterate;
+use crate::bvp::kkt::residuals::step_multipliers;
 use crate::bvp::plan::duals::Duals;
 use crate::bvp::plan::{Failure, Plan, PlanError};
 use crate::{Lagrangian, LiftedSystem};
@@ -70,6 +71,7 @@ mod termination;
 use adaptive::Adaptive;
 pub(super) use at_solution::AtSolution;
 pub(super) use feedback::Linearization;
+use filter::Filter;
 use line_search::Progress;
 pub(super) use state::Sqp;
 use state::{Models, State, Subproblem};
@@ -78,6 +80,23 @@ use termination::{Finished, barrier_floor};
 /// The end of a solve: the plan and whether it is certified (if not, the iterate of a
 /// real-time iteration at its iteration limit), or the failure.
 type Solved<const N: usize, const X: usize> = Result<(Plan<N, X>, bool), PlanError<N, X>>;
+
+/// An accepted point of the line search, its slack steps and the subproblem's own
+/// $x$-equation multipliers (where they are carried): [`Sqp::search`].
+type Step<const N: usize, const X: usize> = (
+    line_search::Accepted<N, X>,
+    Vec<f64>,
+    Option<Vec<SVector<f64, X>>>,
+);
+
+/// An iterate with its stage equalities' multipliers, its barrier and its carried
+/// $x$-equation multipliers (where they are carried).
+type Point<'s, const N: usize, const X: usize> = (
+    &'s Iterate<N, X>,
+    &'s [SVector<f64, N>],
+    &'s Barrier,
+    Option<&'s [SVector<f64, X>]>,
+);
 
 /// The error below which a full step's factorisation is kept for a simplified Newton step
 /// at the next iterate.
@@ -112,7 +131,8 @@ where
             None
         } else if let Some(duals) = warm.filter(fits) {
             let floor = barrier_floor(self.options.tolerance);
-            Some(Barrier::warm(duals, layout, (floor, &values), vectors))
+            let warm = (floor, self.scale, &values[..]);
+            Some(Barrier::warm(duals, layout, warm, vectors, self.dynamics.h))
         } else {
             Some(self.cold_barrier(&values, layout, vectors))
         };
@@ -209,14 +229,14 @@ where
             self.give_iterate(iterate);
             return (Err(PlanError::without_iterate(Failure::NonFinite)), None);
         };
-        // (the stage equalities' multipliers: a warm start's if they fit and are finite, else
-        // 0; a plan read back from a file may hold any numbers)
+        // (the stage equalities' multipliers: a warm start's, scaled, if they fit and are
+        // finite, else 0; a plan read back from a file may hold any numbers)
         let finite = |y: &SVector<f64, N>| y.iter().all(|v| v.is_finite());
         let steps = iterate.u.len();
         let mut y = self.pool.borrow_mut().tops.take(steps);
         match warm.map(|duals| &duals.equalities) {
             Some(given) if given.len() == steps && given.iter().all(finite) => {
-                y.extend_from_slice(given);
+                y.extend(given.iter().map(|y| y * self.scale));
             }
             _ => y.resize(steps, SVector::zeros()),
         }
@@ -227,7 +247,7 @@ where
         let mut state = State {
             iterate,
             y,
-            costate: None,
+            mu: None,
             barrier,
             filter: None,
             full_step: None,
@@ -268,9 +288,9 @@ where
         let Some((ls, y)) = self.least_squares_multipliers(&models, &st.barrier) else {
             st.barrier.y.iter_mut().for_each(|y| *y = 0.0);
             st.y.iter_mut().for_each(|y| *y = SVector::zeros());
-            let mut costate = self.pool.borrow_mut().jets.take(models.stages.len());
-            costate.resize(models.stages.len(), SVector::zeros());
-            st.costate = Some(costate);
+            let mut mu = self.pool.borrow_mut().jets.take(models.stages.len());
+            mu.resize(models.stages.len(), SVector::zeros());
+            st.mu = Some(mu);
             self.give_models(models);
             return;
         };
@@ -279,7 +299,7 @@ where
         let floor = barrier_floor(self.options.tolerance);
         while st.barrier.mu > floor {
             let z = &st.barrier.z;
-            let error = self.barrier_error(&models, &st.barrier, &ls, (z, &momenta));
+            let error = self.barrier_error(&models, &st.barrier, (&ls, None), (z, &momenta));
             if error > 10.0 * st.barrier.mu {
                 break;
             }
@@ -288,10 +308,8 @@ where
         for (y, first) in st.y.iter_mut().zip(&ls.multipliers) {
             *y = *first;
         }
+        st.mu = Some(self.first_step_multipliers(&models, &st.barrier, &ls));
         let mut pool = self.pool.borrow_mut();
-        let mut costate = pool.jets.take(ls.costate.len());
-        costate.extend_from_slice(&ls.costate);
-        st.costate = Some(costate);
         pool.reals.give(core::mem::replace(&mut st.barrier.y, y));
         pool.jets.give(momenta);
         ls.recycle(&mut *pool);
@@ -305,8 +323,8 @@ where
         pool.jets.give(state.iterate.x);
         pool.tops.give(state.iterate.u);
         pool.tops.give(state.y);
-        if let Some(costate) = state.costate {
-            pool.jets.give(costate);
+        if let Some(mu) = state.mu {
+            pool.jets.give(mu);
         }
         for v in state.barrier.into_vectors() {
             pool.reals.give(v);
@@ -434,44 +452,27 @@ where
                 return self.stop_at_limit(st, (models, sub), done, out_of_time);
             }
             iterations += 1;
-            let ds = self.pool.borrow_mut().reals.take(st.barrier.s.len());
-            let theta = self.dynamics.theta;
-            let ds = (st.barrier).slack_steps(&models.inequalities, &sub.direction, theta, ds);
-            let (slacks, globals) = (
-                (&st.barrier, &ds[..]),
-                (&mut st.filter, &mut penalty, &mut progress),
-            );
-            let factor = (!sub.stale).then_some((&sub.riccati, self.dynamics.h * sub.rho));
-            let searched = (&st.iterate, &models, &sub.direction, factor);
-            let carried = (&st.y[..], st.costate.as_deref());
-            let searched = self.line_search(searched, slacks, globals, carried);
+            let at = (&st.iterate, &st.y[..], &st.barrier, st.mu.as_deref());
+            let globals = (&mut st.filter, &mut penalty, &mut progress);
+            let searched = self.search(at, (&models, &sub), globals);
             // (the restoration phases' Newton steps count as iterations)
             iterations = (iterations + progress.take_steps()).min(options.max_iterations);
-            let accepted = match searched {
-                Ok(accepted) => accepted,
+            let step = match searched {
+                Ok(step) => step,
                 Err(Failure::LineSearch) if sub.stale => {
                     // the simplified direction failed: solve this iterate's own subproblem
                     iterations -= 1;
-                    self.pool.borrow_mut().reals.give(ds);
                     self.give_models(models);
                     self.give_subproblem(sub);
                     continue;
                 }
                 Err(failure) => {
                     let failure = self.name_infeasibility(failure, (&st.iterate, &models), goal);
-                    self.pool.borrow_mut().reals.give(ds);
                     let (cost, certificate, momenta) = self.hand_back(models, sub);
                     return Err(fail(failure, cost, certificate, momenta));
                 }
             };
-            let restored = accepted.restored.is_some();
-            let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
-            let (alpha, at_rounding, plain) =
-                self.advance(accepted, (&sub.direction, &ds, sub.rho), state);
-            let mut pool = self.pool.borrow_mut();
-            st.carry_costate(&sub.direction.costate, (alpha, restored), &mut pool);
-            pool.reals.give(ds);
-            drop(pool);
+            let (alpha, at_rounding, plain) = self.take_step(st, step, &sub);
             self.give_models(models);
             stalled = if at_rounding { stalled + 1 } else { 0 };
             let at_floor = at_rounding && st.barrier.mu <= floor;
@@ -479,6 +480,67 @@ where
             let full = plain && alpha == 1.0;
             self.carry(st, sub, full, unconstrained);
         }
+    }
+
+    /// The line search along the subproblem `sub` at the iterate of `models` (with the
+    /// stage equalities' multipliers `y`, the barrier and the carried $x$-equation
+    /// multipliers `mu` of the state; [`Self::line_search`] with the `globals` filter,
+    /// penalty and progress): the accepted point with its slack steps and, where `mu` is
+    /// carried, the subproblem's own ([`step_multipliers`], which it moves towards); or the
+    /// failure, the vectors given back.
+    fn search(
+        &self,
+        (iterate, y, barrier, mu): Point<'_, N, X>,
+        (models, sub): (&Models<N, X>, &Subproblem<N, X>),
+        globals: (&mut Option<Filter>, &mut f64, &mut Progress),
+    ) -> Result<Step<N, X>, Failure> {
+        let ds = self.pool.borrow_mut().reals.take(barrier.s.len());
+        let theta = self.dynamics.theta;
+        let ds = barrier.slack_steps(&models.inequalities, &sub.direction, theta, ds);
+        let slacks = (barrier, &ds[..]);
+        let factor = (!sub.stale).then_some((&sub.riccati, self.dynamics.h * sub.rho));
+        let searched = (iterate, models, &sub.direction, factor);
+        let target = mu.map(|_| {
+            let mut target = self.pool.borrow_mut().jets.take(models.stages.len());
+            let stages = &models.stages;
+            step_multipliers(&self.dynamics, stages, &sub.direction, None, &mut target);
+            target
+        });
+        let carried = mu.zip(target.as_deref());
+        match self.line_search(searched, slacks, globals, (y, carried)) {
+            Ok(accepted) => Ok((accepted, ds, target)),
+            Err(failure) => {
+                let mut pool = self.pool.borrow_mut();
+                pool.reals.give(ds);
+                if let Some(target) = target {
+                    pool.jets.give(target);
+                }
+                Err(failure)
+            }
+        }
+    }
+
+    /// Moves `st` to the accepted point of `step` ([`Self::advance`] along `sub`'s
+    /// direction), its carried $x$-equation multipliers towards the step's by its length
+    /// ([`State::carry_multipliers`]); gives the step's vectors back. Returns as
+    /// [`Self::advance`].
+    fn take_step(
+        &self,
+        st: &mut State<N, X>,
+        (accepted, ds, target): Step<N, X>,
+        sub: &Subproblem<N, X>,
+    ) -> (f64, bool, bool) {
+        let restored = accepted.restored.is_some();
+        let state = (&mut st.iterate, &mut st.barrier, &mut st.y[..]);
+        let (alpha, at_rounding, plain) =
+            self.advance(accepted, (&sub.direction, &ds, sub.rho), state);
+        let mut pool = self.pool.borrow_mut();
+        if let Some(target) = target {
+            st.carry_multipliers(&target, (alpha, restored), &mut pool);
+            pool.jets.give(target);
+        }
+        pool.reals.give(ds);
+        (alpha, at_rounding, plain)
     }
 
     /// The end of a solve at its iteration limit or out of time (`out_of_time`) after `done`
@@ -521,10 +583,10 @@ where
         models: &Models<N, X>,
         sub: &Subproblem<N, X>,
     ) -> f64 {
-        let Some(costate) = &st.costate else {
+        let Some(mu) = &st.mu else {
             return sub.barrier_error;
         };
-        self.error_at_multipliers(models, &st.barrier, (&st.y, costate), &sub.momenta)
+        self.error_at_multipliers(models, &st.barrier, (&st.y, mu))
     }
 
     /// The adaptive barrier update's new $\mu$ at the iterate of `models` and `sub`

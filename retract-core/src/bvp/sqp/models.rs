@@ -24,7 +24,8 @@ impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const 
 where
     Sys: Lagrangian<N, K> + LiftedSystem<S, M> + ?Sized,
 {
-    /// The model of stage `i`: the Hessian of the Lagrangian $h L + y^T g^{=} - h y_g^T g^{\ge}$
+    /// The model of stage `i`: the Hessian of the Lagrangian $\sigma h L + y^T g^{=} - h y_g^T
+    /// g^{\ge}$ ($\sigma$: [`Sqp::scale`]
     /// ($y_g$: the multipliers of $g - s = 0$, [`Barrier::y`]),
     /// the gradient of $h L$, the defect and the equalities with their Jacobians (the barrier's
     /// own terms are added by [`Barrier::add_to_stage`]), pushed onto `stages`; returned: $L$
@@ -43,14 +44,14 @@ where
         let xt = self.x_theta(iterate, i);
         let xb = blocks::<N, K, X>(&xt);
         let derivatives = system.derivatives(&xb, u);
-        let g = &derivatives.gradient;
-        let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&derivatives.hessian, h);
+        let (g, weight) = (&derivatives.gradient, h * self.scale);
+        let (mut hxx, mut hux, mut huu) = flat_hessian::<N, K, X>(&derivatives.hessian, weight);
         let mut stage = StageModel {
             hxx,
             hux,
             huu,
-            gx: SVector::from_fn(|r, _| h * g.x[r / N][r % N]),
-            gu: g.u * h,
+            gx: SVector::from_fn(|r, _| weight * g.x[r / N][r % N]),
+            gu: g.u * weight,
             defect: self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1],
             constraints: self.problem.equalities.len(),
             cx: SMatrix::zeros(),
@@ -243,7 +244,7 @@ where
             }
             let count = barrier.count;
             let own = &inequalities[i * count..(i + 1) * count];
-            cost += h * self.push_stage(stages, (iterate, i), &y[i], barrier);
+            cost += h * self.scale * self.push_stage(stages, (iterate, i), &y[i], barrier);
             let stage = stages.last_mut().ok_or(Failure::NonFinite)?;
             cost_gradient.push((stage.gx, stage.gu));
             barrier.add_to_stage(stage, i, own, h);
@@ -258,14 +259,48 @@ where
         Ok(cost)
     }
 
-    /// $\Phi(x_N)$ (0 without a terminal cost).
+    /// IPOPT's gradient-based scale of the cost at `iterate` (the first iterate of a solve,
+    /// [`super::PlanOptions::scaling_max_gradient`] $= g_{\max}$): $\sigma = \max(10^{-8},
+    /// \min(1, g_{\max} / |\nabla J|_\infty))$, the gradient of $J = \sum_i h L(x_{\theta,i},
+    /// u_i) + \Phi(x_N)$ in every node (the ends included: $x_i$ gets $(1-\theta) h
+    /// \nabla_x L_i + \theta h \nabla_x L_{i-1}$) and every top derivative ($h \nabla_u L_i$);
+    /// 1 where it is not finite or $g_{\max} = \infty$.
+    pub(in crate::bvp) fn objective_scale(&self, iterate: &Iterate<N, X>) -> f64 {
+        let max_gradient = self.options.scaling_max_gradient;
+        let steps = iterate.u.len();
+        if max_gradient == f64::INFINITY || iterate.x.len() != steps + 1 {
+            return 1.0;
+        }
+        let (h, theta) = (self.dynamics.h, self.dynamics.theta);
+        let (mut largest, mut carried) = (0.0_f64, SVector::<f64, X>::zeros());
+        for (i, u) in iterate.u.iter().enumerate() {
+            let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
+            let g = self.problem.system_at(i).gradient(&xb, u);
+            let gx = SVector::<f64, X>::from_fn(|r, _| h * g.x[r / N][r % N]);
+            let node = carried + gx * (1.0 - theta);
+            largest = largest.max(node.amax()).max((g.u * h).amax());
+            carried = gx * theta;
+        }
+        let terminal = self.problem.terminal_cost.map_or(SVector::zeros(), |phi| {
+            let g = phi.gradient(&blocks::<N, K, X>(&iterate.x[steps]), &SVector::zeros());
+            SVector::<f64, X>::from_fn(|r, _| g.x[r / N][r % N])
+        });
+        largest = largest.max((carried + terminal).amax());
+        if !largest.is_finite() || largest <= max_gradient {
+            return 1.0;
+        }
+        (max_gradient / largest).max(1e-8)
+    }
+
+    /// $\sigma \Phi(x_N)$ (0 without a terminal cost; $\sigma$: [`Sqp::scale`]).
     pub(super) fn terminal_value(&self, last: &SVector<f64, X>) -> f64 {
         self.problem.terminal_cost.map_or(0.0, |phi| {
-            phi.value(&blocks::<N, K, X>(last), &SVector::zeros())
+            self.scale * phi.value(&blocks::<N, K, X>(last), &SVector::zeros())
         })
     }
 
-    /// $\Phi(x_N)$, its gradient and its Hessian in $x_N$ (zeros without a terminal cost).
+    /// $\sigma \Phi(x_N)$, its gradient and its Hessian in $x_N$ (zeros without a terminal
+    /// cost; $\sigma$: [`Sqp::scale`]).
     pub(super) fn terminal_model(
         &self,
         last: &SVector<f64, X>,
@@ -274,10 +309,10 @@ where
             return (0.0, SVector::zeros(), SMatrix::zeros());
         };
         let (x, u) = (blocks::<N, K, X>(last), SVector::<f64, N>::zeros());
-        let g = phi.gradient(&x, &u);
-        let (hxx, _, _) = flat_hessian::<N, K, X>(&phi.hessian(&x, &u), 1.0);
-        let gradient = SVector::from_fn(|r, _| g.x[r / N][r % N]);
-        (phi.value(&x, &u), gradient, hxx)
+        let (g, scale) = (phi.gradient(&x, &u), self.scale);
+        let (hxx, _, _) = flat_hessian::<N, K, X>(&phi.hessian(&x, &u), scale);
+        let gradient = SVector::from_fn(|r, _| scale * g.x[r / N][r % N]);
+        (scale * phi.value(&x, &u), gradient, hxx)
     }
 
     /// Every inequality linearised where it is imposed, in the order of [`Barrier`]: those

@@ -280,6 +280,7 @@ where
             count: 0,
             nodes: 0,
             steps: w.u.len(),
+            h: self.dynamics.h,
         };
         let factored = self.factor_corrected(&mut models, &none, rho_last);
         let result = factored.ok().map(|(riccati, rho)| {
@@ -499,7 +500,7 @@ where
         for (i, u) in w.u.iter().enumerate() {
             let xt = self.x_theta(w, i);
             let xb = blocks::<N, K, X>(&xt);
-            e.cost += h * self.problem.system_at(i).lagrangian(&xb, u);
+            e.cost += h * self.scale * self.problem.system_at(i).lagrangian(&xb, u);
             e.constraints += (self.dynamics.next(&w.x[i], u) - w.x[i + 1]).lp_norm(1);
             for g in &self.problem.equalities {
                 e.constraints += g.value(&xb, u).abs();

@@ -51,6 +51,10 @@ pub(in crate::bvp) struct Sqp<
     pub options: PlanOptions,
     /// A real-time iteration: the iterate at the iteration limit is a result, not a failure.
     pub real_time: bool,
+    /// The cost's scale $\sigma$: the iteration minimises $\sigma J$ (its multipliers,
+    /// momenta, barrier parameter and curvature are those of $\sigma J$), and
+    /// [`Self::plan`] reports them unscaled ([`super::PlanOptions::scaling_max_gradient`]).
+    pub scale: f64,
 }
 
 /// The models of all stages at one iterate.
@@ -96,11 +100,13 @@ pub(super) struct State<const N: usize, const X: usize> {
     pub iterate: Iterate<N, X>,
     /// The stage equalities' multipliers.
     pub y: Vec<SVector<f64, N>>,
-    /// The dynamics' costates carried from step to step as IPOPT carries its multipliers
-    /// (from the least-squares estimate, each step a fraction $\alpha$ of the way to the
-    /// subproblem's), for IPOPT's barrier test at the current multipliers; `None` where they
-    /// are not carried (a warm start, after the restoration phase).
-    pub costate: Option<Vec<SVector<f64, X>>>,
+    /// The multipliers $\mu_i$ of the $x$-equations carried from iterate to iterate as IPOPT
+    /// carries its multipliers (from the least-squares estimate, each step a fraction
+    /// $\alpha$ of the way to the subproblem's own,
+    /// [`step_multipliers`](crate::bvp::kkt::residuals::step_multipliers)), for IPOPT's
+    /// barrier test at the current multipliers; `None` where they are not carried (a warm
+    /// start, after the restoration phase).
+    pub mu: Option<Vec<SVector<f64, X>>>,
     pub barrier: Barrier,
     pub filter: Option<Filter>,
     /// The last direction, after a full step (its multipliers are the Newton estimates at the
@@ -118,22 +124,23 @@ pub(super) struct State<const N: usize, const X: usize> {
 }
 
 impl<const N: usize, const X: usize> State<N, X> {
-    /// The carried costates a fraction `alpha` of the way to the step's `costate` (IPOPT's
-    /// $\alpha_y = \alpha$), or dropped after a point of the restoration phase (`restored`).
-    pub(super) fn carry_costate(
+    /// The carried multipliers $\mu$ a fraction `alpha` of the way to the subproblem's
+    /// `target` (IPOPT's $\alpha_y = \alpha$), or dropped after a point of the restoration
+    /// phase (`restored`).
+    pub(super) fn carry_multipliers(
         &mut self,
-        costate: &[SVector<f64, X>],
+        target: &[SVector<f64, X>],
         (alpha, restored): (f64, bool),
         pool: &mut Pool<N, X>,
     ) {
         if restored {
-            if let Some(carried) = self.costate.take() {
+            if let Some(carried) = self.mu.take() {
                 pool.jets.give(carried);
             }
             return;
         }
-        if let Some(carried) = &mut self.costate {
-            for (c, target) in carried.iter_mut().zip(costate) {
+        if let Some(carried) = &mut self.mu {
+            for (c, target) in carried.iter_mut().zip(target) {
                 *c += (target - *c) * alpha;
             }
         }

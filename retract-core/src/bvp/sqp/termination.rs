@@ -51,6 +51,19 @@ where
         direction: &Direction<N, X>,
         z: &[f64],
     ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
+        self.residuals_with(models, barrier, negative_directions, (direction, None), z)
+    }
+
+    /// [`Self::residuals`] with the $x$-equations' multipliers `carried` in place of those
+    /// formed from the direction's costates, where given ([`kkt_residuals`]).
+    fn residuals_with(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        negative_directions: usize,
+        (direction, carried): (&Direction<N, X>, Option<&[SVector<f64, X>]>),
+        z: &[f64],
+    ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
         let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
         let mut pool = self.pool.borrow_mut();
@@ -74,7 +87,7 @@ where
             &self.dynamics,
             stages,
             gradients,
-            direction,
+            (direction, carried),
             &nodes,
             end,
             momenta,
@@ -144,7 +157,7 @@ where
         let (mut cost, mut violation) = (0.0, 0.0_f64);
         for (i, u) in iterate.u.iter().enumerate() {
             let xb = blocks::<N, K, X>(&self.x_theta(iterate, i));
-            cost += h * self.problem.system_at(i).lagrangian(&xb, u);
+            cost += h * self.scale * self.problem.system_at(i).lagrangian(&xb, u);
             let defect = self.dynamics.next(&iterate.x[i], u) - iterate.x[i + 1];
             violation = violation.max(defect.amax());
             for g in &self.problem.equalities {
@@ -177,7 +190,8 @@ where
     /// \text{complementarity}/s_c)$: the feasibility (defects, equalities, ends, $|g - s|$) is
     /// in the transcribed problem's units, where $\mu$ is $h\mu$, so it is divided by $h$ and
     /// the test $E \le 10\mu$ is IPOPT's $E \le 10 h\mu$. At the models' iterate with the
-    /// subproblem's solution `direction`:
+    /// subproblem's solution `direction` (its $x$-equations' multipliers those `carried`,
+    /// where given, [`Self::residuals_with`]; `momenta` enter the scale $s_d$ only):
     /// the smaller of its values with the predicted inequality multipliers `z` and with the
     /// current ones (the predicted ones are off by the whole dual step when the primal step
     /// is short). $\infty$ without inequalities or with $\mu$ at its floor (it only decides
@@ -186,7 +200,7 @@ where
         &self,
         models: &Models<N, X>,
         barrier: &Barrier,
-        direction: &Direction<N, X>,
+        (direction, carried): (&Direction<N, X>, Option<&[SVector<f64, X>]>),
         (z, momenta): (&[f64], &[SVector<f64, X>]),
     ) -> f64 {
         if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.options.tolerance) {
@@ -202,7 +216,8 @@ where
         let count = direction.multipliers.len() * N + momenta.len() * X;
         let compl = barrier.complementarity().1;
         let error = |z: &[f64]| {
-            let (momenta, certificate, scale) = self.residuals(models, barrier, 0, direction, z);
+            let with = (direction, carried);
+            let (momenta, certificate, scale) = self.residuals_with(models, barrier, 0, with, z);
             self.pool.borrow_mut().jets.give(momenta);
             let (s_d, s_c) = barrier.error_scales(z, h, (others, count));
             (scale * certificate.stationarity / s_d)
@@ -212,33 +227,60 @@ where
         error(z).min(error(&barrier.z))
     }
 
-    /// The barrier problem's error ([`Self::barrier_error`]) at the iterate of `models` with
-    /// the multipliers `(y, costate)` of the stage equalities and the dynamics and the
-    /// barrier's own $z$ (IPOPT's $E_\mu$ at its carried multipliers), with the `momenta` of
-    /// the residuals (empty: formed from the costates).
+    /// The barrier problem's error at the iterate of `models` with the multipliers IPOPT
+    /// carries (its $E_\mu$ at its current iterate, per unit time as
+    /// [`Self::barrier_error`]): the stage equalities' `y` and the $x$-equations' `mu`, and
+    /// in the gradient of the Lagrangian the inequalities' rows $g - s = 0$ with their own
+    /// multipliers, the barrier's $y$ (IPOPT's $y_d$), not $z$; the slacks' stationarity
+    /// $\sum_k \sigma_k (y_k - z_k)$ per IPOPT row (one side, or the two of an interval) joins
+    /// the stationarity, both over $s_d$ from all these multipliers; then the feasibility
+    /// over $h$ and $\max |z s - \mu|$ over $s_c$. $\infty$ without inequalities or with $\mu$
+    /// at its floor.
     pub(super) fn error_at_multipliers(
         &self,
         models: &Models<N, X>,
         barrier: &Barrier,
-        (y, costate): (&[SVector<f64, N>], &[SVector<f64, X>]),
-        momenta: &[SVector<f64, X>],
+        (y, mu): (&[SVector<f64, N>], &[SVector<f64, X>]),
     ) -> f64 {
+        if barrier.s.is_empty() || barrier.mu <= barrier_floor(self.options.tolerance) {
+            return f64::INFINITY;
+        }
+        let h = self.dynamics.h;
         let carried = {
             let mut pool = self.pool.borrow_mut();
-            let (mut c, mut m) = (pool.jets.take(costate.len()), pool.tops.take(y.len()));
-            c.extend_from_slice(costate);
+            let mut m = pool.tops.take(y.len());
             m.extend_from_slice(y);
-            let (dx, du) = (pool.jets.take(0), pool.tops.take(0));
+            let (dx, du, costate) = (pool.jets.take(0), pool.tops.take(0), pool.jets.take(0));
             Direction {
                 dx,
                 du,
-                costate: c,
+                costate,
                 multipliers: m,
             }
         };
-        let error = self.barrier_error(models, barrier, &carried, (&barrier.z, momenta));
-        carried.recycle(&mut *self.pool.borrow_mut());
-        error
+        let with = (&carried, Some(mu));
+        let (momenta, certificate, scale) =
+            self.residuals_with(models, barrier, 0, with, &barrier.y);
+        let mut pool = self.pool.borrow_mut();
+        pool.jets.give(momenta);
+        carried.recycle(&mut *pool);
+        drop(pool);
+        let slack = |k: usize| barrier.y[k] - barrier.z[k];
+        let slack_rows = (0..barrier.s.len()).fold(0.0_f64, |m, k| {
+            let row = match self.interval_partner(barrier, k) {
+                Some(p) => slack(k) - slack(p),
+                None => slack(k),
+            };
+            m.max(row.abs())
+        });
+        let others = y.iter().map(|y| y.lp_norm(1)).sum::<f64>()
+            + mu.iter().map(|p| p.lp_norm(1)).sum::<f64>()
+            + barrier.y.iter().map(|y| (h * y).abs()).sum::<f64>();
+        let count = y.len() * N + mu.len() * X + barrier.y.len();
+        let (s_d, s_c) = barrier.error_scales(&barrier.z, h, (others, count));
+        ((scale * certificate.stationarity).max(slack_rows) / s_d)
+            .max(certificate.feasibility / h)
+            .max(barrier.complementarity().1 / s_c)
     }
 
     /// The goal's component whose miss the subproblem cannot reduce, and that miss: where the
@@ -366,14 +408,16 @@ where
         }
     }
 
-    /// The plan at the point `state` (iterate, stage-equality multipliers, barrier).
+    /// The plan at the point `state` (iterate, stage-equality multipliers, barrier), with the
+    /// iteration's cost, momenta, multipliers, barrier parameter and smallest eigenvalue
+    /// (those of $\sigma J$) divided by $\sigma$ = [`Self::scale`].
     pub(super) fn plan(
         &self,
         state: (&Iterate<N, X>, &[SVector<f64, N>], &Barrier),
         cost: f64,
         iterations: usize,
-        momenta: Vec<SVector<f64, X>>,
-        certificate: Certificate,
+        mut momenta: Vec<SVector<f64, X>>,
+        mut certificate: Certificate,
     ) -> Plan<N, X> {
         let (iterate, y, barrier) = state;
         let (h, theta) = (self.dynamics.h, self.dynamics.theta);
@@ -385,24 +429,35 @@ where
             out.extend_from_slice(v);
             out
         };
-        let (step_slacks, step_multipliers) = (copy(step_slacks), copy(step_multipliers));
-        let (node_slacks, node_multipliers) = (copy(node_slacks), copy(node_multipliers));
+        let (step_slacks, mut step_multipliers) = (copy(step_slacks), copy(step_multipliers));
+        let (node_slacks, mut node_multipliers) = (copy(node_slacks), copy(node_multipliers));
         let (mut equalities, mut x, mut u) = (
             pool.tops.take(y.len()),
             pool.jets.take(iterate.x.len()),
             pool.tops.take(iterate.u.len()),
         );
         drop(pool);
-        equalities.extend_from_slice(y);
         x.extend_from_slice(&iterate.x);
         u.extend_from_slice(&iterate.u);
+        // (the iteration's multipliers, momenta, barrier parameter and curvature are those of
+        // the scaled cost: reported unscaled)
+        let unscale = 1.0 / self.scale;
+        equalities.extend(y.iter().map(|y| y * unscale));
+        momenta.iter_mut().for_each(|p| *p *= unscale);
+        for z in step_multipliers
+            .iter_mut()
+            .chain(node_multipliers.iter_mut())
+        {
+            *z *= unscale;
+        }
+        certificate.min_reduced_hessian_eig *= unscale;
         let duals = Duals {
             equalities,
             step_slacks,
             step_multipliers,
             node_slacks,
             node_multipliers,
-            barrier: barrier.mu,
+            barrier: barrier.mu * unscale,
         };
         Plan {
             h,
@@ -410,7 +465,7 @@ where
             x,
             u,
             momenta,
-            cost,
+            cost: cost * unscale,
             iterations,
             certificate,
             violations: self.problem.violations(iterate, theta).0,
