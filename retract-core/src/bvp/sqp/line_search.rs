@@ -429,6 +429,7 @@ where
             }
             if let (0, Some((_, theta_t)), Some(factor)) = (l, parts, factor)
                 && theta_t >= theta
+                && theta > options.tolerance
                 && options.second_order_corrections > 0
                 && (!self.problem.equalities.is_empty() || !barrier.s.is_empty())
             {
