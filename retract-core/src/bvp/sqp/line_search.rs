@@ -274,7 +274,10 @@ where
     /// is feasible to the tolerance (no elastic point can then reduce its violation): its point
     /// if it returns to one the filter accepts, [`Failure::LineSearch`] if it ends at a point
     /// of local infeasibility, [`Failure::TimeLimit`] if the budget ran out in it, and
-    /// otherwise the penalty search's result.
+    /// otherwise the penalty search's result. Where the $x$-equations' multipliers are
+    /// `carried` (with the subproblem's own, [`Carried`]) and the restoration phase could run,
+    /// IPOPT's soft restoration step ([`Self::soft_step`]) comes first while its mode lasts
+    /// and after a filter search that finds no step.
     pub(super) fn line_search(
         &self,
         searched: Searched<'_, N, X>,

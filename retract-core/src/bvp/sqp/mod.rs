@@ -270,9 +270,9 @@ where
 
     /// IPOPT's first multipliers and its test of the barrier error before the first step of a
     /// cold solve: the multipliers start at IPOPT's least-squares estimate
-    /// ([`Self::least_squares_multipliers`]: the stage equalities' in `st.y`, the costates in
-    /// `st.costate`, the inequalities' curvature weights in the barrier's $y$), or at 0 where
-    /// that estimate is discarded; and $\mu$ is decreased ([`Barrier::decrease`]) while the
+    /// ([`Self::least_squares_multipliers`]: the stage equalities' in `st.y`, the
+    /// $x$-equations' in `st.mu` ([`Self::first_step_multipliers`]), the inequalities'
+    /// curvature weights in the barrier's $y$), or at 0 where that estimate is discarded; and $\mu$ is decreased ([`Barrier::decrease`]) while the
     /// barrier error with them is at most $10 \mu$. (The loop's own test then uses the
     /// multipliers carried from these, [`Self::carried_barrier_error`]; the subproblem's
     /// Newton multipliers, which it used before, are far larger at a first guess far from
@@ -574,9 +574,9 @@ where
     }
 
     /// IPOPT's barrier error $E_\mu$ at the current iterate with its carried multipliers
-    /// (the stage equalities' `st.y`, the costates `st.costate` and the inequalities'
-    /// current $z$; [`Self::barrier_error`]); where the costates are not carried, the
-    /// subproblem's own (with the Newton multipliers, `sub.barrier_error`).
+    /// (the stage equalities' `st.y`, the $x$-equations' `st.mu`, the inequality rows' $y$
+    /// and $z$ of the barrier; [`Self::error_at_multipliers`]); where they are not carried,
+    /// the subproblem's own (with the Newton multipliers, `sub.barrier_error`).
     fn carried_barrier_error(
         &self,
         st: &State<N, X>,
