@@ -1013,6 +1013,28 @@ mod tests {
         }
     }
 
+    /// The x-equations' multipliers of the solution `d` ([`step_multipliers`]) against the
+    /// dense KKT solution `sol` of [`dense_kkt`]: its rows are W times the scheme's, so its
+    /// multipliers nu give mu = W^T nu.
+    ///
+    /// [`step_multipliers`]: crate::bvp::kkt::residuals::step_multipliers
+    fn assert_step_multipliers(
+        dynamics: &Dynamics<2, 4>,
+        stages: &[StageModel<2, 4>],
+        d: &Direction<2, 4>,
+        sol: &nalgebra::DVector<f64>,
+    ) {
+        let mut mu = Vec::new();
+        crate::bvp::kkt::residuals::step_multipliers(dynamics, stages, d, None, &mut mu);
+        let nv = (stages.len() + 1) * 4 + stages.len() * 2;
+        for (i, mu) in mu.iter().enumerate() {
+            let nu = SVector::<f64, 4>::from_fn(|r, _| sol[nv + (i + 1) * 4 + r]);
+            let expected = dynamics.w.transpose() * nu;
+            let off = (mu - expected).amax();
+            assert!(off < 1e-9 * (1.0 + expected.amax()), "mu[{i}]: {off:e}");
+        }
+    }
+
     #[test]
     fn riccati_equals_the_dense_kkt_solve() {
         const N: usize = 2;
@@ -1126,17 +1148,7 @@ mod tests {
                         assert!((d.du[i][a] - sol[uc(i) + a]).abs() < 1e-9, "du[{i}][{a}]");
                     }
                 }
-                // the x-equations' multipliers of the solution: the dense system's rows are
-                // W times the scheme's, so its multipliers nu give mu = W^T nu
-                let mut mu = Vec::new();
-                crate::bvp::kkt::residuals::step_multipliers(&dynamics, &stages, &d, None, &mut mu);
-                let nv = (steps + 1) * X + steps * N;
-                for (i, mu) in mu.iter().enumerate() {
-                    let nu = SVector::<f64, X>::from_fn(|r, _| sol[nv + (i + 1) * X + r]);
-                    let expected = dynamics.w.transpose() * nu;
-                    let off = (mu - expected).amax();
-                    assert!(off < 1e-9 * (1.0 + expected.amax()), "mu[{i}]: {off:e}");
-                }
+                assert_step_multipliers(&dynamics, &stages, &d, &sol);
                 // one step of iterative refinement from a wrong solution gives the right one
                 // (the system is linear), costates included
                 let mut wrong = solve();
