@@ -30,15 +30,14 @@ where
         barrier: &Barrier,
         ls: &Direction<N, X>,
     ) -> Vec<SVector<f64, X>> {
+        let gradients = self.lagrangian_gradients(models, barrier, &barrier.z);
         let mut pool = self.pool.borrow_mut();
-        let mut gradients = pool.gradients.take(models.cost_gradient.len());
-        gradients.extend_from_slice(&models.cost_gradient);
-        let h = self.dynamics.h;
-        barrier.lagrangian_gradients(&mut gradients, &models.inequalities, &barrier.z, h);
         let mut mu = pool.jets.take(models.stages.len());
-        let with = Some(&gradients[..]);
+        let with = Some(gradients.as_deref().unwrap_or(&models.cost_gradient));
         step_multipliers(&self.dynamics, &models.stages, ls, with, &mut mu);
-        pool.gradients.give(gradients);
+        if let Some(gradients) = gradients {
+            pool.gradients.give(gradients);
+        }
         mu
     }
 

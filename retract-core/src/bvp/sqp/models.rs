@@ -259,6 +259,28 @@ where
         Ok(cost)
     }
 
+    /// The gradients of the Lagrangian $h L - h z^T g^{\ge}$ at every step with the
+    /// inequality multipliers `z` (a copy of the models' cost gradients from the pool, which
+    /// the caller gives back); `None` without inequalities at the steps, where they are the
+    /// cost gradients themselves.
+    pub(super) fn lagrangian_gradients(
+        &self,
+        models: &Models<N, X>,
+        barrier: &Barrier,
+        z: &[f64],
+    ) -> Option<Vec<(SVector<f64, X>, SVector<f64, N>)>> {
+        (barrier.at_steps() > 0).then(|| {
+            let mut g = self
+                .pool
+                .borrow_mut()
+                .gradients
+                .take(models.cost_gradient.len());
+            g.extend_from_slice(&models.cost_gradient);
+            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, self.dynamics.h);
+            g
+        })
+    }
+
     /// IPOPT's gradient-based scale of the cost at `iterate` (the first iterate of a solve,
     /// [`super::PlanOptions::scaling_max_gradient`] $= g_{\max}$): $\sigma = \max(10^{-8},
     /// \min(1, g_{\max} / |\nabla J|_\infty))$, the gradient of $J = \sum_i h L(x_{\theta,i},

@@ -66,13 +66,8 @@ where
     ) -> (Vec<SVector<f64, X>>, Certificate, f64) {
         let h = self.dynamics.h;
         // the gradients of the Lagrangian: those of h L, less h z^T grad g with inequalities
+        let with_inequalities = self.lagrangian_gradients(models, barrier, z);
         let mut pool = self.pool.borrow_mut();
-        let with_inequalities = (barrier.at_steps() > 0).then(|| {
-            let mut g = pool.gradients.take(models.cost_gradient.len());
-            g.extend_from_slice(&models.cost_gradient);
-            barrier.lagrangian_gradients(&mut g, &models.inequalities, z, h);
-            g
-        });
         let gradients = with_inequalities.as_ref().unwrap_or(&models.cost_gradient);
         let end = (
             &models.terminal_gradient,
