@@ -16,8 +16,11 @@ pub struct PlanOptions {
     /// The scheme parameter $\theta$ (1/2: midpoint).
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub theta: f64,
-    /// Converged when the relative stationarity ([`Certificate::stationarity`](super::Certificate::stationarity)) and the
-    /// constraint violation are both below this.
+    /// Converged when the relative stationarity
+    /// ([`Certificate::stationarity`](super::Certificate::stationarity), scaled as IPOPT's by
+    /// the multipliers' size where that is above the gradient's), the constraint violation and
+    /// the complementarity $\max z s$ (not scaled: stricter than IPOPT's $s_c$) are all below
+    /// this.
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub tolerance: f64,
     /// Accepted instead of `tolerance` when the line search has made only rounding-level

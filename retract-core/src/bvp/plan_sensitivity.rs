@@ -10,6 +10,7 @@
 //! inequalities as penalties in the factorisation, held exactly by the method of
 //! multipliers). Each solve is refined twice.
 
+use std::cell::Cell;
 use std::time::Instant;
 
 use nalgebra::SVector;
@@ -137,6 +138,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             real_time: false,
             // (the plan's multipliers are unscaled: so is the cost here)
             scale: 1.0,
+            check_refinement: Cell::new(false),
         }
         .at_solution(&iterate, &y, &plan.duals)?;
         Ok(PlanSensitivities {

@@ -4,6 +4,7 @@
 //! start and takes one full Newton step ([`OptimalControlProblem::feedback`]), so that the
 //! first input after a disturbance already answers it.
 
+use std::cell::Cell;
 use std::time::Instant;
 
 use nalgebra::SVector;
@@ -292,6 +293,7 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             options: self.options,
             real_time: true,
             scale: 1.0,
+            check_refinement: Cell::new(false),
         }
     }
 }

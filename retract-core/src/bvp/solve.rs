@@ -3,6 +3,7 @@
 //! first guess, build the first iterate from the [`PlanGuess`] and run the SQP iteration
 //! ([`super::sqp`]) on it.
 
+use std::cell::Cell;
 use std::time::Instant;
 
 use nalgebra::SVector;
@@ -108,6 +109,7 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
             options,
             real_time,
             scale: 1.0,
+            check_refinement: Cell::new(false),
         };
         if !real_time {
             sqp.scale = sqp.objective_scale(&iterate);

@@ -917,7 +917,9 @@ mod tests {
 
     /// Iterative refinement leaves the Riccati solution of a subproblem with stage equality
     /// constraints, node terms, an inertia correction and a free end where it is (its
-    /// residual is rounding), and takes a perturbed solution back to it.
+    /// residual is rounding), and takes a perturbed solution back to it; the residual check
+    /// ([`needs_refinement`](crate::bvp::kkt::refine::needs_refinement)) passes the solution
+    /// and the refined one and flags the perturbed one.
     #[test]
     fn refinement_keeps_a_constrained_solution() {
         const N: usize = 2;
@@ -982,7 +984,11 @@ mod tests {
         };
         let exact = solve();
         let model = (&stages[..], &terminal);
-        for perturbation in [0.0, 0.1] {
+        let end = (&r_end, &s_end);
+        let check = |d: &Direction<N, X>| {
+            crate::bvp::kkt::refine::needs_refinement(&dynamics, model, rho, &r0, end, d)
+        };
+        for perturbation in [0.0, 0.1, 1e-7] {
             let mut d = solve();
             for v in d.dx.iter_mut().skip(1).chain(d.costate.iter_mut()) {
                 *v += SVector::<f64, X>::from_fn(|_, _| perturbation * noise(&mut seed));
@@ -990,6 +996,7 @@ mod tests {
             for v in d.du.iter_mut().chain(d.multipliers.iter_mut()) {
                 *v += SVector::<f64, N>::from_fn(|_, _| perturbation * noise(&mut seed));
             }
+            assert_eq!(check(&d), perturbation > 0.0, "perturbation {perturbation}");
             crate::bvp::kkt::refine::refine(
                 &riccati,
                 &dynamics,
@@ -999,6 +1006,7 @@ mod tests {
                 (&r_end, &s_end),
                 (&mut d, &mut Pool::default()),
             );
+            assert!(!check(&d), "refined from {perturbation}");
             for (i, stage) in stages.iter().enumerate() {
                 let off = (d.dx[i + 1] - exact.dx[i + 1])
                     .amax()

@@ -11,8 +11,10 @@
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Certificate {
     /// Max-norm of the gradient of the Lagrangian of the transcription, with the multipliers
-    /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty)$: stationarity per
-    /// unit time relative to the size of the gradient of $L$.
+    /// of the last subproblem, divided by $h \max(1, |\nabla L|_\infty, s_d)$: stationarity
+    /// per unit time relative to the size of the gradient of $L$ and to IPOPT's scale of the
+    /// multipliers, $s_d = \bar\lambda / 100$ with $\bar\lambda$ the mean modulus of the
+    /// stage equalities', the inequalities' ($h z$) and the momenta's components.
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub stationarity: f64,
     /// Max-norm of the constraint violation (dynamics defects, boundary data, stage

@@ -9,7 +9,7 @@ use super::state::{Models, Sqp, Subproblem};
 use crate::bvp::barrier::Barrier;
 use crate::bvp::iterate::Iterate;
 use crate::bvp::kkt::model::StageModel;
-use crate::bvp::kkt::refine::refine;
+use crate::bvp::kkt::refine::{needs_refinement, refine};
 use crate::bvp::kkt::riccati::Riccati;
 use crate::bvp::plan::{Certificate, Failure};
 use crate::{Lagrangian, LiftedSystem};
@@ -112,9 +112,17 @@ where
         let mut pool = self.pool.borrow_mut();
         let stages = &models.stages;
         let mut direction = riccati.solve(&self.dynamics, stages, r0, end, &mut *pool);
+        let model = (&models.stages[..], &models.terminal);
         if ill_conditioned {
-            let model = (&models.stages[..], &models.terminal);
             for _ in 0..REFINEMENTS {
+                let d = (&mut direction, &mut *pool);
+                refine(&riccati, &self.dynamics, model, rho_h, r0, end, d);
+            }
+        } else if self.check_refinement.get() {
+            for _ in 0..REFINEMENTS {
+                if !needs_refinement(&self.dynamics, model, rho_h, r0, end, &direction) {
+                    break;
+                }
                 let d = (&mut direction, &mut *pool);
                 refine(&riccati, &self.dynamics, model, rho_h, r0, end, d);
             }

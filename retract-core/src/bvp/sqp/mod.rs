@@ -108,6 +108,10 @@ const CHORD_ERROR: f64 = 1e-3;
 /// ([`Sqp::name_infeasibility`]).
 const UNREACHABLE_ITERATIONS: usize = 5;
 
+/// The error below which a full Newton step that does not lower it turns on the
+/// refinement check ([`Sqp::watch_refinement`]).
+const REFINEMENT_WATCH: f64 = 1e-2;
+
 impl<Sys, const N: usize, const K: usize, const X: usize, const S: usize, const M: usize>
     Sqp<'_, '_, Sys, N, K, X, S, M>
 where
@@ -357,6 +361,8 @@ where
         let (mut rho_last, mut corrected) = (0.0, false);
         let (mut penalty, mut iterations, mut stalled) = (0.0, 0, 0);
         let (mut progress, mut floor_stalled, mut unreachable) = (Progress::default(), 0, 0);
+        // (the error before the last full Newton step, for the refinement's trigger)
+        let mut before_full: Option<f64> = None;
         let unconstrained = (self.at_steps.is_empty() && self.at_nodes.is_empty())
             && self.problem.equalities.is_empty();
         loop {
@@ -389,6 +395,7 @@ where
             // (a subproblem solved again at this iterate, for a smaller mu, starts its inertia
             // correction where this one did, as IPOPT's single factorisation per iteration)
             let rho_before = rho_last;
+            self.watch_refinement(before_full.take(), &sub);
             corrected = sub.rho > 0.0;
             if corrected {
                 rho_last = sub.rho;
@@ -478,7 +485,22 @@ where
             let at_floor = at_rounding && st.barrier.mu <= floor;
             floor_stalled = if at_floor { floor_stalled + 1 } else { 0 };
             let full = plain && alpha == 1.0;
+            before_full = (full && !sub.stale).then_some(sub.error);
             self.carry(st, sub, full, unconstrained);
+        }
+    }
+
+    /// Turns on the refinement check of every later subproblem ([`Sqp::check_refinement`])
+    /// where a full Newton step from an error `before` below [`REFINEMENT_WATCH`] left the
+    /// error of the new subproblem `sub` no lower: near a solution the step squares the
+    /// error, unless the solve misses its own equations.
+    fn watch_refinement(&self, before: Option<f64>, sub: &Subproblem<N, X>) {
+        if let Some(before) = before
+            && before <= REFINEMENT_WATCH
+            && sub.error >= before
+            && !sub.stale
+        {
+            self.check_refinement.set(true);
         }
     }
 

@@ -3,7 +3,7 @@
 //! models of an iterate ([`Models`]), a solved subproblem ([`Subproblem`]), the state carried
 //! from one iterate to the next ([`State`]); the pool's take and give for them, and the clock.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 use nalgebra::SVector;
@@ -55,6 +55,13 @@ pub(in crate::bvp) struct Sqp<
     /// momenta, barrier parameter and curvature are those of $\sigma J$), and
     /// [`Self::plan`] reports them unscaled ([`super::PlanOptions::scaling_max_gradient`]).
     pub scale: f64,
+    /// Whether each subproblem's solution is checked for a residual above rounding and then
+    /// refined ([`needs_refinement`](crate::bvp::kkt::refine::needs_refinement)): set for
+    /// the rest of the run once a full Newton step near a solution left the error no lower
+    /// (the sign of a solve without the digits the step needs, e.g. a weakly controllable
+    /// system's terminal pivot; the check costs a pass over the steps, a tenth of an
+    /// iteration of the swing-up suite, so it is not made before).
+    pub check_refinement: Cell<bool>,
 }
 
 /// The models of all stages at one iterate.

@@ -24,6 +24,17 @@ pub(super) fn barrier_floor(tolerance: f64) -> f64 {
     tolerance / 2.0
 }
 
+/// The $\ell_1$ norm and the number of the components of the stage equalities' multipliers
+/// `y` and of the `momenta`: their share of IPOPT's scale $s_d$ ([`Barrier::error_scales`]).
+fn multiplier_sum<const N: usize, const X: usize>(
+    y: &[SVector<f64, N>],
+    momenta: &[SVector<f64, X>],
+) -> (f64, usize) {
+    let sum = y.iter().map(|y| y.lp_norm(1)).sum::<f64>()
+        + momenta.iter().map(|p| p.lp_norm(1)).sum::<f64>();
+    (sum, y.len() * N + momenta.len() * X)
+}
+
 /// How [`Sqp::finish`] ended: a certified plan, a failed second-order check, or not yet (a
 /// constraint violated beyond the tolerance where it is imposed).
 #[allow(clippy::large_enum_variant)] // (made once per solve, and moved at once)
@@ -42,7 +53,9 @@ where
     /// subproblem solution `direction` ([`kkt_residuals`] with the gradients of $h L - h z^T
     /// g^{\ge}$, the constraint violation, $\max z g$), its negative directions those of
     /// `riccati`; the momenta; and the scale $\sigma$ of the relative stationarity (its
-    /// absolute value, per unit time, is $\sigma$ times the relative one).
+    /// absolute value, per unit time, is $\sigma$ times the relative one): $\sigma = \max(1,
+    /// |\nabla L|_\infty, s_d)$, with IPOPT's $s_d$ ([`Barrier::error_scales`]) from the
+    /// stage equalities' multipliers, the momenta and $z$.
     pub(super) fn residuals(
         &self,
         models: &Models<N, X>,
@@ -91,6 +104,11 @@ where
             pool.gradients.give(g);
         }
         pool.jets.give(nodes);
+        // IPOPT's s_d from these multipliers: the stationarity relative to the larger of the
+        // gradient's size and the multipliers' (a residual of large multipliers' rounding
+        // does not hold the test up)
+        let (s_d, _) = barrier.error_scales(z, h, multiplier_sum(&direction.multipliers, &momenta));
+        let (stationarity, scale) = (stationarity * scale / scale.max(s_d), scale.max(s_d));
         let complementarity = z
             .iter()
             .zip(&barrier.s)
@@ -202,13 +220,7 @@ where
             return f64::INFINITY;
         }
         let h = self.dynamics.h;
-        let others = direction
-            .multipliers
-            .iter()
-            .map(|y| y.lp_norm(1))
-            .sum::<f64>()
-            + momenta.iter().map(|p| p.lp_norm(1)).sum::<f64>();
-        let count = direction.multipliers.len() * N + momenta.len() * X;
+        let (others, count) = multiplier_sum(&direction.multipliers, momenta);
         let compl = barrier.complementarity().1;
         let error = |z: &[f64]| {
             let with = (direction, carried);
