@@ -482,6 +482,10 @@ where
             let (alpha, at_rounding, plain) = self.take_step(st, step, &sub);
             self.give_models(models);
             stalled = if at_rounding { stalled + 1 } else { 0 };
+            if at_rounding {
+                // (a stall at rounding: the solve may be missing digits)
+                self.check_refinement.set(true);
+            }
             let at_floor = at_rounding && st.barrier.mu <= floor;
             floor_stalled = if at_floor { floor_stalled + 1 } else { 0 };
             let full = plain && alpha == 1.0;

@@ -57,10 +57,11 @@ pub(in crate::bvp) struct Sqp<
     pub scale: f64,
     /// Whether each subproblem's solution is checked for a residual above rounding and then
     /// refined ([`needs_refinement`](crate::bvp::kkt::refine::needs_refinement)): set for
-    /// the rest of the run once a full Newton step near a solution left the error no lower
-    /// (the sign of a solve without the digits the step needs, e.g. a weakly controllable
-    /// system's terminal pivot; the check costs a pass over the steps, a tenth of an
-    /// iteration of the swing-up suite, so it is not made before).
+    /// the rest of the run once a full Newton step near a solution left the error no lower,
+    /// or a line search made only rounding-level progress (the signs of a solve without the
+    /// digits the step needs, e.g. a weakly controllable system's terminal pivot; the check
+    /// costs a pass over the steps, a tenth of an iteration of the swing-up suite, so it is
+    /// not made before).
     pub check_refinement: Cell<bool>,
 }
 
