@@ -385,13 +385,15 @@ fn driven(q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
 /// pivot over the tail then costs the costates their digits at the tail's first step (the
 /// stationarity stalled at $10^{-5}$ to $10^{-3}$ with the iterate converged, 3000 iterations
 /// at N = 100 and 400); the residual check with iterative refinement, turned on by the first
-/// full step that does not lower the error, solves it in a few iterations.
+/// full step that does not lower the error, solves it in a few iterations, to IPOPT's cost on
+/// the same transcription and guess (`NSTEPS=100 python3 validation/ipopt/constrained_suite.py
+/// driven ends=eq endguess=curve`: 1131.7379440548 and, NSTEPS=400, 1130.4911797462, both in
+/// 5 iterations).
 #[test]
 fn a_weakly_controllable_system_converges() {
     let system = Effort::new();
     let constraint = Driven;
-    let mut costs = Vec::new();
-    for steps in [100, 400] {
+    for (steps, ipopt) in [(100, 1131.7379440548), (400, 1130.4911797462)] {
         let start = [0.0; 4];
         let goal = [1.0, 1.0, 0.0, 0.0];
         let plan = OptimalControlProblem::new(&system, &start, &goal, 1.0, steps)
@@ -399,12 +401,14 @@ fn a_weakly_controllable_system_converges() {
             .solve(PlanGuess::Spline)
             .unwrap_or_else(|e| panic!("N = {steps}: {e}"));
         let c = plan.certificate;
-        assert!(plan.iterations <= 15, "N = {steps}: {}", plan.iterations);
+        assert!(plan.iterations <= 10, "N = {steps}: {}", plan.iterations);
         assert!(c.stationarity <= 1e-9 && c.feasibility <= 1e-9, "{c:?}");
         assert_eq!(c.negative_directions, 0);
-        costs.push(plan.cost);
+        let off = (plan.cost - ipopt).abs() / ipopt;
+        assert!(
+            off <= 1e-10,
+            "N = {steps}: J = {} against {ipopt}",
+            plan.cost
+        );
     }
-    // (the transcription's cost converges with N: within 0.2 % of each other)
-    assert!((costs[0] - costs[1]).abs() < 2e-3 * costs[1], "{costs:?}");
-    assert!(costs[1] > 1000.0, "{costs:?}");
 }
