@@ -133,15 +133,19 @@ def problem(name):
         P['mid'] = lambda q, v, u: [(limit - torque(q, v, u)[0], 0, ca.inf), (limit + torque(q, v, u)[0], 0, ca.inf)]
         P['node'] = lambda q, v: []
         P['guess'] = smoothstep(P['q0'], P['qT'], 2.0)
-    elif name == 'driven':
+    elif name.startswith('driven'):
         # the weakly controllable system of tests/planning/degenerate.rs: L = 1/2 |u|^2 with
-        # the stage equality u_1 - u_0 + 0.3 sin q_0 = 0 at the midpoints, from rest at 0 to
-        # rest at (1, 1) in T = 1 (NSTEPS=100 or 400)
-        P.update(n=2, T=1.0, q0=[0, 0], qT=[1, 1])
+        # the stage equality u_1 - u_0 + c sin q_0 = 0 at the midpoints, from rest at 0 to
+        # rest at (1, 1) in T (`driven`: c = 0.3, T = 1; `driven-c0.1-T1`; NSTEPS=100 or 400)
+        c, T = 0.3, 1.0
+        for part in name.split('-')[1:]:
+            if part[0] == 'c': c = float(part[1:])
+            if part[0] == 'T': T = float(part[1:])
+        P.update(n=2, T=T, q0=[0, 0], qT=[1, 1])
         P['L'] = lambda q, v, u: 0.5 * (u[0] ** 2 + u[1] ** 2)
-        P['mid'] = lambda q, v, u: [(u[1] - u[0] + 0.3 * ca.sin(q[0]), 0, 0)]
+        P['mid'] = lambda q, v, u: [(u[1] - u[0] + c * ca.sin(q[0]), 0, 0)]
         P['node'] = lambda q, v: []
-        P['guess'] = smoothstep(P['q0'], P['qT'], 1.0)
+        P['guess'] = smoothstep(P['q0'], P['qT'], T)
     elif name.startswith('quadrotor'):
         fmax = float(name.split('-f')[1].split('-')[0]); m, I, a, g = 1.0, 0.01, 0.1, 9.81
         P.update(n=3, T=2.0, q0=[0, 0, 0], qT=[2, 1, 0])

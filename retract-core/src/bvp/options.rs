@@ -24,8 +24,10 @@ pub struct PlanOptions {
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_float"))]
     pub tolerance: f64,
     /// Accepted instead of `tolerance` when the line search has made only rounding-level
-    /// progress for three iterations (ill-conditioning near active inequalities), as IPOPT's
-    /// acceptable level; and where, at the barrier's floor, the iterate makes only
+    /// progress for three iterations (ill-conditioning near active inequalities) or the error
+    /// has been below this level for fifteen consecutive iterations (IPOPT's
+    /// `acceptable_iter`: an iterate converged as far as the problem's conditioning allows),
+    /// as IPOPT's acceptable level; and where, at the barrier's floor, the iterate makes only
     /// rounding-level progress for ten iterations with the error above this level, or the
     /// iteration limit is reached, the last point whose barrier
     /// problem was solved with stationarity and feasibility below `tolerance` and

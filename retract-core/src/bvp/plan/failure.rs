@@ -65,7 +65,8 @@ pub enum Failure {
     /// (free that component, [`crate::bvp::OptimalControlProblem::with_free_end`], or change
     /// the goal or the equalities), or only their linearisation at the iterate does (a car
     /// that cannot slip, started standing or sideways to a goal beside it): start from a
-    /// guess along which the equalities allow motion towards the goal.
+    /// guess along which the equalities allow motion towards the goal. Inequalities held at
+    /// their bounds act as equalities here (e.g. bounds too narrow for the horizon).
     UnreachableGoal {
         /// The component of $x_N$.
         component: usize,
@@ -141,11 +142,12 @@ impl core::fmt::Display for Failure {
             Failure::UnreachableGoal { component, miss } => write!(
                 f,
                 "the goal cannot be reached from the last iterate: its component {component} \
-                 is left without control by the stage equalities (linearised there) and the \
-                 dynamics, and no step reduces its miss {miss:e}; start from a guess along \
-                 which the equalities allow motion towards the goal (a path already heading \
-                 there), free that component (with_free_end), or make the goal consistent \
-                 with the equalities"
+                 is left without control by the stage equalities or the inequalities at \
+                 their bounds (linearised there) and the dynamics, and no step reduces its \
+                 miss {miss:e}; start from a guess along which the constraints allow motion \
+                 towards the goal (a path already heading there), free that component \
+                 (with_free_end), or make the goal consistent with the constraints (bounds \
+                 wide enough for the horizon)"
             ),
             Failure::FreeTimeSearch {
                 solves,

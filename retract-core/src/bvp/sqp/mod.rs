@@ -108,6 +108,12 @@ const CHORD_ERROR: f64 = 1e-3;
 /// ([`Sqp::name_infeasibility`]).
 const UNREACHABLE_ITERATIONS: usize = 5;
 
+/// The consecutive iterations at the acceptable level after which a point is accepted there
+/// (IPOPT's `acceptable_iter`): an iterate converged as far as the problem's conditioning
+/// allows, whose steps no longer lower the error but are not rounding-sized either (a weakly
+/// controllable system at large $N$), ends there instead of at the iteration limit.
+const ACCEPTABLE_ITERATIONS: usize = 15;
+
 /// The error below which a full Newton step that does not lower it turns on the
 /// refinement check ([`Sqp::watch_refinement`]).
 const REFINEMENT_WATCH: f64 = 1e-2;
@@ -361,6 +367,8 @@ where
         let (mut rho_last, mut corrected) = (0.0, false);
         let (mut penalty, mut iterations, mut stalled) = (0.0, 0, 0);
         let (mut progress, mut floor_stalled, mut unreachable) = (Progress::default(), 0, 0);
+        // (consecutive iterations at the acceptable level: IPOPT's acceptable_iter count)
+        let mut at_acceptable = 0;
         // (the error before the last full Newton step, for the refinement's trigger)
         let mut before_full: Option<f64> = None;
         let unconstrained = (self.at_steps.is_empty() && self.at_nodes.is_empty())
@@ -412,7 +420,9 @@ where
             }
             // converged, or at the acceptable level with no progress left but rounding
             let complementarity = st.barrier.complementarity().0;
-            let acceptable = stalled >= 3 && sub.error.max(complementarity) <= options.acceptable;
+            let within = sub.error.max(complementarity) <= options.acceptable;
+            at_acceptable = if within { at_acceptable + 1 } else { 0 };
+            let acceptable = within && (stalled >= 3 || at_acceptable >= ACCEPTABLE_ITERATIONS);
             let converged = sub.error.max(complementarity) <= options.tolerance || acceptable;
             let at = (&models, &sub);
             if let Some(mu) = self.adapted(&mut st.adaptive, &st.barrier, at, converged) {

@@ -60,7 +60,7 @@ pub(in crate::bvp) struct Sqp<
     /// the rest of the run once a full Newton step near a solution left the error no lower,
     /// or a line search made only rounding-level progress (the signs of a solve without the
     /// digits the step needs, e.g. a weakly controllable system's terminal pivot; the check
-    /// costs a pass over the steps, a tenth of an iteration of the swing-up suite, so it is
+    /// costs a pass over the steps, 5-15 % of the swing-up suite's solve times, so it is
     /// not made before).
     pub check_refinement: Cell<bool>,
 }
