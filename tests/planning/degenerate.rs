@@ -2,7 +2,8 @@
 //! without control authority, so the goal's conditions on it are not independent of the
 //! dynamics (a rank-deficient constraint Jacobian); and an inequality whose gradient vanishes
 //! where it is active (the parking car's turning radius near rest); and a stage equality that
-//! leaves a combination controllable only weakly, through another coordinate's excursions.
+//! leaves a combination controllable only weakly, through another coordinate's excursions;
+//! and an equality of the jet alone at theta = 0, which no step's control can move.
 
 use crate::parking::{CarEffort, SideSlip, Turning, WAYPOINTS};
 use retract::bvp::{
@@ -10,7 +11,7 @@ use retract::bvp::{
     Variable,
 };
 use retract::nalgebra::DMatrix;
-use retract::{higher_order_lagrangian, jet_function};
+use retract::{Error, higher_order_lagrangian, jet_function};
 
 #[higher_order_lagrangian(order = 2)]
 fn effort(_q: [f64; 2], _dq: [f64; 2], ddq: [f64; 2]) -> f64 {
@@ -437,4 +438,44 @@ fn a_weakly_controllable_system_ends_at_the_acceptable_level() {
         let off = (plan.cost - ipopt).abs() / ipopt;
         assert!(off <= 1e-9, "c = {c}: J = {} against {ipopt}", plan.cost);
     }
+}
+
+/// $q_1' = 2 q_0 q_0'$: an equality of the jet alone (the velocity along the parabola
+/// $q_1 = q_0^2$).
+#[jet_function(order = 2)]
+fn parabola_speed(q: [f64; 2], dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
+    dq[1] - 2.0 * q[0] * dq[0]
+}
+
+/// At $\theta = 0$ an equality is imposed at the node $x_i$, which the step's $u_i$ does not
+/// move: one without the top derivative is refused before iterating, saying why (it ended
+/// as an infeasible point at iteration 0, naming the dynamics); at $\theta = 1/2$ the same
+/// problem is certified.
+#[test]
+fn an_equality_without_the_top_derivative_at_theta_zero_is_refused() {
+    let system = Effort::new();
+    let constraint = ParabolaSpeed;
+    let goal = [1.0, 1.0, 0.0, 0.0];
+    let solve = |theta| {
+        OptimalControlProblem::new(&system, &[0.0; 4], &goal, 1.0, 40)
+            .with_equality(&constraint)
+            .with_options(PlanOptions::default().with_theta(theta))
+            .solve(PlanGuess::Spline)
+    };
+    let error = solve(0.0).unwrap_err();
+    assert!(
+        matches!(
+            error.failure,
+            Failure::Invalid(Error::InvalidArgument {
+                name: "equalities",
+                ..
+            })
+        ),
+        "{error}"
+    );
+    assert!(error.last.is_none());
+    assert!(error.to_string().contains("theta = 0"), "{error}");
+    let plan = solve(0.5).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(plan.certificate.negative_directions, 0);
+    assert!(plan.certificate.feasibility <= 1e-9);
 }

@@ -14,6 +14,15 @@ impl<'a, Sys: ?Sized, const N: usize, const K: usize, const X: usize>
     /// Adds the equality constraint $g(x_{\theta,i}, u_i) = 0$ at every step (e.g. a passive
     /// joint's torque, written under `#[jet_function]`). At most $n$ constraints, jointly of
     /// full rank in the top derivative $u$ (so that each step can satisfy them).
+    ///
+    /// A constraint on lower derivatives only reaches $u$ through the evaluation point
+    /// $x_{\theta,i}$, by a factor $\theta h^{k-j}$ for the highest derivative $q^{(j)}$ it
+    /// involves: one on $q'$ at order 2 (a car's no-slip condition) is solved at any $N$, one
+    /// on $q$ alone loses digits as $h^2$ (the linear $q_1 = 2 q_0$ at $T = 1$ stalls from
+    /// $N = 200$). Write such a constraint on the top derivative instead (differentiated
+    /// $k - j$ times, with ends that satisfy it and its derivatives). At $\theta = 0$, where
+    /// $x_{\theta,i} = x_i$ does not depend on $u_i$ at all, it is refused
+    /// ([`Failure::Invalid`](crate::bvp::Failure::Invalid)).
     pub fn with_equality(mut self, constraint: &'a (dyn JetFunction<N, K> + Sync)) -> Self {
         self.equalities.push(constraint);
         self

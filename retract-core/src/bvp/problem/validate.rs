@@ -45,6 +45,13 @@ impl<Sys: ?Sized, const N: usize, const K: usize, const X: usize>
                 "at most n equality constraints per step (each must fix a direction of u)",
             );
         }
+        if o.theta == 0.0 && self.equalities.iter().any(|g| !g.involves_top()) {
+            return invalid(
+                "equalities",
+                "at theta = 0 an equality is imposed at x_i, which u_i does not move: it must \
+                 involve the top derivative (write it on q^(k), or use theta > 0)",
+            );
+        }
         if !self
             .start
             .iter()
