@@ -479,3 +479,47 @@ fn an_equality_without_the_top_derivative_at_theta_zero_is_refused() {
     assert_eq!(plan.certificate.negative_directions, 0);
     assert!(plan.certificate.feasibility <= 1e-9);
 }
+
+/// $q_1 = 2 q_0$: a constraint of the position alone, which reaches $u$ only through the
+/// evaluation point, by $\theta h^2 / 2$.
+#[jet_function(order = 2)]
+fn on_a_line(q: [f64; 2], _dq: [f64; 2], _ddq: [f64; 2]) -> f64 {
+    q[1] - 2.0 * q[0]
+}
+
+/// The rest-to-rest move to $(1, 2)$ along $q_1 = 2 q_0$ in $T = 1$: the constraint at
+/// every midpoint with the fixed ends is linearly dependent (the alternating sum of the
+/// midpoint rows is the difference of the end rows), so the terminal pivot is regularised
+/// at every iteration, and its solves, refined, meet the consistent rows. (Without the
+/// refinement: 270 iterations at N = 200, the iteration limit at stationarity $10^{-4}$
+/// from N = 400.) The cost converges to the continuous minimum $5 \cdot 6 = 30$ (the
+/// one-dimensional rest-to-rest effort 6, times $1 + 2^2$) at second order.
+#[test]
+fn a_position_constraint_dependent_on_the_ends_converges() {
+    let system = Effort::new();
+    let constraint = OnALine;
+    let goal = [1.0, 2.0, 0.0, 0.0];
+    let errors: Vec<f64> = [200, 400, 1000]
+        .iter()
+        .map(|&steps| {
+            let plan = OptimalControlProblem::new(&system, &[0.0; 4], &goal, 1.0, steps)
+                .with_equality(&constraint)
+                .solve(PlanGuess::Spline)
+                .unwrap_or_else(|e| panic!("N = {steps}: {e}"));
+            assert!(plan.iterations <= 20, "N = {steps}: {}", plan.iterations);
+            assert!(
+                plan.certificate.feasibility <= 1e-9,
+                "{:?}",
+                plan.certificate
+            );
+            assert_eq!(plan.certificate.negative_directions, 0);
+            plan.cost - 30.0
+        })
+        .collect();
+    let ratio = errors[0] / errors[1];
+    assert!((3.9..4.1).contains(&ratio), "errors {errors:?}");
+    assert!(
+        errors.iter().all(|e| *e > 0.0 && *e < 1e-3),
+        "errors {errors:?}"
+    );
+}

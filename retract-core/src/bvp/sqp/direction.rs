@@ -18,6 +18,9 @@ use crate::{Lagrangian, LiftedSystem};
 /// ([`refine`]), and the number of refinement steps.
 const REFINE_RATIO: f64 = 1e6;
 const REFINEMENTS: usize = 2;
+/// The most refinement steps of a solve with a regularised terminal pivot (IPOPT's
+/// `max_refinement_steps`), each only while [`needs_refinement`] says so.
+const REGULARIZED_REFINEMENTS: usize = 10;
 
 /// IPOPT's first inertia correction $\bar\delta_w^0$ (`first_hessian_perturbation`), in the
 /// transcribed problem's units: $h \rho$.
@@ -96,8 +99,10 @@ where
     /// The subproblem solved with the factorisation `riccati` (inertia correction `rho`;
     /// `stale` if it is the previous iterate's): its direction (refined [`REFINEMENTS`] times
     /// where an active inequality's barrier Hessian $h z / s \nabla g \nabla g^T$ is
-    /// [`REFINE_RATIO`] above the rest: it costs the solve digits), the multipliers and
-    /// residuals that go with it, and the errors of the problem and of the barrier problem.
+    /// [`REFINE_RATIO`] above the rest: it costs the solve digits; else, where the refinement
+    /// check is on or the terminal pivot was regularised, while [`needs_refinement`] says so),
+    /// the multipliers and residuals that go with it, and the errors of the problem and of the
+    /// barrier problem.
     pub(super) fn solved(
         &self,
         (models, barrier): (&Models<N, X>, &Barrier),
@@ -118,8 +123,15 @@ where
                 let d = (&mut direction, &mut *pool);
                 refine(&riccati, &self.dynamics, model, rho_h, r0, end, d);
             }
-        } else if self.check_refinement.get() {
-            for _ in 0..REFINEMENTS {
+        } else if self.check_refinement.get() || riccati.regularized {
+            // (a regularised terminal pivot solves the dependent rows only approximately:
+            // refinement, IPOPT's ten steps at most, recovers a consistent system's solution)
+            let steps = if riccati.regularized {
+                REGULARIZED_REFINEMENTS
+            } else {
+                REFINEMENTS
+            };
+            for _ in 0..steps {
                 if !needs_refinement(&self.dynamics, model, rho_h, r0, end, &direction) {
                     break;
                 }
